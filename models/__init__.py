@@ -1,0 +1,61 @@
+"""scatterbench models: polarized light scattering by coated, flake-pigmented,
+rough and diffuse surfaces (seeds 000, 001, 003; conventions in DESIGN.md).
+
+Angles are radians; results broadcast and have shape ``broadcast + (4, 4)``.
+"""
+
+from .base import CHUNK, Model, Sum
+from .facet import FacetBRDF
+from .fresnel import fresnel_coefficients, fresnel_reflectance, fresnel_transmittance
+from .params import ParamInfo
+from .polarization import (
+    ellipsometric,
+    is_physical,
+    jones_to_mueller,
+    reciprocal_jones,
+    reciprocal_mueller,
+    stokes,
+)
+from .slopes import (
+    AnisotropicExponentialSlopes,
+    AnisotropicGaussianSlopes,
+    ExponentialAngles,
+    ExponentialSlopes,
+    GaussianAngles,
+    GaussianSlopes,
+    SlopeDistribution,
+    TabulatedSlopes,
+)
+from .subsurface_facet import SubsurfaceFacetBRDF
+
+__all__ = [
+    "CHUNK",
+    "Model",
+    "Sum",
+    "ParamInfo",
+    "FacetBRDF",
+    "SubsurfaceFacetBRDF",
+    "SlopeDistribution",
+    "ExponentialSlopes",
+    "GaussianSlopes",
+    "AnisotropicExponentialSlopes",
+    "AnisotropicGaussianSlopes",
+    "GaussianAngles",
+    "ExponentialAngles",
+    "TabulatedSlopes",
+    "fresnel_coefficients",
+    "fresnel_reflectance",
+    "fresnel_transmittance",
+    "jones_to_mueller",
+    "ellipsometric",
+    "is_physical",
+    "reciprocal_jones",
+    "reciprocal_mueller",
+    "stokes",
+]
+
+
+def list_models():
+    """Names and parameter listings of every model class (like SCATMECH's model lists)."""
+    classes = [FacetBRDF, SubsurfaceFacetBRDF]
+    return "\n\n".join(c.info() for c in classes)

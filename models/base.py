@@ -1,0 +1,211 @@
+"""The model interface: one evaluation path for one geometry or millions.
+
+Every BRDF/BTDF model is a frozen dataclass of declared parameters
+(:mod:`models.params`) deriving from :class:`Model`.  A model implements
+``_mueller16(theta_i, theta_r, phi_r)`` on flat float64 arrays and returns the
+16 Mueller elements as a ``(16, n)`` array; :class:`Model` validates and
+broadcasts the user's angles, evaluates them in cache-sized chunks (so memory
+stays bounded and numpy's temporaries stay in cache) and returns
+``broadcast_shape + (4, 4)``.  Non-depolarizing models also implement
+``_jones_flat``.
+
+Models combine incoherently with arithmetic, as in ``astropy.modeling``:
+``m1 + m2`` and ``0.3 * m`` give a :class:`Sum`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import broadcast_angles
+from .params import Declared, check_finite_array, check_polar_angle, param
+from .polarization import ellipsometric, stokes
+
+__all__ = ["Model", "Sum", "CHUNK"]
+
+#: Geometries evaluated per chunk: ~20 float64 temporaries of this length fit in L2.
+CHUNK = 8192
+
+
+class Model(Declared):
+    """Base class of every scattering model (BRDF in 1/sr).
+
+    Subclasses set ``depolarizing`` (True when no Jones matrix exists),
+    ``reciprocal`` (True when Helmholtz reciprocity must hold) and
+    ``transmission`` (True for a BTDF, whose second polar angle is measured from
+    -z).
+    """
+
+    depolarizing = False
+    reciprocal = True
+    transmission = False
+    #: angle names used in error messages
+    _angle_names = ("theta_i", "theta_r", "phi_r")
+
+    # -- subclass hooks -----------------------------------------------------------
+    def _mueller16(self, ti, tr, pr):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _jones_flat(self, ti, tr, pr):
+        raise NotImplementedError(f"{type(self).__name__} is depolarizing: it has no Jones matrix")
+
+    # -- validation and chunked evaluation ----------------------------------------
+    def _angles(self, theta_i, theta_r, phi_r):
+        n1, n2, n3 = self._angle_names
+        ti = check_polar_angle(n1, theta_i)
+        tr = check_polar_angle(n2, theta_r)
+        pr = check_finite_array(n3, phi_r)
+        return broadcast_angles(ti, tr, pr)
+
+    def mueller(self, theta_i, theta_r, phi_r=0.0):
+        """Mueller-matrix BRDF ``(..., 4, 4)`` in 1/sr, s/p bases (SCATMECH ``psps``)."""
+        shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
+        n = ti.size
+        out = np.empty((n, 16))
+        for start in range(0, n, CHUNK):
+            sl = slice(start, min(start + CHUNK, n))
+            block = self._mueller16(ti[sl], tr[sl], pr[sl])
+            out[sl] = block.T
+        return out.reshape(shape + (4, 4))
+
+    def brdf(self, theta_i, theta_r, phi_r=0.0):
+        """Unpolarized-in, total-out BRDF ``M00`` (1/sr)."""
+        shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
+        n = ti.size
+        out = np.empty(n)
+        for start in range(0, n, CHUNK):
+            sl = slice(start, min(start + CHUNK, n))
+            out[sl] = self._brdf_flat(ti[sl], tr[sl], pr[sl])
+        return out.reshape(shape)
+
+    def _brdf_flat(self, ti, tr, pr):
+        return self._mueller16(ti, tr, pr)[0]
+
+    def jones(self, theta_i, theta_r, phi_r=0.0):
+        """Jones matrix ``(..., 2, 2)`` acting on ``(E_s, E_p)``, normalized so that its
+        Mueller matrix is the Mueller BRDF (units sr^-1/2).  Only for
+        non-depolarizing models; the overall phase is arbitrary."""
+        if self.depolarizing:
+            raise NotImplementedError(
+                f"{type(self).__name__} is depolarizing: it has no Jones matrix"
+            )
+        shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
+        n = ti.size
+        out = np.empty((n, 2, 2), dtype=complex)
+        for start in range(0, n, CHUNK):
+            sl = slice(start, min(start + CHUNK, n))
+            out[sl] = self._jones_flat(ti[sl], tr[sl], pr[sl])
+        return out.reshape(shape + (2, 2))
+
+    def scattered_stokes(self, theta_i, theta_r, phi_r=0.0, incident="unpolarized"):
+        """Scattered Stokes vector BRDF ``(..., 4)`` for an incident state (name or vector)."""
+        s_in = stokes(incident)
+        return self.mueller(theta_i, theta_r, phi_r) @ s_in
+
+    def polarization(self, theta_i, theta_r, phi_r=0.0, incident="unpolarized"):
+        """``dict(brdf, eta, P_C, P)`` of the scattered light (seed 000 Sec. 3)."""
+        s_in = np.asarray(stokes(incident))
+        i, eta, pc, p = ellipsometric(self.scattered_stokes(theta_i, theta_r, phi_r, s_in))
+        return {"brdf": i / s_in[0], "eta": eta, "P_C": pc, "P": p}
+
+    def rotated(self, angle):
+        """The model of the sample rotated by ``angle`` about z.  Models with no
+        preferred azimuth (isotropic slopes, smooth interfaces) return themselves."""
+        return self
+
+    # -- integration hints -------------------------------------------------------------
+    def lobe(self, theta_i):
+        """``(theta_center, phi_center, width)`` of a narrow lobe, or ``None``.
+
+        Integrators use it to put points where the model is sharply peaked.
+        """
+        return None
+
+    # -- composition -----------------------------------------------------------------
+    def __add__(self, other):
+        if not isinstance(other, Model):
+            return NotImplemented
+        return Sum(terms=tuple(_terms(self) + _terms(other)))
+
+    def __mul__(self, w):
+        if isinstance(w, Model):
+            return NotImplemented
+        return Sum(terms=tuple((float(w) * k, m) for k, m in _terms(self)))
+
+    __rmul__ = __mul__
+
+    @classmethod
+    def info(cls) -> str:
+        """Docstring summary and declared parameters, for listing models."""
+        head = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else cls.__name__
+        lines = [f"{cls.__name__}: {head}"]
+        for p in cls.parameters():
+            lines.append(f"    {p.name:<12} default={p.default!r:<14} {p.doc} ({p.range_text()})")
+        return "\n".join(lines)
+
+
+def _terms(m):
+    if isinstance(m, Sum):
+        return list(m.terms)
+    return [(1.0, m)]
+
+
+@dataclass(frozen=True)
+class Sum(Model):
+    """Incoherent, weighted sum of models: ``M = sum_k w_k M_k``.
+
+    Built by ``m1 + m2`` and ``w * m``.  Depolarizing in general (a sum of
+    Jones-derived Mueller matrices need not be one), reciprocal when every term
+    is.
+    """
+
+    terms: tuple = param((), "tuple of (weight, model) pairs", kind="object")
+
+    depolarizing = True
+
+    def _validate(self):
+        if not self.terms:
+            raise ValueError("terms must hold at least one (weight, model) pair")
+        clean = []
+        for item in self.terms:
+            if not (isinstance(item, tuple) and len(item) == 2 and isinstance(item[1], Model)):
+                raise ValueError("terms must be (weight, model) pairs with a Model instance")
+            w = float(item[0])
+            if not math.isfinite(w) or w < 0:
+                raise ValueError(f"weight must be a finite real >= 0; got {item[0]!r}")
+            clean.append((w, item[1]))
+        object.__setattr__(self, "terms", tuple(clean))
+        if any(m.transmission != self.terms[0][1].transmission for _, m in self.terms):
+            raise ValueError("terms must all be BRDFs or all BTDFs")
+
+    @property
+    def transmission(self):  # type: ignore[override]
+        return self.terms[0][1].transmission
+
+    @property
+    def reciprocal(self):  # type: ignore[override]
+        return all(m.reciprocal for _, m in self.terms)
+
+    def _mueller16(self, ti, tr, pr):
+        total = None
+        for w, m in self.terms:
+            block = w * m._mueller16(ti, tr, pr)
+            total = block if total is None else total + block
+        return total
+
+    def lobe(self, theta_i):
+        lobes = [m.lobe(theta_i) for _, m in self.terms]
+        lobes = [lb for lb in lobes if lb is not None]
+        if not lobes:
+            return None
+        return min(lobes, key=lambda lb: lb[2])
+
+    def rotated(self, angle):
+        return Sum(terms=tuple((w, m.rotated(angle)) for w, m in self.terms))
+
+    def __repr__(self):
+        return " + ".join(f"{w:g}*{m!r}" for w, m in self.terms)
+

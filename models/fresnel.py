@@ -1,0 +1,140 @@
+"""Fresnel amplitude coefficients of a single planar interface (Born & Wolf).
+
+All functions take the cosine of the angle of incidence ``c`` in medium ``n1``
+and the relative index ``m = n2 / n1`` (complex ``n + ik`` with ``k >= 0`` for
+absorbing media, ``math.inf`` for a perfect conductor).  With
+``w = m cos(theta_t) = sqrt(m^2 - 1 + c^2)`` on the principal branch
+(``+i|...|`` beyond the critical angle, the decaying evanescent wave):
+
+    r_s = (c - w) / (c + w)            t_s = 2 c / (c + w)
+    r_p = (m^2 c - w) / (m^2 c + w)    t_p = 2 m c / (m^2 c + w)
+
+This is the sign convention of SCATMECH (``Thin_Film_Transfer_Matrix`` with no
+films): ``r_p = -r_s`` at normal incidence.  Seed 000 Appendix Eq. A.2 as
+printed has ``(n2/n1) cos(theta)`` where ``(n2/n1)^2 cos(theta)`` belongs (with
+it ``r_p`` would vanish at normal incidence for every material), and Eq. A.3-A.4
+carry stray factors ``n1`` and ``n1/n2``; the standard forms above are used and
+tested (``R + T = 1`` with the ``Re(w)/c`` flux factor, agreement with SCATMECH).
+A perfect conductor has ``r_s = -1``, ``r_p = +1``, ``t_s = t_p = 0``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "fresnel_coefficients",
+    "fresnel_reflectance",
+    "fresnel_transmittance",
+    "reflection_rs_k",
+    "coating_transmission",
+    "critical_angle",
+]
+
+
+def _w(c, m):
+    arg = m * m - 1.0 + c * c
+    arg = np.asarray(arg, dtype=complex)
+    arg = np.where(arg.imag == 0, arg.real + 0j, arg)  # +0 imaginary part: TIR branch +i
+    return np.sqrt(arg)
+
+
+def fresnel_coefficients(cos_i, n1, n2):
+    """``(r_s, r_p, t_s, t_p)`` for light in ``n1`` (real) hitting ``n2``.
+
+    ``cos_i`` is the cosine of the angle of incidence (array, in [0, 1]).
+    ``n2`` may be complex (``k >= 0``) or ``math.inf``.
+    """
+    c = np.asarray(cos_i, dtype=float)
+    if n2 == math.inf:
+        one = np.ones_like(c, dtype=complex)
+        return -one, one.copy(), 0 * one, 0 * one
+    m = complex(n2) / complex(n1)
+    if m == 1:
+        zero = np.zeros_like(c, dtype=complex)
+        return zero, zero.copy(), zero + 1, zero + 1
+    w = _w(c, m)
+    m2c = m * m * c
+    rs = (c - w) / (c + w)
+    rp = (m2c - w) / (m2c + w)
+    ts = 2 * c / (c + w)
+    tp = 2 * m * c / (m2c + w)
+    return rs, rp, ts, tp
+
+
+def fresnel_reflectance(cos_i, n1, n2):
+    """Intensity reflectances ``(R_s, R_p)``."""
+    rs, rp, _, _ = fresnel_coefficients(cos_i, n1, n2)
+    return np.abs(rs) ** 2, np.abs(rp) ** 2
+
+
+def fresnel_transmittance(cos_i, n1, n2):
+    """Intensity transmittances ``(T_s, T_p)`` into a non-absorbing ``n2``.
+
+    ``T = Re(n2 cos t) / (n1 cos i) |t|^2 = Re(w) / c |t|^2``: the ratio of the
+    normal components of the Poynting vectors, zero beyond the critical angle.
+    """
+    if n2 == math.inf:
+        z = np.zeros_like(np.asarray(cos_i, float))
+        return z, z.copy()
+    c = np.asarray(cos_i, dtype=float)
+    m = complex(n2) / complex(n1)
+    if m.imag != 0:
+        raise ValueError("fresnel_transmittance needs a non-absorbing n2 (k = 0)")
+    _, _, ts, tp = fresnel_coefficients(c, n1, n2)
+    w = _w(c, m)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = np.where(c > 0, w.real / np.where(c > 0, c, 1.0), 0.0)
+    return f * np.abs(ts) ** 2, f * np.abs(tp) ** 2
+
+
+def reflection_rs_k(cos_i, m):
+    """``r_s`` and ``K = (r_s + r_p) / sin^2(theta)`` for a reflection at cosine ``cos_i``.
+
+    ``K = 2 (1 - m^2) / ((c + w)(m^2 c + w))`` is smooth at normal incidence,
+    where ``r_s + r_p`` and ``sin^2`` both vanish.  The facet Jones matrices are
+    written with ``r_s`` and ``K`` so that they need no division by
+    ``sin^2(2 alpha)`` (seed 000 Eq. 19a), which is what makes exact
+    retroreflection (alpha = 0) finite.  ``m`` is the relative index (complex,
+    scalar) or ``math.inf``.
+    """
+    c = np.asarray(cos_i, dtype=float)
+    if m == math.inf:
+        return np.full(c.shape, -1.0 + 0j), np.zeros(c.shape, dtype=complex)
+    m = complex(m)
+    if m == 1:
+        z = np.zeros(c.shape, dtype=complex)
+        return z, z.copy()
+    w = _w(c, m)
+    cw = c + w
+    m2 = m * m
+    rs = (c - w) / cw
+    k = 2.0 * (1.0 - m2) / (cw * (m2 * c + w))
+    return rs, k
+
+
+def coating_transmission(cos_theta, n):
+    """Real ``t_s(theta; 1, n)`` and ``t_p(theta; 1, n)`` into a non-absorbing ``n >= 1``.
+
+    From the ambient (index 1) into the coating there is no total internal
+    reflection, so these are real; ``cos_theta`` is the external cosine.
+    """
+    c = np.asarray(cos_theta, dtype=float)
+    n = float(n)
+    w = np.sqrt(n * n - 1.0 + c * c)
+    ts = 2.0 * c / (c + w)
+    tp = 2.0 * n * c / (n * n * c + w)
+    return ts, tp
+
+
+def critical_angle(n1, n2):
+    """Critical angle (radians) for light in ``n1`` hitting a real ``n2 < n1``; ``None`` if none."""
+    n1 = float(np.real(n1))
+    if n2 == math.inf:
+        return None
+    n2 = complex(n2)
+    if n2.imag != 0 or n2.real >= n1:
+        return None
+    return math.asin(n2.real / n1)

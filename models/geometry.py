@@ -1,0 +1,88 @@
+"""Scattering geometry shared by every model (DESIGN.md conventions, SCATMECH's).
+
+Mean surface normal +z.  The incident ray travels along
+``k_i = (sin ti, 0, -cos ti)`` (incident azimuth pi); the reflected ray along
+``k_r = (sin tr cos pr, sin tr sin pr, cos tr)``; specular is ``tr = ti, pr = 0``
+and retroreflection ``tr = ti, pr = pi``.  A transmitted ray travels along
+``(sin tt cos pt, sin tt sin pt, -cos tt)``.
+
+Polarization basis per ray (seed 000 Sec. 2.B, SCATMECH ``GetBasisVectorsSP``):
+``s = unit(z x k)``, ``p = k x s`` so that ``{s, p, k}`` is right-handed; for a
+ray along the z axis ``s = y``.  This fixes two printed slips of seed 000 Eq. 8:
+Eq. 8a has ``cos(phi_r)`` where ``sin(phi_r)`` belongs (``s_r = -x sin(phi_r) +
+y cos(phi_r)``), and with Eq. 8b as printed ``{s, p, k}`` would be left-handed;
+the right-handed ``p_r`` is ``-x cos(tr)cos(pr) - y cos(tr)sin(pr) + z sin(tr)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "incident_direction",
+    "scattered_direction",
+    "transmitted_direction",
+    "sp_basis",
+    "refracted_cos",
+    "broadcast_angles",
+]
+
+
+def incident_direction(theta_i):
+    """Unit propagation vector of the incident ray, shape ``(..., 3)``."""
+    t = np.asarray(theta_i, dtype=float)
+    return np.stack([np.sin(t), np.zeros_like(t), -np.cos(t)], axis=-1)
+
+
+def scattered_direction(theta_r, phi_r):
+    """Unit propagation vector of a ray leaving the surface upward, ``(..., 3)``."""
+    t, p = np.broadcast_arrays(np.asarray(theta_r, float), np.asarray(phi_r, float))
+    st = np.sin(t)
+    return np.stack([st * np.cos(p), st * np.sin(p), np.cos(t)], axis=-1)
+
+
+def transmitted_direction(theta_t, phi_t):
+    """Unit propagation vector of a ray transmitted downward, ``(..., 3)``."""
+    t, p = np.broadcast_arrays(np.asarray(theta_t, float), np.asarray(phi_t, float))
+    st = np.sin(t)
+    return np.stack([st * np.cos(p), st * np.sin(p), -np.cos(t)], axis=-1)
+
+
+def sp_basis(k):
+    """The ``(s, p)`` polarization basis of propagation vectors ``k`` (``(..., 3)``).
+
+    ``s = unit(z x k)`` and ``p = k x s``; along the z axis (where ``z x k`` is
+    zero) ``s`` is taken as ``+y`` as SCATMECH does.
+    """
+    k = np.asarray(k, dtype=float)
+    s = np.stack([-k[..., 1], k[..., 0], np.zeros_like(k[..., 0])], axis=-1)
+    norm = np.sqrt(s[..., 0] ** 2 + s[..., 1] ** 2)
+    along_z = norm <= 1e-15
+    safe = np.where(along_z, 1.0, norm)
+    s = s / safe[..., None]
+    s = np.where(along_z[..., None], np.array([0.0, 1.0, 0.0]), s)
+    p = np.cross(k, s)
+    return s, p
+
+
+def refracted_cos(sin_theta, n1, n2):
+    """``cos`` of the refracted angle in medium ``n2`` for a ray at ``sin_theta`` in ``n1``.
+
+    Complex in general: ``sqrt(1 - (n1 sin / n2)^2)`` on the principal branch,
+    which for real indices beyond the critical angle gives ``+i|...|`` (the
+    evanescent, decaying wave) and for ``n2 = n + ik`` with ``k >= 0`` a
+    non-negative imaginary part.  Same branch as SCATMECH's
+    ``cos_internal_angle``.
+    """
+    ratio = np.asarray(n1, dtype=complex) / np.asarray(n2, dtype=complex)
+    arg = 1.0 - (ratio * np.asarray(sin_theta)) ** 2
+    # Force a +0 imaginary part where it vanished so TIR takes the +i branch.
+    arg = np.where(arg.imag == 0, arg.real + 0j, arg)
+    return np.sqrt(arg)
+
+
+def broadcast_angles(*arrays):
+    """Broadcast angle arrays to one shape; returns ``(shape, flat arrays)``."""
+    b = np.broadcast_arrays(*[np.asarray(a, dtype=float) for a in arrays])
+    shape = b[0].shape
+    return shape, [np.ascontiguousarray(x).reshape(-1) for x in b]

@@ -1,0 +1,228 @@
+"""Declared, validated model parameters.
+
+Every model and distribution in :mod:`models` is a frozen dataclass whose fields
+are declared with :func:`param`: a default, a one-line description and a kind
+that fixes the allowed range.  ``Declared.__post_init__`` validates every field
+and raises a ``ValueError`` that names the parameter and its allowed range, so a
+bad value never reaches the physics.  ``Cls.parameters()`` lists the declared
+parameters the way SCATMECH's ``AskUser``/``ListParameters`` does.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "Declared",
+    "ParamInfo",
+    "param",
+    "check_real",
+    "check_index",
+    "check_polar_angle",
+    "check_finite_array",
+]
+
+
+@dataclass(frozen=True)
+class ParamInfo:
+    """What a declared parameter is: name, default, description and range."""
+
+    name: str
+    default: Any
+    doc: str
+    kind: str
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+
+    def range_text(self) -> str:
+        if self.kind == "index":
+            return "n + ik with n > 0 and k >= 0, or math.inf (perfect conductor)"
+        if self.kind == "real_index":
+            return f"real, finite, >= {self.low:g}"
+        if self.kind in ("real", "int"):
+            lo = "-inf" if self.low is None else f"{self.low:g}"
+            hi = "inf" if self.high is None else f"{self.high:g}"
+            lb = "(" if (self.low_open or self.low is None) else "["
+            hb = ")" if (self.high_open or self.high is None) else "]"
+            what = "integer" if self.kind == "int" else "finite real"
+            return f"{what} in {lb}{lo}, {hi}{hb}"
+        if self.kind == "choice":
+            return "one of " + ", ".join(repr(c) for c in self.low)
+        return self.kind
+
+
+def param(
+    default: Any,
+    doc: str,
+    *,
+    kind: str = "real",
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    high_open: bool = False,
+    choices: tuple | None = None,
+):
+    """Declare a model parameter (a dataclass field with validation metadata).
+
+    ``kind`` is one of ``real``, ``int``, ``index`` (complex refractive index,
+    ``k >= 0``, ``math.inf`` allowed), ``real_index`` (non-absorbing index
+    ``>= low``), ``choice`` (``choices``), ``object`` (checked by the model).
+    """
+    info = dict(
+        doc=doc,
+        kind=kind,
+        low=tuple(choices) if kind == "choice" else low,
+        high=high,
+        low_open=low_open,
+        high_open=high_open,
+    )
+    if isinstance(default, (list, dict, np.ndarray)):
+        return field(default_factory=lambda: default, metadata={"scatterbench": info})
+    return field(default=default, metadata={"scatterbench": info})
+
+
+def check_real(name, value, low=None, high=None, low_open=False, high_open=False) -> float:
+    """Return ``value`` as a float or raise ``ValueError`` naming ``name`` and the range."""
+    lo = "-inf" if low is None else f"{low:g}"
+    hi = "inf" if high is None else f"{high:g}"
+    lb = "(" if (low_open or low is None) else "["
+    hb = ")" if (high_open or high is None) else "]"
+    rng = f"a finite real number in {lb}{lo}, {hi}{hb}"
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        if isinstance(value, numbers.Complex) and complex(value).imag == 0:
+            value = complex(value).real
+        else:
+            raise ValueError(f"{name} must be {rng}; got {value!r}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be {rng}; got {value!r}")
+    bad = (
+        (low is not None and (v < low or (low_open and v == low)))
+        or (high is not None and (v > high or (high_open and v == high)))
+    )
+    if bad:
+        raise ValueError(f"{name} must be {rng}; got {value!r}")
+    return v
+
+
+def check_index(name, value) -> complex | float:
+    """Validate a refractive index ``n + ik`` (``k >= 0``) or ``math.inf``.
+
+    Returns ``math.inf`` for a perfect conductor, otherwise a ``complex`` whose
+    imaginary part is a non-negative float (``-0.0`` is normalised to ``+0.0`` so
+    that the principal square roots used for total internal reflection pick the
+    evanescent, decaying branch).
+    """
+    rng = "n + ik with n > 0 and k >= 0 (both finite), or math.inf for a perfect conductor"
+    if isinstance(value, bool) or not isinstance(value, numbers.Complex):
+        raise ValueError(f"{name} must be {rng}; got {value!r}")
+    z = complex(value)
+    if z.real == math.inf and z.imag == 0:
+        return math.inf
+    if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+        raise ValueError(f"{name} must be {rng}; got {value!r}")
+    if z.real <= 0 or z.imag < 0:
+        raise ValueError(f"{name} must be {rng}; got {value!r}")
+    return complex(z.real, abs(z.imag))
+
+
+def check_polar_angle(name, value) -> np.ndarray:
+    """Polar angles in radians: finite, in [0, pi/2]. Returns a float array."""
+    a = check_finite_array(name, value)
+    if a.size and (np.min(a) < 0.0 or np.max(a) > math.pi / 2):
+        raise ValueError(
+            f"{name} must lie in [0, pi/2] radians (a polar angle above the surface); "
+            f"got values in [{np.min(a):.6g}, {np.max(a):.6g}]"
+        )
+    return a
+
+
+def check_finite_array(name, value) -> np.ndarray:
+    """A real array with only finite values (float32 is promoted to float64)."""
+    try:
+        a = np.asarray(value)
+    except Exception as exc:  # pragma: no cover - numpy raises many types
+        raise ValueError(f"{name} must be a real number or array of real numbers") from exc
+    if a.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be a real number or array of real numbers; got {a.dtype}")
+    a = a.astype(np.float64, copy=False)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite (no NaN or inf)")
+    return a
+
+
+class Declared:
+    """Mixin for frozen dataclasses whose fields were declared with :func:`param`."""
+
+    def __post_init__(self):
+        for f in dataclasses.fields(self):
+            info = f.metadata.get("scatterbench")
+            if info is None:
+                continue
+            value = getattr(self, f.name)
+            kind = info["kind"]
+            if kind == "real":
+                v = check_real(
+                    f.name, value, info["low"], info["high"], info["low_open"], info["high_open"]
+                )
+            elif kind == "int":
+                if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+                    raise ValueError(f"{f.name} must be an integer; got {value!r}")
+                check_real(
+                    f.name, value, info["low"], info["high"], info["low_open"], info["high_open"]
+                )
+                v = int(value)
+            elif kind == "index":
+                v = check_index(f.name, value)
+            elif kind == "real_index":
+                z = value
+                if isinstance(z, numbers.Complex) and not isinstance(z, numbers.Real):
+                    if complex(z).imag != 0:
+                        raise ValueError(
+                            f"{f.name} must be a real (non-absorbing) index >= {info['low']:g}; "
+                            f"got {value!r}"
+                        )
+                    z = complex(z).real
+                v = check_real(f.name, z, info["low"], None)
+            elif kind == "choice":
+                if value not in info["low"]:
+                    allowed = ", ".join(repr(c) for c in info["low"])
+                    raise ValueError(f"{f.name} must be one of {allowed}; got {value!r}")
+                v = value
+            else:
+                v = value
+            object.__setattr__(self, f.name, v)
+        self._validate()
+
+    def _validate(self):
+        """Hook for cross-parameter checks in subclasses."""
+
+    @classmethod
+    def parameters(cls) -> list[ParamInfo]:
+        """The declared parameters: name, default, description and allowed range."""
+        out = []
+        for f in dataclasses.fields(cls):
+            info = f.metadata.get("scatterbench")
+            if info is None:
+                continue
+            default = f.default if f.default is not dataclasses.MISSING else None
+            out.append(ParamInfo(name=f.name, default=default, **info))
+        return out
+
+    def replace(self, **changes):
+        """A copy with some parameters changed (validated again)."""
+        return dataclasses.replace(self, **changes)
+
+    def describe(self) -> str:
+        lines = [type(self).__name__]
+        for p in self.parameters():
+            lines.append(f"  {p.name} = {getattr(self, p.name)!r}  # {p.doc}; {p.range_text()}")
+        return "\n".join(lines)
