@@ -26,8 +26,9 @@ from .polarization import ellipsometric, stokes
 
 __all__ = ["Model", "Sum", "CHUNK"]
 
-#: Geometries evaluated per chunk: ~20 float64 temporaries of this length fit in L2.
-CHUNK = 8192
+#: Geometries evaluated per chunk, chosen so a model's float64 temporaries stay in
+#: L2 cache (measured best of 1024..32768 for the facet models on this machine).
+CHUNK = 4096
 
 
 class Model(Declared):
@@ -208,4 +209,3 @@ class Sum(Model):
 
     def __repr__(self):
         return " + ".join(f"{w:g}*{m!r}" for w, m in self.terms)
-

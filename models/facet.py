@@ -25,9 +25,9 @@ products reduce to Eq. 19's ``a2 = p_r'.h`` and ``a3 = p_i'.h`` and to
 ``alpha = 0`` (:func:`models.fresnel.reflection_rs_k`), so exact
 retroreflection is finite with no special case, where Eq. 18 is 0/0.  Because
 ``q = r_s U + K V`` with real ``U``, ``V`` (a non-absorbing coating has real
-transmission coefficients), the Mueller matrix needs only the four real numbers
-``|r_s|^2, |K|^2, Re(r_s K*), Im(r_s K*)``: the whole evaluation is real
-arithmetic on cache-sized chunks.
+transmission coefficients), the Jones elements are formed directly as real and
+imaginary parts and the Mueller matrix follows in real arithmetic on cache-sized
+chunks (:func:`models.polarization.mueller16_from_jones`).
 """
 
 from __future__ import annotations
@@ -40,117 +40,81 @@ import numpy as np
 from .base import Model
 from .fresnel import coating_transmission, reflection_rs_k
 from .params import param
-from .polarization import mueller_from_products
+from .polarization import mueller16_from_jones
 from .slopes import ExponentialSlopes, SlopeDistribution
 
-__all__ = ["FacetBRDF", "facet_reflection"]
+__all__ = ["FacetBRDF", "facet_jones"]
 
 
-def _geometry(ti, tr, pr, n):
-    """Internal directions, facet vector ``h`` and the q-matrix factors."""
-    sti, cti = np.sin(ti), np.cos(ti)
-    st_r, ct_r = np.sin(tr), np.cos(tr)
-    cp, sp = np.cos(pr), np.sin(pr)
+def facet_jones(ti, tr, pr, n, substrate, slopes):
+    """Jones elements ``(ss, ps, sp, pp)`` as ``(re, im)`` pairs of flat arrays
+    (``ps`` = p in, s out), scaled so that their Mueller matrix is the BRDF.
+
+    Flat float64 arrays in.  Zero where a ray is grazing (``theta = pi/2``: no
+    projected area, as in SCATMECH) or where the slope density vanishes.
+    """
+    # Incident and scattered polar angles are handled as one (2, n) stack: the
+    # same trigonometry, Snell refraction and coating transmission for both.
+    cos_ext = np.cos(np.stack([ti, tr]))
+    # sin = sqrt(1 - cos^2): exact to ~1e-16 absolute (it loses relative precision
+    # only below ~1e-8 rad, where sin enters additively); cos, which divides the
+    # BRDF, stays exact.
+    sin_ext = np.sqrt(np.maximum(1.0 - cos_ext * cos_ext, 0.0))
+    sp, cp = np.sin(pr), np.cos(pr)
     if n == 1.0:
-        si, ci, sr, cr = sti, cti, st_r, ct_r
+        sin_int, cos_int = sin_ext, cos_ext
     else:
-        si = sti / n  # Eq. 2
-        sr = st_r / n  # Eq. 3
-        ci = np.sqrt(1.0 - si * si)
-        cr = np.sqrt(1.0 - sr * sr)
+        sin_int = sin_ext * (1.0 / n)  # Eq. 2-3
+        cos_int = np.sqrt(1.0 - sin_int * sin_int)
+    si, sr = sin_int
+    ci, cr = cos_int
+    # h = k_r' - k_i' bisects the internal directions: facet normal h/|h| (Eq. 5-7).
     hx = sr * cp - si
     hy = sr * sp
     hz = cr + ci
     g = hx * hx + hy * hy + hz * hz  # |h|^2 = 4 cos^2(alpha), Eq. 5
-    return sti, cti, st_r, ct_r, cp, sp, si, ci, sr, cr, hx, hy, hz, g
-
-
-def facet_reflection(ti, tr, pr, n, substrate, slopes):
-    """Real decomposition ``q = r_s U + K V`` and the Eq. 49 prefactor.
-
-    Returns ``(S, rs, K, U, V)`` for flat arrays; ``U`` and ``V`` are dicts over
-    ``ss, ps, sp, pp`` (``ps`` = p in, s out).  ``S`` is zero where no facet
-    connects the two directions or a ray is grazing (``cos = 0``).
-    """
-    (sti, cti, st_r, ct_r, cp, sp, si, ci, sr, cr, hx, hy, hz, g) = _geometry(ti, tr, pr, n)
-    ok = (cti > 0) & (ct_r > 0)
-    hz_safe = np.where(ok, hz, 1.0)
-    g_safe = np.where(ok, g, 1.0)
-    zx = hx / hz_safe
-    zy = hy / hz_safe
-    p3 = slopes.p3(zx, zy)
-    # Eq. 49: P3 / (4 cos ti cos tr cos^4 theta_n), cos theta_n = hz / |h|.
-    denom = np.where(ok, 4.0 * cti * ct_r * hz_safe**4, 1.0)
-    S = np.where(ok, p3 * g_safe * g_safe / denom, 0.0)
-    c = 0.5 * np.sqrt(g_safe)  # cos(alpha), local incidence in the coating
-    m = substrate if substrate == math.inf else complex(substrate) / n
-    rs, K = reflection_rs_k(np.minimum(c, 1.0), m)
-    a2 = cr * cp * si + sr * ci  # p_r'.h  (Eq. 19b)
-    a3 = ci * sr * cp + si * cr  # p_i'.h  (Eq. 19c)
-    e_r = si * sp  # s_r'.h
-    e_i = sr * sp  # s_i'.h
-    inv_g = 1.0 / g_safe
-    V = {"ss": e_r * e_i * inv_g, "ps": e_r * a3 * inv_g, "sp": a2 * e_i * inv_g, "pp": a2 * a3 * inv_g}
-    D = {"ss": cp, "ps": -sp * ci, "sp": -cr * sp, "pp": sr * si - cr * cp * ci}
-    if n != 1.0:
-        # Eq. 16-18: t(theta_r; 1, n) for the outgoing index, t(theta_i; 1, n) incoming.
-        tsi, tpi = coating_transmission(cti, n)
-        tsr, tpr = coating_transmission(ct_r, n)
-        tt = {"ss": tsr * tsi, "ps": tsr * tpi, "sp": tpr * tsi, "pp": tpr * tpi}
-    else:
-        tt = None
-    U = {}
-    for k in ("ss", "ps", "sp", "pp"):
-        u = D[k] - 2.0 * V[k]
-        v = V[k]
-        if tt is not None:
-            u = u * tt[k]
-            v = v * tt[k]
-        U[k] = u
-        V[k] = v
-    return S, rs, K, U, V
-
-
-def facet_mueller16(S, rs, K, U, V):
-    """Mueller elements ``(16, n)`` of ``S * Mueller(r_s U + K V)`` in real arithmetic."""
-    A = S * (rs.real**2 + rs.imag**2)
-    B = S * (K.real**2 + K.imag**2)
-    x = rs * np.conj(K)
-    a = S * x.real
-    b = S * x.imag
-
-    def norm(k):
-        u, v = U[k], V[k]
-        return A * u * u + B * v * v + 2.0 * a * u * v
-
-    def prod(k1, k2):
-        u1, v1, u2, v2 = U[k1], V[k1], U[k2], V[k2]
-        cross = u1 * v2
-        cross2 = v1 * u2
-        return A * u1 * u2 + B * v1 * v2 + a * (cross + cross2), b * (cross - cross2)
-
-    return mueller_from_products(
-        norm("ss"),
-        norm("pp"),
-        norm("ps"),
-        norm("sp"),
-        prod("ss", "ps"),
-        prod("pp", "sp"),
-        prod("ss", "sp"),
-        prod("pp", "ps"),
-        prod("pp", "ss"),
-        prod("ps", "sp"),
-    )
-
-
-def facet_jones(S, rs, K, U, V):
+    inv_hz = 1.0 / hz
+    p3 = slopes.p3(hx * inv_hz, hy * inv_hz)
+    # Eq. 49: P3 / (4 cos ti cos tr cos^4 theta_n), with cos theta_n = hz / |h|.
+    q = g * inv_hz * inv_hz
+    S = p3 * q * q / (4.0 * cos_ext[0] * cos_ext[1])
+    S[(ti >= 0.5 * math.pi) | (tr >= 0.5 * math.pi)] = 0.0
     root = np.sqrt(S)
-    J = np.empty(S.shape + (2, 2), dtype=complex)
-    J[:, 0, 0] = root * (rs * U["ss"] + K * V["ss"])
-    J[:, 0, 1] = root * (rs * U["ps"] + K * V["ps"])
-    J[:, 1, 0] = root * (rs * U["sp"] + K * V["sp"])
-    J[:, 1, 1] = root * (rs * U["pp"] + K * V["pp"])
-    return J
+    c = np.minimum(0.5 * np.sqrt(g), 1.0)  # cos(alpha), local incidence in the coating
+    m = substrate if substrate == math.inf else complex(substrate) / n
+    rs, K = reflection_rs_k(c, m)
+    # q_ab = r_s D_ab + (K - 2 r_s) (e_a.h)(e_b.h)/|h|^2  (see module docstring)
+    r_re = rs.real * root
+    r_im = rs.imag * root
+    k_re = K.real * root - 2.0 * r_re
+    k_im = K.imag * root - 2.0 * r_im
+    inv_g = 1.0 / g
+    ho_s = si * sp  # s_r'.h
+    ho_p = cr * cp * si + sr * ci  # p_r'.h  (a2, Eq. 19b)
+    hi_s = sr * sp * inv_g  # s_i'.h / |h|^2
+    hi_p = (ci * sr * cp + si * cr) * inv_g  # p_i'.h / |h|^2  (a3, Eq. 19c)
+    d_ss, d_ps, d_sp, d_pp = cp, -sp * ci, -cr * sp, sr * si - cr * cp * ci  # e_a . e_b
+    if n != 1.0:
+        # Eq. 14-18: t(theta_r; 1, n) on the way out, t(theta_i; 1, n) on the way in.
+        (tsi, tsr), (tpi, tpr) = coating_transmission(cos_ext, n)
+        ho_s = ho_s * tsr
+        ho_p = ho_p * tpr
+        hi_s = hi_s * tsi
+        hi_p = hi_p * tpi
+        d_ss = d_ss * (tsr * tsi)
+        d_ps = d_ps * (tsr * tpi)
+        d_sp = d_sp * (tpr * tsi)
+        d_pp = d_pp * (tpr * tpi)
+
+    def elem(d, b):
+        return r_re * d + k_re * b, r_im * d + k_im * b
+
+    return (
+        elem(d_ss, ho_s * hi_s),
+        elem(d_ps, ho_s * hi_p),
+        elem(d_sp, ho_p * hi_s),
+        elem(d_pp, ho_p * hi_p),
+    )
 
 
 class _FacetModel(Model):
@@ -160,24 +124,22 @@ class _FacetModel(Model):
         return 1.0
 
     def _parts(self, ti, tr, pr):
-        return facet_reflection(ti, tr, pr, self._coating(), self.substrate, self.slopes)
+        return facet_jones(ti, tr, pr, self._coating(), self.substrate, self.slopes)
 
     def _mueller16(self, ti, tr, pr):
-        return facet_mueller16(*self._parts(ti, tr, pr))
+        return mueller16_from_jones(*self._parts(ti, tr, pr))
 
     def _jones_flat(self, ti, tr, pr):
-        return facet_jones(*self._parts(ti, tr, pr))
+        J = np.empty(ti.shape + (4,), dtype=complex)
+        for k, (re, im) in enumerate(self._parts(ti, tr, pr)):
+            J[:, k] = re + 1j * im
+        return J.reshape(ti.shape + (2, 2))
 
     def _brdf_flat(self, ti, tr, pr):
-        S, rs, K, U, V = self._parts(ti, tr, pr)
-        A = rs.real**2 + rs.imag**2
-        B = K.real**2 + K.imag**2
-        a = (rs * np.conj(K)).real
         tot = 0.0
-        for k in ("ss", "ps", "sp", "pp"):
-            u, v = U[k], V[k]
-            tot = tot + A * u * u + B * v * v + 2.0 * a * u * v
-        return 0.5 * S * tot
+        for re, im in self._parts(ti, tr, pr):
+            tot = tot + re * re + im * im
+        return 0.5 * tot
 
     def _validate(self):
         if not isinstance(self.slopes, SlopeDistribution):
@@ -190,7 +152,7 @@ class _FacetModel(Model):
         return self.replace(slopes=self.slopes.rotated(angle))
 
     def lobe(self, theta_i):
-        """Specular lobe: centre (theta_i, 0); width in theta_r of ~ 2 n sigma cos(ti')/cos(ti)."""
+        """Specular lobe: centre (theta_i, 0); width in theta_r ~ 2 n sigma cos(ti')/cos(ti)."""
         n = self._coating()
         si = math.sin(theta_i) / n
         ci = math.sqrt(1 - si * si)
@@ -216,5 +178,9 @@ class FacetBRDF(_FacetModel):
         ``math.inf`` for a perfect conductor.
     """
 
-    slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
-    substrate: complex = param(1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor)", kind="index")
+    slopes: SlopeDistribution = param(
+        ExponentialSlopes(0.1), "facet slope distribution", kind="object"
+    )
+    substrate: complex = param(
+        1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor)", kind="index"
+    )

@@ -104,9 +104,8 @@ def check_real(name, value, low=None, high=None, low_open=False, high_open=False
     v = float(value)
     if not math.isfinite(v):
         raise ValueError(f"{name} must be {rng}; got {value!r}")
-    bad = (
-        (low is not None and (v < low or (low_open and v == low)))
-        or (high is not None and (v > high or (high_open and v == high)))
+    bad = (low is not None and (v < low or (low_open and v == low))) or (
+        high is not None and (v > high or (high_open and v == high))
     )
     if bad:
         raise ValueError(f"{name} must be {rng}; got {value!r}")

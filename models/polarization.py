@@ -23,7 +23,7 @@ import numpy as np
 
 __all__ = [
     "jones_to_mueller",
-    "mueller_from_products",
+    "mueller16_from_jones",
     "stokes",
     "stokes_from_jones_vector",
     "ellipsometric",
@@ -35,64 +35,62 @@ __all__ = [
 ]
 
 
-def mueller_from_products(nss, npp, nps, nsp, x1, x2, x3, x4, x5, x6, out=None):
-    """Assemble Mueller elements from the Hermitian products of a Jones matrix.
+def mueller16_from_jones(ss, ps, sp, pp, out=None):
+    """Mueller elements ``(16, n)`` (row-major) from Jones elements as ``(re, im)`` pairs.
 
-    ``nab = |ab|^2`` and the complex products ``x1 = ss ps*``, ``x2 = pp sp*``,
-    ``x3 = ss sp*``, ``x4 = pp ps*``, ``x5 = pp ss*``, ``x6 = ps sp*``, each given
-    as a ``(re, im)`` pair of real arrays.  Returns (or fills) an array of shape
-    ``(16, ...)`` in row-major Mueller order.  Both the generic
-    :func:`jones_to_mueller` and the real-arithmetic fast paths of the facet
-    models go through this one map, so the convention lives in one place.
+    ``ps`` is p in, s out; ``sp`` is s in, p out.  Bohren & Huffman's map as
+    SCATMECH writes it (``MuellerMatrix(const JonesMatrix&)``), with the complex
+    products spelled out in real arithmetic.  Every non-depolarizing model and
+    :func:`jones_to_mueller` go through this one map, so the convention lives
+    in one place.  ``out`` may be a preallocated ``(16, n)`` array.
     """
-    shape = np.shape(nss)
+
+    def norm(z):
+        return z[0] * z[0] + z[1] * z[1]
+
+    def prod(z, w):  # z * conj(w) as (re, im)
+        return z[0] * w[0] + z[1] * w[1], z[1] * w[0] - z[0] * w[1]
+
+    nss, npp, nps, nsp = norm(ss), norm(pp), norm(ps), norm(sp)
+    x1r, x1i = prod(ss, ps)
+    x2r, x2i = prod(pp, sp)
+    x3r, x3i = prod(ss, sp)
+    x4r, x4i = prod(pp, ps)
+    x5r, x5i = prod(pp, ss)
+    x6r, x6i = prod(ps, sp)
     if out is None:
-        out = np.empty((16,) + shape)
-    (x1r, x1i), (x2r, x2i), (x3r, x3i) = x1, x2, x3
-    (x4r, x4i), (x5r, x5i), (x6r, x6i) = x4, x5, x6
+        out = np.empty((16,) + np.shape(nss))
     a = nss + npp
     b = nss - npp
-    out[0] = 0.5 * (a + nps + nsp)
-    out[1] = 0.5 * (b + nsp - nps)
-    out[2] = x1r + x2r
-    out[3] = x1i - x2i
-    out[4] = 0.5 * (b - nsp + nps)
-    out[5] = 0.5 * (a - nsp - nps)
-    out[6] = x1r - x2r
-    out[7] = x1i + x2i
-    out[8] = x3r + x4r
-    out[9] = x3r - x4r
-    out[10] = x5r + x6r
-    out[11] = -x5i - x6i
-    out[12] = x4i - x3i
-    out[13] = -x3i - x4i
-    out[14] = x5i - x6i
-    out[15] = x5r - x6r
+    c = nps + nsp
+    d = nsp - nps
+    np.add(a, c, out=out[0])
+    np.add(b, d, out=out[1])
+    np.subtract(b, d, out=out[4])
+    np.subtract(a, c, out=out[5])
+    out[[0, 1, 4, 5]] *= 0.5
+    np.add(x1r, x2r, out=out[2])
+    np.subtract(x1i, x2i, out=out[3])
+    np.subtract(x1r, x2r, out=out[6])
+    np.add(x1i, x2i, out=out[7])
+    np.add(x3r, x4r, out=out[8])
+    np.subtract(x3r, x4r, out=out[9])
+    np.add(x5r, x6r, out=out[10])
+    np.add(x5i, x6i, out=out[11])
+    np.negative(out[11], out=out[11])
+    np.subtract(x4i, x3i, out=out[12])
+    np.add(x3i, x4i, out=out[13])
+    np.negative(out[13], out=out[13])
+    np.subtract(x5i, x6i, out=out[14])
+    np.subtract(x5r, x6r, out=out[15])
     return out
-
-
-def _cprod(a, b):
-    z = a * np.conj(b)
-    return z.real, z.imag
 
 
 def jones_to_mueller(J):
     """Mueller matrix ``(..., 4, 4)`` of Jones matrices ``(..., 2, 2)``."""
     J = np.asarray(J, dtype=complex)
-    ss, ps, sp, pp = J[..., 0, 0], J[..., 0, 1], J[..., 1, 0], J[..., 1, 1]
-    flat = mueller_from_products(
-        np.abs(ss) ** 2,
-        np.abs(pp) ** 2,
-        np.abs(ps) ** 2,
-        np.abs(sp) ** 2,
-        _cprod(ss, ps),
-        _cprod(pp, sp),
-        _cprod(ss, sp),
-        _cprod(pp, ps),
-        _cprod(pp, ss),
-        _cprod(ps, sp),
-    )
-    return np.moveaxis(flat, 0, -1).reshape(J.shape[:-2] + (4, 4))
+    parts = [(J[..., a, b].real, J[..., a, b].imag) for a, b in ((0, 0), (0, 1), (1, 0), (1, 1))]
+    return np.moveaxis(mueller16_from_jones(*parts), 0, -1).reshape(J.shape[:-2] + (4, 4))
 
 
 _NAMED = {

@@ -291,7 +291,9 @@ class _AngleDistribution(SlopeDistribution):
     def p1_area(self, theta_n):
         """``P1^A(theta_n)`` as declared (normalized over the hemisphere)."""
         t = np.asarray(theta_n, dtype=float)
-        return np.where(t < math.pi / 2, self._shape(np.minimum(t, math.pi / 2)), 0.0) / self._norms[0]
+        return (
+            np.where(t < math.pi / 2, self._shape(np.minimum(t, math.pi / 2)), 0.0) / self._norms[0]
+        )
 
     def _p3_unit(self, zx, zy):
         z2 = zx * zx + zy * zy
