@@ -90,9 +90,7 @@ class Model(Declared):
         Mueller matrix is the Mueller BRDF (units sr^-1/2).  Only for
         non-depolarizing models; the overall phase is arbitrary."""
         if self.depolarizing:
-            raise NotImplementedError(
-                f"{type(self).__name__} is depolarizing: it has no Jones matrix"
-            )
+            raise NotImplementedError(f"{type(self).__name__} is depolarizing: it has no Jones matrix")
         shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
         n = ti.size
         out = np.empty((n, 2, 2), dtype=complex)

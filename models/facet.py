@@ -144,8 +144,7 @@ class _FacetModel(Model):
     def _validate(self):
         if not isinstance(self.slopes, SlopeDistribution):
             raise ValueError(
-                f"slopes must be a slope distribution (e.g. models.ExponentialSlopes); "
-                f"got {self.slopes!r}"
+                f"slopes must be a slope distribution (e.g. models.ExponentialSlopes); got {self.slopes!r}"
             )
 
     def rotated(self, angle):
@@ -178,9 +177,5 @@ class FacetBRDF(_FacetModel):
         ``math.inf`` for a perfect conductor.
     """
 
-    slopes: SlopeDistribution = param(
-        ExponentialSlopes(0.1), "facet slope distribution", kind="object"
-    )
-    substrate: complex = param(
-        1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor)", kind="index"
-    )
+    slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
+    substrate: complex = param(1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor)", kind="index")

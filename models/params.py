@@ -169,15 +169,11 @@ class Declared:
             value = getattr(self, f.name)
             kind = info["kind"]
             if kind == "real":
-                v = check_real(
-                    f.name, value, info["low"], info["high"], info["low_open"], info["high_open"]
-                )
+                v = check_real(f.name, value, info["low"], info["high"], info["low_open"], info["high_open"])
             elif kind == "int":
                 if isinstance(value, bool) or not isinstance(value, numbers.Integral):
                     raise ValueError(f"{f.name} must be an integer; got {value!r}")
-                check_real(
-                    f.name, value, info["low"], info["high"], info["low_open"], info["high_open"]
-                )
+                check_real(f.name, value, info["low"], info["high"], info["low_open"], info["high_open"])
                 v = int(value)
             elif kind == "index":
                 v = check_index(f.name, value)
@@ -186,8 +182,7 @@ class Declared:
                 if isinstance(z, numbers.Complex) and not isinstance(z, numbers.Real):
                     if complex(z).imag != 0:
                         raise ValueError(
-                            f"{f.name} must be a real (non-absorbing) index >= {info['low']:g}; "
-                            f"got {value!r}"
+                            f"{f.name} must be a real (non-absorbing) index >= {info['low']:g}; got {value!r}"
                         )
                     z = complex(z).real
                 v = check_real(f.name, z, info["low"], None)

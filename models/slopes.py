@@ -223,7 +223,8 @@ class _Anisotropic(SlopeDistribution):
 
 @dataclass(frozen=True)
 class AnisotropicExponentialSlopes(_Anisotropic):
-    """Anisotropic exponential slopes (SCATMECH ``Anisotropic_Exponential_Slope_Distribution_Function``):
+    """Anisotropic exponential slopes, as SCATMECH's
+    ``Anisotropic_Exponential_Slope_Distribution_Function``:
 
     ``P3^xy = C 3/(pi sx sy) exp(-sqrt(6) sqrt((u/sx)^2 + (v/sy)^2))`` with
     ``(u, v)`` the slope in axes rotated by ``rotation`` from x.  For
@@ -291,9 +292,7 @@ class _AngleDistribution(SlopeDistribution):
     def p1_area(self, theta_n):
         """``P1^A(theta_n)`` as declared (normalized over the hemisphere)."""
         t = np.asarray(theta_n, dtype=float)
-        return (
-            np.where(t < math.pi / 2, self._shape(np.minimum(t, math.pi / 2)), 0.0) / self._norms[0]
-        )
+        return np.where(t < math.pi / 2, self._shape(np.minimum(t, math.pi / 2)), 0.0) / self._norms[0]
 
     def _p3_unit(self, zx, zy):
         z2 = zx * zx + zy * zy

@@ -35,9 +35,7 @@ class SubsurfaceFacetBRDF(_FacetModel):
         Index of the flakes / substrate, ``n + ik`` with ``k >= 0``, or ``inf``.
     """
 
-    slopes: SlopeDistribution = param(
-        ExponentialSlopes(0.1), "facet slope distribution", kind="object"
-    )
+    slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
     coating: float = param(1.5, "coating index (real, non-absorbing)", kind="real_index", low=1.0)
     substrate: complex = param(
         1.37 + 7.62j, "flake/substrate index n + ik (inf: perfect conductor)", kind="index"
