@@ -43,6 +43,8 @@ class Model(Declared):
     depolarizing = False
     reciprocal = True
     transmission = False
+    #: True when M00 is even in phi_r (mirror plane of incidence); integrators use it.
+    mirror_symmetric = True
     #: angle names used in error messages
     _angle_names = ("theta_i", "theta_r", "phi_r")
 
@@ -187,6 +189,10 @@ class Sum(Model):
     @property
     def reciprocal(self):  # type: ignore[override]
         return all(m.reciprocal for _, m in self.terms)
+
+    @property
+    def mirror_symmetric(self):  # type: ignore[override]
+        return all(m.mirror_symmetric for _, m in self.terms)
 
     def _mueller16(self, ti, tr, pr):
         total = None

@@ -150,6 +150,11 @@ class _FacetModel(Model):
     def rotated(self, angle):
         return self.replace(slopes=self.slopes.rotated(angle))
 
+    @property
+    def mirror_symmetric(self) -> bool:
+        """True when the sample has a mirror plane at phi = 0 (isotropic slopes)."""
+        return self.slopes.isotropic
+
     def lobe(self, theta_i):
         """Specular lobe: centre (theta_i, 0); width in theta_r ~ 2 n sigma cos(ti')/cos(ti)."""
         n = self._coating()

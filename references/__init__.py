@@ -1,0 +1,84 @@
+"""Published numbers and SCATMECH reference values, with provenance.
+
+Data only: loaders return plain Python / numpy structures.  Every data file
+starts with ``#`` comment lines saying where its numbers come from (the seed
+and table, or the script and pySCATMECH version that generated them).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+
+import numpy as np
+
+__all__ = ["data_path", "read_csv", "provenance", "table1", "scatmech_facet", "table1_scatmech"]
+
+_DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+
+def data_path(name: str) -> str:
+    return os.path.join(_DATA, name)
+
+
+def provenance(name: str) -> str:
+    """The leading ``#`` comment lines of a data file, without the ``#``."""
+    lines = []
+    with open(data_path(name)) as fh:
+        for line in fh:
+            if not line.startswith("#"):
+                break
+            lines.append(line[1:].strip())
+    return "\n".join(lines)
+
+
+def read_csv(name: str) -> list[dict]:
+    """Rows of a committed CSV file (comment lines skipped) as dicts of strings."""
+    with open(data_path(name)) as fh:
+        rows = [line for line in fh if not line.startswith("#")]
+    return list(csv.DictReader(rows))
+
+
+def _index(text: str):
+    return math.inf if text.strip() == "inf" else complex(text)
+
+
+def table1() -> list[dict]:
+    """Seed 000 Table I: 27 rows with substrate, index, coating, sigma, printed value."""
+    out = []
+    for r in read_csv("table1_seed000.csv"):
+        out.append(
+            {
+                "substrate": r["substrate"],
+                "index": _index(r["substrate_index"]),
+                "coating": float(r["coating"]),
+                "sigma": float(r["sigma"]),
+                "printed": float(r["printed"]),
+            }
+        )
+    return out
+
+
+def scatmech_facet() -> dict:
+    """SCATMECH Mueller BRDFs of the facet models: parameter columns and ``mueller`` (N, 4, 4)."""
+    rows = read_csv("scatmech_facet.csv")
+    out = {
+        "model": np.array([r["model"] for r in rows]),
+        "sdf": np.array([r["sdf"] for r in rows]),
+    }
+    for k in ("coating", "substrate_n", "substrate_k", "sigma", "theta_i", "theta_r", "phi_r"):
+        out[k] = np.array([float(r[k]) for r in rows])
+    out["mueller"] = np.array(
+        [[float(r[f"m{i}{j}"]) for i in range(4) for j in range(4)] for r in rows]
+    ).reshape(-1, 4, 4)
+    return out
+
+
+def table1_scatmech() -> dict:
+    """SCATMECH-integrated Table I entries keyed by ``(substrate, coating, sigma)``."""
+    out = {}
+    for r in read_csv("table1_scatmech.csv"):
+        key = (r["substrate"], float(r["coating"]), float(r["sigma"]))
+        out[key] = {"value": float(r["reflectance"]), "grid_change": float(r["grid_change"])}
+    return out
