@@ -88,7 +88,10 @@ def _slope_to_direction(zx, zy, ti_int):
     return kr, cos_a, nrm[2]
 
 
-def table1_entry(coating, substrate, sigma, n_psi=240, n_rho=120, theta_i=math.radians(60)):
+THETA_60 = math.radians(60.0)
+
+
+def table1_entry(coating, substrate, sigma, n_psi=240, n_rho=120, theta_i=THETA_60):
     """Integrated reflectance of SCATMECH's subsurface facet model, in slope space."""
     n = coating
     model = scatmech_model("subsurface" if n != 1.0 else "facet", n, substrate, "Exponential", sigma)
