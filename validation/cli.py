@@ -1,0 +1,65 @@
+"""``scatterbench`` command line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+__all__ = ["main"]
+
+
+def _cmd_validate(args) -> int:
+    from .checks import format_checks, run_checks
+    from .table1 import format_table1
+
+    t0 = time.perf_counter()
+    results = run_checks()
+    print(format_checks(results))
+    for c in results:
+        if c.name.startswith("Table I: entries") and "rows" in c.extra:
+            from .table1 import Table1Row
+
+            rows = [Table1Row(**r) for r in c.extra["rows"]]
+            print()
+            print(f"Seed 000 Table I (theta_i = 60 deg), computed in {c.extra['seconds']:.2f} s:")
+            print(format_table1(rows))
+    print(f"\nvalidate finished in {time.perf_counter() - t0:.1f} s")
+    return 1 if any(c.status == "fail" for c in results) else 0
+
+
+def _cmd_table1(args) -> int:
+    from .table1 import compute_table1, format_table1
+
+    rows, seconds = compute_table1(tol=args.tol)
+    print(format_table1(rows))
+    print(f"27 entries in {seconds:.2f} s (tol {args.tol:g})")
+    return 0
+
+
+def _cmd_models(args) -> int:
+    import models
+
+    print(models.list_models())
+    return 0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="scatterbench",
+        description="Validation and benchmark harness for polarized light-scattering models.",
+    )
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("validate", help="run every check; print a table; exit 1 if any fails")
+    p.set_defaults(func=_cmd_validate)
+    p = sub.add_parser("table1", help="seed 000 Table I beside the printed values")
+    p.add_argument("--tol", type=float, default=1e-4, help="absolute integration tolerance")
+    p.set_defaults(func=_cmd_table1)
+    p = sub.add_parser("models", help="list the models and their declared parameters")
+    p.set_defaults(func=_cmd_models)
+    args = ap.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
