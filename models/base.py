@@ -67,12 +67,13 @@ class Model(Declared):
         """Mueller-matrix BRDF ``(..., 4, 4)`` in 1/sr, s/p bases (SCATMECH ``psps``)."""
         shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
         n = ti.size
-        out = np.empty((n, 16))
+        # Element-major storage: each chunk's (16, k) block is copied without a
+        # transpose; the (..., 4, 4) result is a strided view of it.
+        out = np.empty((16, n))
         for start in range(0, n, CHUNK):
             sl = slice(start, min(start + CHUNK, n))
-            block = self._mueller16(ti[sl], tr[sl], pr[sl])
-            out[sl] = block.T
-        return out.reshape(shape + (4, 4))
+            out[:, sl] = self._mueller16(ti[sl], tr[sl], pr[sl])
+        return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
 
     def brdf(self, theta_i, theta_r, phi_r=0.0):
         """Unpolarized-in, total-out BRDF ``M00`` (1/sr)."""

@@ -59,7 +59,7 @@ def facet_jones(ti, tr, pr, n, substrate, slopes):
     # sin = sqrt(1 - cos^2): exact to ~1e-16 absolute (it loses relative precision
     # only below ~1e-8 rad, where sin enters additively); cos, which divides the
     # BRDF, stays exact.
-    sin_ext = np.sqrt(np.maximum(1.0 - cos_ext * cos_ext, 0.0))
+    sin_ext = np.sqrt(1.0 - cos_ext * cos_ext)  # |cos| <= 1 from np.cos
     sp, cp = np.sin(pr), np.cos(pr)
     if n == 1.0:
         sin_int, cos_int = sin_ext, cos_ext
@@ -78,16 +78,19 @@ def facet_jones(ti, tr, pr, n, substrate, slopes):
     # Eq. 49: P3 / (4 cos ti cos tr cos^4 theta_n), with cos theta_n = hz / |h|.
     q = g * inv_hz * inv_hz
     S = p3 * q * q / (4.0 * cos_ext[0] * cos_ext[1])
-    S[(ti >= 0.5 * math.pi) | (tr >= 0.5 * math.pi)] = 0.0
+    if ti.max() >= 0.5 * math.pi or tr.max() >= 0.5 * math.pi:
+        S[(ti >= 0.5 * math.pi) | (tr >= 0.5 * math.pi)] = 0.0
     root = np.sqrt(S)
-    c = np.minimum(0.5 * np.sqrt(g), 1.0)  # cos(alpha), local incidence in the coating
+    c = 0.5 * np.sqrt(g)  # cos(alpha), local incidence in the coating (|h| <= 2)
     m = substrate if substrate == math.inf else complex(substrate) / n
     rs, K = reflection_rs_k(c, m)
     # q_ab = r_s D_ab + (K - 2 r_s) (e_a.h)(e_b.h)/|h|^2  (see module docstring)
     r_re = rs.real * root
     r_im = rs.imag * root
-    k_re = K.real * root - 2.0 * r_re
-    k_im = K.imag * root - 2.0 * r_im
+    k_re = K.real * root
+    k_re -= 2.0 * r_re
+    k_im = K.imag * root
+    k_im -= 2.0 * r_im
     inv_g = 1.0 / g
     ho_s = si * sp  # s_r'.h
     ho_p = cr * cp * si + sr * ci  # p_r'.h  (a2, Eq. 19b)
@@ -97,17 +100,21 @@ def facet_jones(ti, tr, pr, n, substrate, slopes):
     if n != 1.0:
         # Eq. 14-18: t(theta_r; 1, n) on the way out, t(theta_i; 1, n) on the way in.
         (tsi, tsr), (tpi, tpr) = coating_transmission(cos_ext, n)
-        ho_s = ho_s * tsr
-        ho_p = ho_p * tpr
-        hi_s = hi_s * tsi
-        hi_p = hi_p * tpi
+        ho_s *= tsr
+        ho_p *= tpr
+        hi_s *= tsi
+        hi_p *= tpi
         d_ss = d_ss * (tsr * tsi)
         d_ps = d_ps * (tsr * tpi)
         d_sp = d_sp * (tpr * tsi)
         d_pp = d_pp * (tpr * tpi)
 
     def elem(d, b):
-        return r_re * d + k_re * b, r_im * d + k_im * b
+        re = r_re * d
+        re += k_re * b
+        im = r_im * d
+        im += k_im * b
+        return re, im
 
     return (
         elem(d_ss, ho_s * hi_s),

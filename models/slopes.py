@@ -354,7 +354,7 @@ class ExponentialAngles(_AngleDistribution):
 class TabulatedSlopes(SlopeDistribution):
     """Isotropic ``P3^xy`` from measured values (seed 000 Sec. 4, Fig. 4).
 
-    ``zeta`` (increasing, >= 0) and ``p3`` (> 0) are the measured slope density;
+    ``zeta`` (increasing, >= 0) and ``values`` (> 0) are the measured slope density;
     between points ``log P3`` is interpolated linearly (exact for an exponential
     distribution), below the first point it is held, beyond the last it is
     zero (nothing was measured there).  ``coverage`` is *computed*: the Eq. 33
@@ -363,19 +363,19 @@ class TabulatedSlopes(SlopeDistribution):
     """
 
     zeta: tuple = param((0.0, 1.0), "tabulated slopes (increasing, >= 0)", kind="object")
-    p3: tuple = param((1.0, 1.0), "P3^xy at those slopes (> 0)", kind="object")
+    values: tuple = param((1.0, 1.0), "P3^xy at those slopes (> 0)", kind="object")
 
     def _validate(self):
         z = np.asarray(self.zeta, dtype=float)
-        p = np.asarray(self.p3, dtype=float)
+        p = np.asarray(self.values, dtype=float)
         if z.ndim != 1 or z.size < 2 or not np.all(np.isfinite(z)) or np.any(z < 0):
             raise ValueError("zeta must be at least two finite slopes >= 0")
         if np.any(np.diff(z) <= 0):
             raise ValueError("zeta must be strictly increasing")
         if p.shape != z.shape or not np.all(np.isfinite(p)) or np.any(p <= 0):
-            raise ValueError("p3 must have one finite value > 0 per slope")
+            raise ValueError("values must hold one finite P3 value > 0 per slope")
         object.__setattr__(self, "zeta", tuple(z.tolist()))
-        object.__setattr__(self, "p3", tuple(p.tolist()))
+        object.__setattr__(self, "values", tuple(p.tolist()))
 
     @property
     def scale(self):
@@ -386,7 +386,7 @@ class TabulatedSlopes(SlopeDistribution):
 
     @cached_property
     def _table(self):
-        return np.asarray(self.zeta), np.log(np.asarray(self.p3))
+        return np.asarray(self.zeta), np.log(np.asarray(self.values))
 
     def _p3_raw(self, zeta):
         z, lp = self._table
@@ -410,7 +410,7 @@ class TabulatedSlopes(SlopeDistribution):
     def normalized(self):
         """The same table scaled so that its coverage is 1."""
         c = self.coverage
-        return TabulatedSlopes(zeta=self.zeta, p3=tuple(np.asarray(self.p3) / c))
+        return TabulatedSlopes(zeta=self.zeta, values=tuple(np.asarray(self.values) / c))
 
     def mean_sec(self):
         z = np.asarray(self.zeta)

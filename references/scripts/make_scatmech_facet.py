@@ -49,11 +49,16 @@ def scatmech_model(kind, coating, substrate, dist, sigma):
     )
 
 
-def random_cases(n_cases, seed):
-    rng = np.random.default_rng(seed)
-    rows = []
-    per_model = 10  # geometries per parameter set
-    while len(rows) < n_cases:
+def _parameter_sets(rng, n_sets):
+    """Corners of the requested ranges first, then random parameter sets."""
+    sets = []
+    for kind in ("facet", "subsurface"):
+        for dist in ("Exponential", "Gaussian"):
+            for sigma in (0.05, 1.0):
+                for substrate in (1.37 + 7.62j, 1.5 + 0j):
+                    for coating in (1.0,) if kind == "facet" else (1.0, 2.2):
+                        sets.append((kind, coating, substrate, dist, sigma))
+    while len(sets) < n_sets:
         kind = "facet" if rng.random() < 0.35 else "subsurface"
         coating = 1.0 if kind == "facet" else float(np.round(rng.uniform(1.0, 2.2), 4))
         if rng.random() < 0.5:  # absorbing: metals and semiconductors
@@ -62,15 +67,23 @@ def random_cases(n_cases, seed):
             substrate = complex(np.round(rng.uniform(1.2, 3.0), 4), 0.0)
         dist = "Exponential" if rng.random() < 0.5 else "Gaussian"
         sigma = float(np.round(math.exp(rng.uniform(math.log(0.05), math.log(1.0))), 5))
+        sets.append((kind, coating, substrate, dist, sigma))
+    return sets
+
+
+def random_cases(n_cases, seed, per_set=10):
+    """``per_set`` random geometries (polar angles up to 80 deg, every azimuth) per parameter set."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for kind, coating, substrate, dist, sigma in _parameter_sets(rng, -(-n_cases // per_set)):
         model = scatmech_model(kind, coating, substrate, dist, sigma)
-        for _ in range(per_model):
+        for _ in range(per_set):
             ti = float(rng.uniform(0.0, math.radians(80.0)))
             tr = float(rng.uniform(0.0, math.radians(80.0)))
             pr = float(rng.uniform(-math.pi, math.pi))
             M = np.array(model.MuellerBRDF(ti, tr, pr), dtype=float)
-            rows.append(
-                [kind, coating, substrate.real, substrate.imag, dist, sigma, ti, tr, pr, *M.ravel().tolist()]
-            )
+            params = [kind, coating, substrate.real, substrate.imag, dist, sigma]
+            rows.append([*params, ti, tr, pr, *M.ravel().tolist()])
     return rows[:n_cases]
 
 
