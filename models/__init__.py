@@ -57,5 +57,4 @@ __all__ = [
 
 def list_models():
     """Names and parameter listings of every model class (like SCATMECH's model lists)."""
-    classes = [FacetBRDF, SubsurfaceFacetBRDF]
-    return "\n\n".join(c.info() for c in classes)
+    return "\n\n".join(c.info() for c in Model.registry)

@@ -47,6 +47,13 @@ class Model(Declared):
     mirror_symmetric = True
     #: angle names used in error messages
     _angle_names = ("theta_i", "theta_r", "phi_r")
+    #: every public model class, in definition order (for listings and sweeps)
+    registry: list = []
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if not cls.__name__.startswith("_") and cls.__module__.startswith("models"):
+            Model.registry.append(cls)
 
     # -- subclass hooks -----------------------------------------------------------
     def _mueller16(self, ti, tr, pr):  # pragma: no cover - abstract

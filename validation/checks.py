@@ -401,9 +401,52 @@ CHECKS = [
 ]
 
 
+def _table1_section(results):
+    from .table1 import Table1Row, format_table1
+
+    for c in results:
+        if c.name.startswith("Table I: entries") and "rows" in c.extra:
+            rows = [Table1Row(**r) for r in c.extra["rows"]]
+            return (
+                f"Seed 000 Table I (theta_i = 60 deg), computed in {c.extra['seconds']:.2f} s",
+                format_table1(rows),
+            )
+    return None
+
+
+#: Extra output printed after the check table: callables ``f(results) -> (title, text) | None``.
+SECTIONS = [_table1_section]
+
+
+def check_modules():
+    """This module and every ``validation.checks_*`` module (one per model family).
+
+    Each may define ``CHECKS`` (callables returning a :class:`Check` or a list)
+    and ``SECTIONS`` (callables ``f(results) -> (title, text) | None``).
+    """
+    import importlib
+    import pkgutil
+    import sys
+
+    mods = [sys.modules[__name__]]
+    pkg = sys.modules[__package__]
+    for info in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda i: i.name):
+        if info.name.startswith("checks_"):
+            mods.append(importlib.import_module(f"{__package__}.{info.name}"))
+    return mods
+
+
+def all_checks():
+    return [fn for m in check_modules() for fn in getattr(m, "CHECKS", [])]
+
+
+def all_sections():
+    return [fn for m in check_modules() for fn in getattr(m, "SECTIONS", [])]
+
+
 def run_checks(checks=None):
     out = []
-    for fn in checks or CHECKS:
+    for fn in checks or all_checks():
         r = fn()
         out.extend(r if isinstance(r, list) else [r])
     return out

@@ -10,20 +10,17 @@ __all__ = ["main"]
 
 
 def _cmd_validate(args) -> int:
-    from .checks import format_checks, run_checks
-    from .table1 import format_table1
+    from .checks import all_sections, format_checks, run_checks
 
     t0 = time.perf_counter()
     results = run_checks()
     print(format_checks(results))
-    for c in results:
-        if c.name.startswith("Table I: entries") and "rows" in c.extra:
-            from .table1 import Table1Row
-
-            rows = [Table1Row(**r) for r in c.extra["rows"]]
-            print()
-            print(f"Seed 000 Table I (theta_i = 60 deg), computed in {c.extra['seconds']:.2f} s:")
-            print(format_table1(rows))
+    for section in all_sections():
+        out = section(results)
+        if out:
+            title, text = out
+            print(f"\n{title}:")
+            print(text)
     print(f"\nvalidate finished in {time.perf_counter() - t0:.1f} s")
     return 1 if any(c.status == "fail" for c in results) else 0
 
