@@ -134,8 +134,18 @@ def check_index(name, value) -> complex | float:
 
 
 def check_polar_angle(name, value) -> np.ndarray:
-    """Polar angles in radians: finite, in [0, pi/2]. Returns a float array."""
+    """Polar angles in radians: finite, in [0, pi/2]. Returns a float64 array.
+
+    Lower-precision inputs are judged in their own precision: float32(pi/2) is
+    slightly above the float64 pi/2 and means grazing, so it is accepted and
+    clipped to pi/2.
+    """
+    raw = np.asarray(value)
     a = check_finite_array(name, value)
+    if raw.dtype.kind == "f" and raw.dtype.itemsize < 8 and a.size:
+        top = float(np.asarray(math.pi / 2, dtype=raw.dtype))
+        if top > math.pi / 2:
+            a = np.where((a > math.pi / 2) & (a <= top), math.pi / 2, a)
     if a.size and (np.min(a) < 0.0 or np.max(a) > math.pi / 2):
         raise ValueError(
             f"{name} must lie in [0, pi/2] radians (a polar angle above the surface); "

@@ -34,6 +34,17 @@ def _cmd_table1(args) -> int:
     return 0
 
 
+def _cmd_stability(args) -> int:
+    from .stability import classify, format_sweep, sweep
+
+    t0 = time.perf_counter()
+    findings = sweep(energy=not args.no_energy)
+    print(format_sweep(findings))
+    print(f"stability sweep finished in {time.perf_counter() - t0:.1f} s")
+    _, bad = classify(findings)
+    return 1 if bad else 0
+
+
 def _cmd_models(args) -> int:
     import models
 
@@ -52,6 +63,9 @@ def main(argv=None) -> int:
     p = sub.add_parser("table1", help="seed 000 Table I beside the printed values")
     p.add_argument("--tol", type=float, default=1e-4, help="absolute integration tolerance")
     p.set_defaults(func=_cmd_table1)
+    p = sub.add_parser("stability", help="sweep every model at its extremes; exit 1 on unaccepted findings")
+    p.add_argument("--no-energy", action="store_true", help="skip the integrated-reflectance checks")
+    p.set_defaults(func=_cmd_stability)
     p = sub.add_parser("models", help="list the models and their declared parameters")
     p.set_defaults(func=_cmd_models)
     args = ap.parse_args(argv)

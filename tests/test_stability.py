@@ -1,0 +1,64 @@
+"""The stability sweep: no unaccepted findings, and it does find what is broken."""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+import models
+from models.base import Model
+from models.params import param
+from validation.stability import classify, edge_geometries, edge_instances, load_accepted, sweep
+
+
+@pytest.fixture(scope="module")
+def findings():
+    return sweep()
+
+
+def test_no_unaccepted_findings(findings):
+    _, bad = classify(findings)
+    assert not bad, "\n".join(f"{f.model} {f.kind} {f.value} {f.params} {f.where}" for f, _ in bad)
+
+
+def test_every_accepted_entry_has_a_reason():
+    for e in load_accepted():
+        assert len(e["reason"]) > 40
+
+
+def test_sweep_reaches_the_edges():
+    inst = edge_instances(models.SubsurfaceFacetBRDF)
+    sigmas = {getattr(m.slopes, "sigma", None) for m in inst}
+    assert {1e-4, 10.0} <= sigmas
+    assert math.inf in {m.substrate for m in inst} and (1 + 0j) in {m.substrate for m in inst}
+    assert {1.0, 3.0} <= {m.coating for m in inst}
+    ti, tr, pr = edge_geometries(models.SubsurfaceFacetBRDF(coating=2.0, substrate=1.5))
+    assert (
+        math.pi / 2 in ti and 0.0 in ti and np.any(np.isclose(ti, math.asin(0.5) - 1e-9, atol=0, rtol=1e-15))
+    )
+    assert math.pi in pr and -math.pi in pr
+
+
+@dataclass(frozen=True)
+class Fragile(Model):
+    """Deliberately broken: NaN at retroreflection, negative at grazing, warns on division."""
+
+    depolarizing = True
+    k: float = param(1.0, "a knob", low=0.0, high=2.0)
+
+    def _mueller16(self, ti, tr, pr):
+        out = np.zeros((16, ti.size))
+        out[0] = 1.0 / np.cos(pr)  # 1/0 warning never exact, but huge near pi/2...
+        out[0][np.abs(np.abs(pr) - math.pi) < 1e-15] = np.nan
+        out[0][tr >= math.pi / 2] = -1.0
+        out[5] = 1.5 * np.abs(out[0])  # M11 > M00: unphysical
+        return out
+
+
+def test_sweep_catches_a_broken_model():
+    found = sweep(classes=[Fragile], energy=False)
+    kinds = {f.kind for f in found}
+    assert {"non-finite", "negative-M00", "unphysical"} <= kinds
+    _, bad = classify(found)
+    assert bad

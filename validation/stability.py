@@ -1,0 +1,291 @@
+"""Stability sweep: every model at the edges of its parameter space and geometry.
+
+For each public model class (``models.Model.registry``) the sweep builds
+instances at the edges of each declared parameter, one parameter at a time
+from the defaults (nested declared objects, such as slope distributions, are
+swept the same way), and evaluates them on edge geometries: polar angles 0,
+1e-9, 89.99 deg and exactly 90 deg, exact specular and retroreflection, the
+critical angle of each interface +- 1e-9, azimuths 0, +-pi and +-1e-12, and the
+same angles as float32.  It records
+
+* ``fp-warning``: a floating-point warning (division by zero, overflow, invalid
+  operation; gradual underflow to zero is the correct IEEE result for far
+  tails and is not counted),
+* ``non-finite``: a NaN or inf in the Mueller (or Jones) matrix,
+* ``negative-M00``: a negative BRDF,
+* ``unphysical``: a coherency-matrix eigenvalue below ``-1e-9 M00``,
+* ``reciprocity``: a relative violation above 1e-9 (reciprocal models),
+* ``energy``: an integrated reflectance above ``1 + error`` at 0, 57 or 89.99 deg.
+
+Findings that physics explains are listed, each with its reason, in
+``accepted_findings.toml`` beside this module; anything else is a failure of
+``scatterbench stability`` and of the test suite.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import tomllib
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import models
+from models.params import Declared
+from models.polarization import coherency_eigenvalues
+
+from .energy import hit_fraction
+from .integrate import integrated_reflectance
+from .reciprocity import reciprocity_error
+
+__all__ = [
+    "Finding",
+    "edge_instances",
+    "edge_geometries",
+    "sweep",
+    "load_accepted",
+    "classify",
+    "format_sweep",
+]
+
+ACCEPTED_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accepted_findings.toml")
+
+# Edge values by parameter name, for the names the models use; other parameters
+# fall back to their declared bounds.
+_NAMED_EDGES = {
+    "sigma": (1e-4, 1e-2, 1.0, 10.0),
+    "sigma_x": (1e-4, 10.0),
+    "sigma_y": (1e-4, 10.0),
+    "coverage": (1e-3, 1.0),
+    "rotation": (0.0, 1.0, -math.pi),
+    "coating": (1.0, 1.0 + 1e-9, 1.5, 3.0),
+    "n": (1.0, 1.0 + 1e-9, 1.5, 3.0),
+    "g": (-0.99, 0.0, 0.99),
+    "rho": (0.0, 1.0),
+}
+_INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
+
+
+@dataclass(frozen=True)
+class Finding:
+    model: str
+    params: str
+    kind: str
+    value: float
+    where: str
+    fields: dict = field(default_factory=dict)
+
+
+def _edges_for(info, default):
+    if info.kind == "object":
+        if isinstance(default, Declared):
+            return [inst for inst in _one_at_a_time(default) if inst != default]
+        return []
+    if info.kind == "index":
+        return [v for v in _INDEX_EDGES if v != default]
+    if info.kind == "choice":
+        return [c for c in info.low if c != default]
+    if info.name in _NAMED_EDGES:
+        vals = _NAMED_EDGES[info.name]
+    else:
+        lo, hi = info.low, info.high
+        vals = []
+        if lo is not None:
+            vals.append(lo * (1 + 1e-9) + (1e-12 if lo == 0 else 0) if info.low_open else lo)
+        if hi is not None:
+            vals.append(hi * (1 - 1e-9) if info.high_open else hi)
+        if hi is None and isinstance(default, (int, float)) and default:
+            vals.append(default * 100)
+    if info.kind == "real_index":
+        vals = [v for v in vals if v >= info.low]
+    if info.kind == "int":
+        vals = [int(v) for v in vals]
+    return [v for v in vals if v != default]
+
+
+def _one_at_a_time(base):
+    out = [base]
+    for info in type(base).parameters():
+        default = getattr(base, info.name)
+        for value in _edges_for(info, default):
+            try:
+                out.append(dataclasses.replace(base, **{info.name: value}))
+            except ValueError:
+                continue  # outside this parameter's declared range (e.g. a real_index bound)
+    return out
+
+
+def edge_instances(cls):
+    """Model instances at the edges of each declared parameter (one at a time)."""
+    try:
+        base = cls()
+    except ValueError:
+        return []  # compositions without a default (Sum): their terms are swept
+    return _one_at_a_time(base)
+
+
+def _real_indices(obj, out=None):
+    out = [] if out is None else out
+    if isinstance(obj, Declared):
+        for info in type(obj).parameters():
+            v = getattr(obj, info.name)
+            if info.kind in ("index", "real_index") and v != math.inf and complex(v).imag == 0:
+                out.append(float(complex(v).real))
+            elif isinstance(v, Declared):
+                _real_indices(v, out)
+    return out
+
+
+def edge_geometries(model):
+    """``(ti, tr, pr)`` flat arrays of edge geometries for one model."""
+    d = math.radians
+    thetas = [0.0, 1e-9, 0.5, 1.0, d(89.99), math.pi / 2 - 1e-9, math.pi / 2]
+    idx = _real_indices(model)
+    crit = set()
+    for a in idx:
+        if a > 1:
+            crit.add(math.asin(1 / a))
+        for b in idx:
+            if b < a:
+                crit.add(math.asin(b / a))
+    for c in sorted(crit):
+        thetas += [max(c - 1e-9, 0.0), min(c + 1e-9, math.pi / 2)]
+    phis = [0.0, math.pi, -math.pi, math.pi / 2, 1e-12, math.pi - 1e-12]
+    t = np.array(sorted(set(thetas)))
+    ti, tr, pr = np.meshgrid(t, t, np.array(phis), indexing="ij")
+    return ti.ravel(), tr.ravel(), pr.ravel()
+
+
+def _label(ti, tr, pr):
+    return f"ti={math.degrees(ti):.9g} deg, tr={math.degrees(tr):.9g} deg, phi={math.degrees(pr):.9g} deg"
+
+
+def _evaluate(model, ti, tr, pr, found, name, params):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
+            M = model.mueller(ti, tr, pr)
+            J = None if model.depolarizing else model.jones(ti, tr, pr)
+            M32 = model.mueller(ti.astype(np.float32), tr.astype(np.float32), pr.astype(np.float32))
+    for w in caught:
+        found.append(Finding(name, params, "fp-warning", 1.0, str(w.message)))
+    bad = ~np.all(np.isfinite(M), axis=(-1, -2))
+    if J is not None:
+        bad |= ~np.all(np.isfinite(J), axis=(-1, -2))
+    bad |= ~np.all(np.isfinite(M32), axis=(-1, -2))
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        found.append(Finding(name, params, "non-finite", float(bad.sum()), _label(ti[k], tr[k], pr[k])))
+        M = np.where(np.isfinite(M), M, 0.0)
+    m00 = M[..., 0, 0]
+    if np.any(m00 < 0):
+        k = int(np.argmin(m00))
+        found.append(Finding(name, params, "negative-M00", float(m00[k]), _label(ti[k], tr[k], pr[k])))
+    live = m00 > 1e-250
+    if np.any(live):
+        ev = coherency_eigenvalues(M[live])[..., 0] / m00[live]
+        if ev.min() < -1e-9:
+            k = int(np.flatnonzero(live)[np.argmin(ev)])
+            found.append(Finding(name, params, "unphysical", float(ev.min()), _label(ti[k], tr[k], pr[k])))
+    return M
+
+
+def _check_reciprocity(model, ti, tr, pr, found, name, params):
+    if not model.reciprocal:
+        return
+    keep = (ti < math.pi / 2) & (tr < math.pi / 2)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore", under="ignore"):
+        r = reciprocity_error(model, ti[keep], tr[keep], pr[keep])
+    worst = max(r.scalar, r.mueller, r.jones or 0.0)
+    if not np.isfinite(worst) or worst > 1e-9:
+        found.append(Finding(name, params, "reciprocity", float(worst), "edge geometries"))
+
+
+def _check_energy(model, found, name, params):
+    if model.transmission:
+        return
+    slopes = getattr(model, "slopes", None)
+    coating = float(getattr(model, "coating", 1.0))
+    for ti in (0.0, 1.0, math.radians(89.99)):
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore", under="ignore"):
+            r = integrated_reflectance(model, ti, tol=1e-3, max_evaluations=2_000_000)
+        excess = r.value - 1.0 - r.error
+        if excess > 0:
+            fields = {"excess": excess, "value": r.value, "theta_i": ti}
+            if slopes is not None:
+                fields["hit_fraction"] = hit_fraction(slopes, ti, coating)
+            found.append(
+                Finding(name, params, "energy", r.value, f"theta_i = {math.degrees(ti):.4g} deg", fields)
+            )
+
+
+def sweep(classes=None, energy=True):
+    """Run the sweep; returns every finding (accepted or not)."""
+    found = []
+    classes = classes if classes is not None else [c for c in models.Model.registry if c is not models.Sum]
+    for cls in classes:
+        for inst in edge_instances(cls):
+            name, params = cls.__name__, repr(inst)
+            ti, tr, pr = edge_geometries(inst)
+            _evaluate(inst, ti, tr, pr, found, name, params)
+            _check_reciprocity(inst, ti, tr, pr, found, name, params)
+            if energy:
+                _check_energy(inst, found, name, params)
+    return found
+
+
+def load_accepted(path=ACCEPTED_PATH):
+    """Accepted findings: ``[[accepted]]`` tables with model, kind, condition, reason."""
+    with open(path, "rb") as fh:
+        data = tomllib.load(fh)
+    entries = data.get("accepted", [])
+    for i, e in enumerate(entries):
+        for key in ("model", "kind", "reason"):
+            if not e.get(key):
+                raise ValueError(f"{path}: accepted entry {i + 1} needs a non-empty '{key}'")
+    return entries
+
+
+def _matches(entry, f):
+    if entry["model"] not in ("*", f.model) or entry["kind"] != f.kind:
+        return False
+    cond = entry.get("condition")
+    if not cond:
+        return True
+    try:
+        return bool(eval(cond, {"__builtins__": {}, "math": math}, dict(f.fields)))  # noqa: S307
+    except NameError:
+        return False
+
+
+def classify(findings, accepted=None):
+    """Split findings into ``(accepted, unaccepted)``; accepted items carry their reason."""
+    accepted = load_accepted() if accepted is None else accepted
+    ok, bad = [], []
+    for f in findings:
+        entry = next((e for e in accepted if _matches(e, f)), None)
+        (ok if entry else bad).append((f, entry["reason"] if entry else None))
+    return ok, bad
+
+
+def format_sweep(findings, accepted=None) -> str:
+    ok, bad = classify(findings, accepted)
+    lines = []
+    groups = {}
+    for f, reason in ok + bad:
+        key = (f.model, f.kind, reason)
+        groups.setdefault(key, []).append(f)
+    lines.append(f"{'model':<22} {'kind':<13} {'count':>5} {'worst':>11}  status")
+    lines.append("-" * 70)
+    for (model, kind, reason), fs in sorted(groups.items(), key=lambda kv: (kv[0][2] is not None, kv[0][:2])):
+        worst = max(fs, key=lambda f: abs(f.value))
+        status = "ACCEPTED" if reason else "UNACCEPTED"
+        lines.append(f"{model:<22} {kind:<13} {len(fs):>5} {worst.value:>11.4g}  {status}")
+        lines.append(f"    e.g. {worst.params} at {worst.where}")
+        if reason:
+            lines.append(f"    reason: {reason}")
+    lines.append(f"{len(findings)} findings: {len(ok)} accepted, {len(bad)} unaccepted")
+    return "\n".join(lines)
