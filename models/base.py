@@ -70,26 +70,77 @@ class Model(Declared):
         pr = check_finite_array(n3, phi_r)
         return broadcast_angles(ti, tr, pr)
 
-    def mueller(self, theta_i, theta_r, phi_r=0.0):
-        """Mueller-matrix BRDF ``(..., 4, 4)`` in 1/sr, s/p bases (SCATMECH ``psps``)."""
-        shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
-        n = ti.size
+    def _chunks(self, theta_i, theta_r, phi_r):
+        """Validate the angles; return ``(shape, n, blocks)`` where ``blocks`` yields
+        ``(slice, ti, tr, pr)`` flat chunks of the broadcast geometries.
+
+        The broadcast arrays are never materialized: inputs of the full shape are
+        sliced, scalars are filled per chunk and other broadcast inputs are
+        gathered per chunk, so a (1000, 1) x (1, 10^4) scan uses chunk-sized
+        memory, not 10^7-sized inputs.
+        """
+        n1, n2, n3 = self._angle_names
+        arrays = [
+            check_polar_angle(n1, theta_i),
+            check_polar_angle(n2, theta_r),
+            check_finite_array(n3, phi_r),
+        ]
+        shape = np.broadcast_shapes(*(a.shape for a in arrays))
+        n = math.prod(shape)
+        flat = [a.reshape(-1) if a.shape == shape else None for a in arrays]
+
+        def blocks():
+            for start in range(0, n, CHUNK):
+                stop = min(start + CHUNK, n)
+                idx = None
+                parts = []
+                for a, f in zip(arrays, flat, strict=True):
+                    if f is not None:
+                        parts.append(f[start:stop])
+                    elif a.size == 1:
+                        parts.append(np.full(stop - start, a.reshape(-1)[0]))
+                    else:
+                        if idx is None:
+                            idx = np.unravel_index(np.arange(start, stop), shape)
+                        parts.append(np.broadcast_to(a, shape)[idx])
+                yield (slice(start, stop), *parts)
+
+        return shape, n, blocks()
+
+    def iter_mueller(self, theta_i, theta_r, phi_r=0.0):
+        """Stream the Mueller BRDF: yields ``(flat_slice, block)`` with ``block`` of shape
+        ``(k, 4, 4)`` for consecutive runs of the C-ordered broadcast geometries.
+
+        Memory stays bounded by the chunk size however many geometries there are
+        (10^7 and beyond): reduce or store each block as it comes.
+        """
+        _, _, blocks = self._chunks(theta_i, theta_r, phi_r)
+        for sl, ti, tr, pr in blocks:
+            yield sl, self._mueller16(ti, tr, pr).T.reshape(-1, 4, 4)
+
+    def mueller(self, theta_i, theta_r, phi_r=0.0, out=None):
+        """Mueller-matrix BRDF ``(..., 4, 4)`` in 1/sr, s/p bases (SCATMECH ``psps``).
+
+        ``out``, optional: a ``(16, N)`` float64 array (e.g. a ``numpy.memmap``)
+        to write into, element-major, for very large evaluations.
+        """
+        shape, n, blocks = self._chunks(theta_i, theta_r, phi_r)
         # Element-major storage: each chunk's (16, k) block is copied without a
         # transpose; the (..., 4, 4) result is a strided view of it.
-        out = np.empty((16, n))
-        for start in range(0, n, CHUNK):
-            sl = slice(start, min(start + CHUNK, n))
-            out[:, sl] = self._mueller16(ti[sl], tr[sl], pr[sl])
+        if out is None:
+            out = np.empty((16, n))
+        elif out.shape != (16, n):
+            raise ValueError(f"out must have shape (16, {n}); got {out.shape}")
+        for sl, ti, tr, pr in blocks:
+            out[:, sl] = self._mueller16(ti, tr, pr)
         return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
 
     def brdf(self, theta_i, theta_r, phi_r=0.0):
         """Unpolarized-in, total-out BRDF ``M00`` (1/sr)."""
-        shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
-        n = ti.size
+        shape, n, blocks = self._chunks(theta_i, theta_r, phi_r)
         out = np.empty(n)
-        for start in range(0, n, CHUNK):
-            sl = slice(start, min(start + CHUNK, n))
-            out[sl] = self._brdf_flat(ti[sl], tr[sl], pr[sl])
+        for sl, ti, tr, pr in blocks:
+            out[sl] = self._brdf_flat(ti, tr, pr)
         return out.reshape(shape)
 
     def _brdf_flat(self, ti, tr, pr):
@@ -101,12 +152,10 @@ class Model(Declared):
         non-depolarizing models; the overall phase is arbitrary."""
         if self.depolarizing:
             raise NotImplementedError(f"{type(self).__name__} is depolarizing: it has no Jones matrix")
-        shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
-        n = ti.size
+        shape, n, blocks = self._chunks(theta_i, theta_r, phi_r)
         out = np.empty((n, 2, 2), dtype=complex)
-        for start in range(0, n, CHUNK):
-            sl = slice(start, min(start + CHUNK, n))
-            out[sl] = self._jones_flat(ti[sl], tr[sl], pr[sl])
+        for sl, ti, tr, pr in blocks:
+            out[sl] = self._jones_flat(ti, tr, pr)
         return out.reshape(shape + (2, 2))
 
     def scattered_stokes(self, theta_i, theta_r, phi_r=0.0, incident="unpolarized"):

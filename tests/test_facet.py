@@ -163,3 +163,17 @@ def test_polarization_helper():
     out = m.polarization(1.0, np.linspace(0, 1.4, 5), 0.3, incident="linear:45")
     assert set(out) == {"brdf", "eta", "P_C", "P"}
     np.testing.assert_allclose(out["P"], 1.0, atol=1e-12)  # non-depolarizing model, pure input
+
+
+def test_streaming_and_out_match_mueller(tmp_path):
+    m = models.SubsurfaceFacetBRDF()
+    tr = np.linspace(0, 1.5, 700)[:, None]
+    pr = np.linspace(-3, 3, 13)[None, :]
+    full = m.mueller(0.4, tr, pr)
+    streamed = np.concatenate([b for _, b in m.iter_mueller(0.4, tr, pr)])
+    np.testing.assert_array_equal(streamed, full.reshape(-1, 4, 4))
+    buf = np.lib.format.open_memmap(tmp_path / "m.npy", mode="w+", shape=(16, full[..., 0, 0].size))
+    via_out = m.mueller(0.4, tr, pr, out=buf)
+    np.testing.assert_array_equal(via_out, full)
+    with pytest.raises(ValueError, match="out"):
+        m.mueller(0.4, tr, pr, out=np.empty((16, 3)))
