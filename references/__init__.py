@@ -82,3 +82,9 @@ def table1_scatmech() -> dict:
         key = (r["substrate"], float(r["coating"]), float(r["sigma"]))
         out[key] = {"value": float(r["reflectance"]), "grid_change": float(r["grid_change"])}
     return out
+
+
+def scene_paths() -> list[str]:
+    """Paths of the example scene files shipped with scatterbench (one per preset)."""
+    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenes")
+    return sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".toml"))

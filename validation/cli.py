@@ -95,6 +95,22 @@ def _cmd_tradeoff(args) -> int:
     return 0
 
 
+def _cmd_scene(args) -> int:
+    from models import scene as scene_mod
+
+    from .scene_eval import write_scene_outputs
+
+    try:
+        sc = scene_mod.load(args.file)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(sc.describe())
+    csv_path, png_path = write_scene_outputs(sc, args.out)
+    print(f"wrote {csv_path} and {png_path}")
+    return 0
+
+
 def _cmd_models(args) -> int:
     import models
 
@@ -121,6 +137,10 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="fewer settings per knob")
     p.add_argument("--tol", type=float, default=None, help="report the cheapest setting meeting this error")
     p.set_defaults(func=_cmd_tradeoff)
+    p = sub.add_parser("scene", help="evaluate a scene file: in-plane and out-of-plane scans (CSV + PNG)")
+    p.add_argument("file", help="scene TOML file")
+    p.add_argument("--out", default="reports/scenes", help="output folder")
+    p.set_defaults(func=_cmd_scene)
     p = sub.add_parser("models", help="list the models and their declared parameters")
     p.set_defaults(func=_cmd_models)
     args = ap.parse_args(argv)

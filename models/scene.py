@@ -1,0 +1,313 @@
+"""Scenes: a sample and a measurement described once, in TOML, built into the
+cheapest model that represents them.
+
+``load(path)`` reads and validates a scene file (standard-library ``tomllib``);
+every error names the file, the key and the allowed values.  ``Scene.build()``
+returns the composite model holding only the mechanisms the scene declares,
+and ``Scene.mechanisms()`` says which ones and why.
+
+Schema (angles in degrees in files, as everywhere outside the Python API)::
+
+    name = "Aluminium flakes under a clear coat"
+
+    [illumination]
+    theta_i_deg = 60.0
+    polarization = "linear:45"     # unpolarized | s | p | +45 | -45 | left | right | linear:<deg> | [I, Q, U, V]
+    wavelength_nm = 632.8
+    source = "collimated"          # collimated | point
+    distance_mm = 500.0            # point source: distance to the sample centre
+    sample_radius_mm = 10.0        # point source: illuminated radius
+
+    [coating]                      # optional clear layer over the substrate/flakes
+    index = 1.5
+    [coating.roughness]            # optional: rough top surface (its own facet reflection)
+    distribution = "gaussian"
+    sigma = 0.02
+
+    [substrate]                    # the flakes or the substrate under the coating
+    index = [1.37, 7.62]           # [n, k], a number, or "inf" (perfect conductor)
+    distribution = "exponential"   # omit for a flat (specular) substrate
+    sigma = 0.1
+    coverage = 1.0
+
+    [volume]                       # optional volume scatterer (pigment) in the coating
+    ...
+
+    [detector]
+    aperture_deg = 0.7
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+
+from . import slopes as _slopes
+from .base import Model
+from .facet import FacetBRDF
+from .polarization import stokes
+from .subsurface_facet import SubsurfaceFacetBRDF
+
+__all__ = ["Scene", "Mechanism", "load", "loads", "DISTRIBUTIONS"]
+
+#: distribution names in scene files and the classes (and their parameters) they map to
+DISTRIBUTIONS = {
+    "exponential": (_slopes.ExponentialSlopes, ("sigma", "coverage")),
+    "gaussian": (_slopes.GaussianSlopes, ("sigma", "coverage")),
+    "anisotropic-exponential": (
+        _slopes.AnisotropicExponentialSlopes,
+        ("sigma_x", "sigma_y", "rotation_deg", "coverage"),
+    ),
+    "anisotropic-gaussian": (
+        _slopes.AnisotropicGaussianSlopes,
+        ("sigma_x", "sigma_y", "rotation_deg", "coverage"),
+    ),
+    "gaussian-angle": (_slopes.GaussianAngles, ("sigma_deg", "coverage")),
+    "exponential-angle": (_slopes.ExponentialAngles, ("sigma_deg", "coverage")),
+}
+
+_TOP = {"name", "description", "illumination", "coating", "substrate", "volume", "detector", "fit"}
+_ILLUM = {"theta_i_deg", "polarization", "wavelength_nm", "source", "distance_mm", "sample_radius_mm"}
+
+
+class SceneError(ValueError):
+    """A scene file problem; the message names the file, the key and the allowed values."""
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    name: str
+    model: Model
+    why: str
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str
+    path: str
+    theta_i: float  # radians
+    polarization: tuple
+    wavelength_nm: float | None
+    source: str
+    distance_mm: float | None
+    sample_radius_mm: float | None
+    coating: dict | None
+    substrate: dict | None
+    volume: dict | None
+    detector: dict | None
+    fit: dict | None = None
+    notes: tuple = field(default_factory=tuple)
+
+    def mechanisms(self) -> list[Mechanism]:
+        """The scattering mechanisms this scene requires, each with the reason it is there."""
+        out = []
+        coat_n = self.coating["index"] if self.coating else None
+        rough_top = self.coating.get("roughness") if self.coating else None
+        if self.substrate is not None and self.substrate.get("slopes") is not None:
+            if coat_n is not None:
+                out.append(
+                    Mechanism(
+                        "subsurface facets",
+                        SubsurfaceFacetBRDF(
+                            slopes=self.substrate["slopes"], coating=coat_n, substrate=self.substrate["index"]
+                        ),
+                        "facets (flakes or a rough substrate) under the coating: seed 000's subsurface facet model",
+                    )
+                )
+            else:
+                out.append(
+                    Mechanism(
+                        "exposed facets",
+                        FacetBRDF(slopes=self.substrate["slopes"], substrate=self.substrate["index"]),
+                        "a rough substrate with no coating: the exposed facet model",
+                    )
+                )
+        if rough_top is not None:
+            out.append(
+                Mechanism(
+                    "rough coating surface",
+                    FacetBRDF(slopes=rough_top, substrate=coat_n),
+                    "the coating's top surface is rough: facet reflection by the exposed interface",
+                )
+            )
+        if self.volume is not None:
+            raise SceneError(
+                f"{self.path}: [volume]: volume scattering models are not available in this build"
+            )
+        return out
+
+    def build(self) -> Model:
+        """The incoherent sum of :meth:`mechanisms` (a single model when there is one)."""
+        mech = self.mechanisms()
+        if not mech:
+            raise SceneError(
+                f"{self.path}: the scene declares no scattering mechanism (a flat substrate and a smooth "
+                "coating only reflect specularly); add [substrate] distribution, [coating.roughness] or [volume]"
+            )
+        total = mech[0].model
+        for m in mech[1:]:
+            total = total + m.model
+        return total
+
+    def describe(self) -> str:
+        lines = [f"scene {self.name!r} ({self.path})"]
+        for m in self.mechanisms():
+            lines.append(f"  - {m.name}: {type(m.model).__name__} — {m.why}")
+        lines.extend(f"  note: {n}" for n in self.notes)
+        return "\n".join(lines)
+
+
+def _err(path, key, msg):
+    return SceneError(f"{path}: {key}: {msg}")
+
+
+def _unknown(path, section, table, allowed):
+    for k in table:
+        if k not in allowed:
+            raise _err(path, f"{section}{k}", f"unknown key; allowed: {', '.join(sorted(allowed))}")
+
+
+def _number(path, key, value, low=None, high=None, low_open=False):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise _err(path, key, f"must be a finite number; got {value!r}")
+    if low is not None and (value < low or (low_open and value == low)):
+        raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {value!r}")
+    if high is not None and value > high:
+        raise _err(path, key, f"must be <= {high:g}; got {value!r}")
+    return float(value)
+
+
+def _index(path, key, value):
+    if value == "inf":
+        return math.inf
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        z = complex(float(value), 0.0)
+    elif isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value):
+        z = complex(float(value[0]), float(value[1]))
+    else:
+        raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {value!r}')
+    if not (math.isfinite(z.real) and math.isfinite(z.imag)) or z.real <= 0 or z.imag < 0:
+        raise _err(path, key, f"must have n > 0 and k >= 0; got {value!r}")
+    return z
+
+
+def _distribution(path, section, table):
+    kind = table.get("distribution")
+    if kind not in DISTRIBUTIONS:
+        raise _err(path, f"{section}distribution", f"must be one of {', '.join(DISTRIBUTIONS)}; got {kind!r}")
+    cls, names = DISTRIBUTIONS[kind]
+    kwargs = {}
+    for name in names:
+        if name not in table:
+            if name in ("coverage", "rotation_deg"):
+                continue
+            raise _err(path, f"{section}{name}", f"required for distribution {kind!r}")
+        v = _number(path, f"{section}{name}", table[name])
+        if name.endswith("_deg"):
+            kwargs[name[:-4]] = math.radians(v)
+        else:
+            kwargs[name] = v
+    try:
+        return cls(**kwargs)
+    except ValueError as exc:
+        raise _err(path, f"{section}{kind}", str(exc)) from exc
+
+
+def loads(text: str, path: str = "<scene>") -> Scene:
+    """Parse and validate scene TOML text."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from exc
+    _unknown(path, "", data, _TOP)
+    name = data.get("name")
+    if not isinstance(name, str) or not name.strip():
+        raise _err(path, "name", "a non-empty string is required")
+    ill = data.get("illumination")
+    if not isinstance(ill, dict):
+        raise _err(path, "[illumination]", "the table is required (theta_i_deg at least)")
+    _unknown(path, "[illumination] ", ill, _ILLUM)
+    if "theta_i_deg" not in ill:
+        raise _err(path, "[illumination] theta_i_deg", "required, in [0, 90]")
+    theta_i = math.radians(_number(path, "[illumination] theta_i_deg", ill["theta_i_deg"], 0.0, 90.0))
+    try:
+        pol = tuple(float(x) for x in stokes(ill.get("polarization", "unpolarized")))
+    except ValueError as exc:
+        raise _err(path, "[illumination] polarization", str(exc)) from exc
+    wl = ill.get("wavelength_nm")
+    wl = None if wl is None else _number(path, "[illumination] wavelength_nm", wl, 0.0, low_open=True)
+    source = ill.get("source", "collimated")
+    if source not in ("collimated", "point"):
+        raise _err(path, "[illumination] source", f"must be 'collimated' or 'point'; got {source!r}")
+    dist = rad = None
+    if source == "point":
+        for key in ("distance_mm", "sample_radius_mm"):
+            if key not in ill:
+                raise _err(
+                    path, f"[illumination] {key}", "required for source = 'point' (a finite number > 0)"
+                )
+        dist = _number(path, "[illumination] distance_mm", ill["distance_mm"], 0.0, low_open=True)
+        rad = _number(path, "[illumination] sample_radius_mm", ill["sample_radius_mm"], 0.0, low_open=True)
+        if rad > dist:
+            raise _err(path, "[illumination] sample_radius_mm", "must not exceed distance_mm")
+    coating = None
+    if "coating" in data:
+        c = data["coating"]
+        _unknown(path, "[coating] ", c, {"index", "roughness"})
+        if "index" not in c:
+            raise _err(path, "[coating] index", "required: a real index >= 1")
+        n = _number(path, "[coating] index", c["index"], 1.0)
+        coating = {"index": n}
+        if "roughness" in c:
+            coating["roughness"] = _distribution(path, "[coating.roughness] ", c["roughness"])
+    substrate = None
+    if "substrate" in data:
+        s = data["substrate"]
+        allowed = {"index", "distribution"} | {k for _, ks in DISTRIBUTIONS.values() for k in ks}
+        _unknown(path, "[substrate] ", s, allowed)
+        if "index" not in s:
+            raise _err(path, "[substrate] index", 'required: n, [n, k] or "inf"')
+        substrate = {"index": _index(path, "[substrate] index", s["index"])}
+        substrate["slopes"] = _distribution(path, "[substrate] ", s) if "distribution" in s else None
+    volume = data.get("volume")
+    detector = data.get("detector")
+    if detector is not None:
+        _unknown(path, "[detector] ", detector, {"aperture_deg"})
+        detector = {
+            "aperture_deg": _number(
+                path, "[detector] aperture_deg", detector.get("aperture_deg", 0.0), 0.0, 90.0
+            )
+        }
+    notes = []
+    if source == "point":
+        notes.append(
+            "point source declared; evaluated as collimated by this build (no point-source wrapper available)"
+        )
+    return Scene(
+        name=name,
+        path=path,
+        theta_i=theta_i,
+        polarization=pol,
+        wavelength_nm=wl,
+        source=source,
+        distance_mm=dist,
+        sample_radius_mm=rad,
+        coating=coating,
+        substrate=substrate,
+        volume=volume,
+        detector=detector,
+        fit=data.get("fit"),
+        notes=tuple(notes),
+    )
+
+
+def load(path) -> Scene:
+    """Read and validate a scene file."""
+    path = str(path)
+    try:
+        with open(path, "rb") as fh:
+            text = fh.read().decode("utf-8")
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from exc
+    return loads(text, path)

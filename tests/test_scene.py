@@ -1,0 +1,91 @@
+"""Scene files: loading, validation errors naming file and key, mechanisms, evaluation."""
+
+import csv
+import os
+
+import pytest
+
+import models
+import references
+from models import scene
+from validation.cli import main
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = references.scene_paths()
+
+
+@pytest.mark.parametrize("path", SCENES, ids=os.path.basename)
+def test_example_scenes_load_build_and_explain(path):
+    sc = scene.load(path)
+    mech = sc.mechanisms()
+    assert mech and all(m.why for m in mech)
+    model = sc.build()
+    assert isinstance(model, models.Model)
+    assert model.mueller(sc.theta_i, 0.3, 0.2).shape == (4, 4)
+
+
+def test_coated_flakes_build_only_the_subsurface_facet_model():
+    sc = scene.load(
+        os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
+    )
+    assert [type(m.model) for m in sc.mechanisms()] == [models.SubsurfaceFacetBRDF]
+    m = sc.build()
+    assert m.coating == 1.5 and m.substrate == 1.37 + 7.62j and m.slopes.sigma == 0.1
+
+
+BASE = 'name = "x"\n[illumination]\ntheta_i_deg = 30\n'
+
+
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ("name = 3\n[illumination]\ntheta_i_deg = 1\n", "name"),
+        ('name = "x"\n', "[illumination]"),
+        ('name = "x"\n[illumination]\ntheta_i_deg = 95\n', "theta_i_deg"),
+        (BASE + 'polarization = "diagonal"\n', "polarization"),
+        (BASE + 'source = "laser"\n', "source"),
+        (BASE + 'source = "point"\n', "distance_mm"),
+        (BASE + "[coating]\nindex = 0.9\n", "[coating] index"),
+        (
+            BASE + '[substrate]\nindex = [1.5, -0.1]\ndistribution = "gaussian"\nsigma = 0.1\n',
+            "[substrate] index",
+        ),
+        (BASE + '[substrate]\nindex = 1.5\ndistribution = "gaussian"\n', "[substrate] sigma"),
+        (BASE + '[substrate]\nindex = 1.5\ndistribution = "gaussian"\nsigma = -1\n', "[substrate] gaussian"),
+        (BASE + '[substrate]\nindex = 1.5\ndistribution = "cauchy"\nsigma = 1\n', "distribution"),
+        (BASE + "[substrat]\nindex = 1.5\n", "substrat"),
+        (BASE + "[illumination.extra]\n", "extra"),
+        ("name = [", "not valid TOML"),
+    ],
+)
+def test_malformed_scene_names_file_and_key(text, key):
+    with pytest.raises(ValueError) as exc:
+        scene.loads(text, "sample.toml")
+    msg = str(exc.value)
+    assert msg.startswith("sample.toml") and key in msg
+
+
+def test_flat_smooth_scene_has_no_mechanism():
+    sc = scene.loads(BASE + "[coating]\nindex = 1.5\n[substrate]\nindex = [1.37, 7.62]\n", "flat.toml")
+    assert sc.mechanisms() == []
+    with pytest.raises(ValueError, match="no scattering mechanism"):
+        sc.build()
+
+
+def test_missing_file():
+    with pytest.raises(ValueError, match="cannot read"):
+        scene.load("/nonexistent/scene.toml")
+
+
+def test_scene_command_writes_csv_and_png(tmp_path):
+    path = os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
+    assert main(["scene", path, "--out", str(tmp_path)]) == 0
+    rows = list(
+        csv.reader(
+            line for line in open(tmp_path / "aluminium_flakes_clearcoat.csv") if not line.startswith("#")
+        )
+    )
+    assert rows[0] == ["scan", "theta_i_deg", "theta_r_deg", "phi_r_deg", "brdf", "eta_deg", "P", "P_C"]
+    assert {r[0] for r in rows[1:]} == {"in-plane", "out-of-plane"}
+    assert (tmp_path / "aluminium_flakes_clearcoat.png").stat().st_size > 1000
+    assert main(["scene", "/nonexistent.toml", "--out", str(tmp_path)]) == 2

@@ -1,0 +1,93 @@
+"""Evaluate a scene: in-plane curve and out-of-plane scan of BRDF, eta, P, P_C.
+
+The in-plane curve runs over the signed scattering angle from -89 to +89 deg
+(negative: the incidence side, phi = 180 deg); the out-of-plane scan keeps
+``theta_r = theta_i`` and runs ``phi_r`` from 0 (specular) to 180 deg
+(retroreflection), as in seed 000 Sec. 3.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+
+import numpy as np
+
+from models.polarization import ellipsometric
+
+from .atomic import atomic_savefig, atomic_write_text
+
+__all__ = ["scan", "write_scene_outputs"]
+
+
+def scan(scene, n_inplane=357, n_azimuth=181):
+    model = scene.build()
+    s_in = np.asarray(scene.polarization, dtype=float)
+    ti = scene.theta_i
+    x = np.radians(np.linspace(-89.0, 89.0, n_inplane))
+    phi = np.radians(np.linspace(0.0, 180.0, n_azimuth))
+    rows = {}
+    for label, tr, pr, coord in (
+        ("in-plane", np.abs(x), np.where(x >= 0, 0.0, math.pi), np.degrees(x)),
+        ("out-of-plane", np.full_like(phi, ti), phi, np.degrees(phi)),
+    ):
+        S = model.mueller(ti, tr, pr) @ s_in
+        i, eta, pc, p = ellipsometric(S)
+        rows[label] = {
+            "coord": coord,
+            "theta_r_deg": np.degrees(tr),
+            "phi_r_deg": np.degrees(pr),
+            "brdf": i / s_in[0],
+            "eta_deg": np.degrees(eta),
+            "P": p,
+            "P_C": pc,
+        }
+    return model, rows
+
+
+def write_scene_outputs(scene, out_dir):
+    """Write ``<stem>.csv`` and ``<stem>.png``; returns their paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    model, rows = scan(scene)
+    stem = os.path.splitext(os.path.basename(scene.path))[0]
+    buf = io.StringIO()
+    buf.write(f"# scene: {scene.name}\n# file: {scene.path}\n")
+    buf.write(f"# model: {model!r}\n# incident Stokes: {list(scene.polarization)}\n")
+    w = csv.writer(buf)
+    w.writerow(["scan", "theta_i_deg", "theta_r_deg", "phi_r_deg", "brdf", "eta_deg", "P", "P_C"])
+    ti_deg = math.degrees(scene.theta_i)
+    for label, r in rows.items():
+        for k in range(len(r["brdf"])):
+            w.writerow(
+                [label, f"{ti_deg:.6g}", f"{r['theta_r_deg'][k]:.6g}", f"{r['phi_r_deg'][k]:.6g}"]
+                + [f"{r[c][k]:.10g}" for c in ("brdf", "eta_deg", "P", "P_C")]
+            )
+    csv_path = os.path.join(out_dir, f"{stem}.csv")
+    atomic_write_text(csv_path, buf.getvalue())
+    fig, axes = plt.subplots(4, 2, figsize=(10, 10), sharex="col")
+    for col, (label, r) in enumerate(rows.items()):
+        xlab = "signed scattering angle (deg)" if label == "in-plane" else "phi_r (deg), theta_r = theta_i"
+        ax = axes[0, col]
+        ax.semilogy(r["coord"], np.maximum(r["brdf"], 1e-12))
+        ax.set_ylabel("BRDF (1/sr)")
+        ax.set_title(f"{label}, theta_i = {ti_deg:g} deg")
+        # eta is defined modulo 180 deg: unwrap it for the plot (the CSV keeps (-90, 90])
+        eta = np.degrees(np.unwrap(np.radians(2 * np.nan_to_num(r["eta_deg"]))) / 2)
+        axes[1, col].plot(r["coord"], eta)
+        axes[1, col].set_ylabel("eta (deg)")
+        for row, key, ylab in ((2, "P", "P"), (3, "P_C", "P_C")):
+            axes[row, col].plot(r["coord"], r[key])
+            axes[row, col].set_ylabel(ylab)
+        axes[3, col].set_xlabel(xlab)
+    fig.suptitle(scene.name)
+    fig.tight_layout()
+    png_path = os.path.join(out_dir, f"{stem}.png")
+    atomic_savefig(fig, png_path, dpi=100)
+    plt.close(fig)
+    return csv_path, png_path
