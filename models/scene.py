@@ -39,6 +39,7 @@ Schema (angles in degrees in files, as everywhere outside the Python API)::
 
 from __future__ import annotations
 
+import copy
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -49,7 +50,7 @@ from .facet import FacetBRDF
 from .polarization import stokes
 from .subsurface_facet import SubsurfaceFacetBRDF
 
-__all__ = ["Scene", "Mechanism", "load", "loads", "DISTRIBUTIONS"]
+__all__ = ["Scene", "SceneError", "Mechanism", "load", "loads", "from_dict", "DISTRIBUTIONS"]
 
 #: distribution names in scene files and the classes (and their parameters) they map to
 DISTRIBUTIONS = {
@@ -98,6 +99,48 @@ class Scene:
     detector: dict | None
     fit: dict | None = None
     notes: tuple = field(default_factory=tuple)
+    raw: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def get_value(self, key: str):
+        """The raw value at a dotted key of the scene file, e.g. ``substrate.sigma``,
+        ``coating.index``, ``substrate.index[1]`` (k of an [n, k] index)."""
+        node, last, idx = self._locate(copy.deepcopy(self.raw), key)
+        v = node[last]
+        return v[idx] if idx is not None else v
+
+    def with_values(self, values: dict) -> Scene:
+        """A new, re-validated scene with the given dotted keys set (for fits and sweeps)."""
+        data = copy.deepcopy(self.raw)
+        for key, value in values.items():
+            node, last, idx = self._locate(data, key)
+            if idx is None:
+                node[last] = value
+            else:
+                cur = node[last]
+                if not isinstance(cur, list):
+                    cur = [cur, 0.0]
+                cur = list(cur)
+                cur[idx] = value
+                node[last] = cur
+        return from_dict(data, self.path)
+
+    def _locate(self, data, key):
+        idx = None
+        if key.endswith("]") and "[" in key:
+            key, _, rest = key.partition("[")
+            try:
+                idx = int(rest[:-1])
+            except ValueError as exc:
+                raise SceneError(f"{self.path}: {key}: bad index in {rest!r}") from exc
+        parts = key.split(".")
+        node = data
+        for p in parts[:-1]:
+            if not isinstance(node.get(p), dict):
+                raise SceneError(f"{self.path}: {key}: no table [{p}] in the scene")
+            node = node[p]
+        if parts[-1] not in node:
+            raise SceneError(f"{self.path}: {key}: not set in the scene")
+        return node, parts[-1], idx
 
     def mechanisms(self) -> list[Mechanism]:
         """The scattering mechanisms this scene requires, each with the reason it is there."""
@@ -220,6 +263,11 @@ def loads(text: str, path: str = "<scene>") -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML: {exc}") from exc
+    return from_dict(data, path)
+
+
+def from_dict(data: dict, path: str = "<scene>") -> Scene:
+    """Validate a scene given as the dict a TOML file parses to."""
     _unknown(path, "", data, _TOP)
     name = data.get("name")
     if not isinstance(name, str) or not name.strip():
@@ -299,6 +347,7 @@ def loads(text: str, path: str = "<scene>") -> Scene:
         detector=detector,
         fit=data.get("fit"),
         notes=tuple(notes),
+        raw=copy.deepcopy(data),
     )
 
 

@@ -89,3 +89,16 @@ def test_scene_command_writes_csv_and_png(tmp_path):
     assert {r[0] for r in rows[1:]} == {"in-plane", "out-of-plane"}
     assert (tmp_path / "aluminium_flakes_clearcoat.png").stat().st_size > 1000
     assert main(["scene", "/nonexistent.toml", "--out", str(tmp_path)]) == 2
+
+
+def test_with_values_rebuilds_and_revalidates():
+    sc = scene.load(references.scene_paths()[0])
+    s2 = sc.with_values({"substrate.sigma": 0.25, "substrate.index[1]": 7.0, "coating.index": 1.6})
+    m = s2.build()
+    assert m.slopes.sigma == 0.25 and m.substrate == 1.37 + 7.0j and m.coating == 1.6
+    assert sc.build().slopes.sigma == 0.1  # the original is untouched
+    assert s2.get_value("substrate.index[0]") == 1.37
+    with pytest.raises(ValueError, match=r"\[substrate\].*sigma"):
+        sc.with_values({"substrate.sigma": -1.0})
+    with pytest.raises(ValueError, match="not set"):
+        sc.with_values({"substrate.nothing": 1.0})
