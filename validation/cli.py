@@ -143,8 +143,26 @@ def main(argv=None) -> int:
     p.set_defaults(func=_cmd_scene)
     p = sub.add_parser("models", help="list the models and their declared parameters")
     p.set_defaults(func=_cmd_models)
+    for mod in _command_modules():
+        mod.register(sub)
     args = ap.parse_args(argv)
     return args.func(args)
+
+
+def _command_modules():
+    """``validation.cmd_*`` modules: each defines ``register(subparsers)`` adding its
+    subcommands (with ``set_defaults(func=...)``), so features add commands without
+    editing this file."""
+    import importlib
+    import pkgutil
+
+    import validation
+
+    mods = []
+    for info in sorted(pkgutil.iter_modules(validation.__path__), key=lambda i: i.name):
+        if info.name.startswith("cmd_"):
+            mods.append(importlib.import_module(f"validation.{info.name}"))
+    return mods
 
 
 if __name__ == "__main__":
