@@ -1,0 +1,42 @@
+"""``scatterbench report`` and ``scatterbench nightly``."""
+
+from __future__ import annotations
+
+import os
+
+
+def _report(args) -> int:
+    from .report import write_report
+
+    res = write_report(args.out, quick=args.quick)
+    s = res["summary"]
+    print(
+        f"wrote {os.path.join(args.out, 'report.html')} and results.json: {s['n_checks']} checks, "
+        f"{s['n_pass']} pass, {s['n_finding']} findings, {s['n_fail']} fail in {res['meta']['seconds']:.1f} s"
+    )
+    return 1 if s["n_fail"] else 0
+
+
+def _nightly(args) -> int:
+    from .report import nightly
+
+    code, regressions, run_dir = nightly(args.history, quick=args.quick)
+    print(f"nightly run written to {run_dir}; latest -> {os.path.relpath(run_dir, args.history)}")
+    for r in regressions:
+        print(f"REGRESSION: {r}")
+    if not regressions:
+        print("no regression against the previous night")
+    return code
+
+
+def register(sub):
+    p = sub.add_parser("report", help="compute the full validation report (HTML + results.json)")
+    p.add_argument("--out", default="reports/latest", help="output folder")
+    p.add_argument("--quick", action="store_true", help="fewer points per section (< 2 min)")
+    p.set_defaults(func=_report)
+    p = sub.add_parser(
+        "nightly", help="run the report into a dated history folder and compare with the previous night"
+    )
+    p.add_argument("--history", required=True, help="history folder (runs/, latest)")
+    p.add_argument("--quick", action="store_true")
+    p.set_defaults(func=_nightly)

@@ -1,0 +1,120 @@
+"""Compute every section, render one self-contained HTML page and results.json."""
+
+from __future__ import annotations
+
+import datetime
+import json
+import os
+import sys
+import time
+import traceback
+
+from ..atomic import atomic_write_json, atomic_write_text
+from .core import Context, Section, render_html
+from .sections import SECTION_FUNCS, _git_commit
+
+__all__ = ["build_report", "write_report"]
+
+
+def _progress(total, label):
+    """A tqdm bar on a terminal; silent in CI or when stderr is not a terminal."""
+    from tqdm import tqdm
+
+    quiet = bool(os.environ.get("CI")) or not sys.stderr.isatty()
+    return tqdm(total=total, desc=label, disable=quiet, unit="section", leave=False)
+
+
+def build_report(quick=False, previous=None, seed=20261122, only=None, extra_scenes=(), checks=None):
+    """Run every section; returns ``(results, html)``.  A section that raises is kept
+    on the page with its error and counts as a failed check; the others still run.
+
+    ``only``: names of the sections to compute (summary and provenance always run);
+    ``extra_scenes``: scene files shown beside the built-in examples;
+    ``checks``: the check functions of the summary (default: every check).
+    """
+    ctx = Context(quick=quick, previous=previous, seed=seed)
+    ctx.cache["extra_scenes"] = list(extra_scenes)
+    if checks is not None:
+        ctx.cache["check_funcs"] = list(checks)
+    t0 = time.perf_counter()
+    funcs = [
+        f
+        for f in SECTION_FUNCS
+        if only is None or f.__name__.removeprefix("section_") in set(only) | {"summary", "provenance"}
+    ]
+    order = [f for f in funcs if f.__name__ not in ("section_summary", "section_provenance")]
+    order += [f for f in funcs if f.__name__ == "section_provenance"]
+    order += [f for f in funcs if f.__name__ == "section_summary"]
+    done = {}
+    times = ctx.cache.setdefault("section_times", {})
+    with _progress(len(order), "report") as bar:
+        for fn in order:
+            name = fn.__name__.removeprefix("section_")
+            bar.set_postfix_str(name)
+            t = time.perf_counter()
+            try:
+                sec = fn(ctx)
+            except Exception as exc:  # a broken section must not lose the rest of the report
+                sec = Section(name, name, error=f"{type(exc).__name__}: {exc}")
+                sec.blocks = []
+                ctx.cache.setdefault("extra_checks", []).append(
+                    {
+                        "name": f"report section '{name}' computed",
+                        "measured": 1.0,
+                        "tolerance": 0.0,
+                        "status": "fail",
+                        "detail": traceback.format_exc(limit=3),
+                    }
+                )
+            sec.seconds = time.perf_counter() - t
+            times[name] = sec.seconds
+            done[fn.__name__] = sec
+            bar.update(1)
+    sections = [done[f.__name__] for f in funcs]
+    checks = done["section_summary"].checks
+    summary = {
+        "n_checks": len(checks),
+        "n_pass": sum(c["status"] == "pass" for c in checks),
+        "n_finding": sum(c["status"] == "finding" for c in checks),
+        "n_fail": sum(c["status"] == "fail" for c in checks),
+    }
+    meta = {
+        "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
+        "git_commit": _git_commit(),
+        "quick": quick,
+        "seed": seed,
+        "seconds": time.perf_counter() - t0,
+    }
+    results = {
+        "meta": meta,
+        "summary": summary,
+        "checks": checks,
+        "sections": {s.id: s.as_json() for s in sections},
+    }
+    # round-trip through JSON so the page is rendered from exactly what results.json holds
+    results = json.loads(json.dumps(results, default=float))
+    html = render_html(meta, sections, summary)
+    return results, html
+
+
+def read_results(path):
+    try:
+        with open(path) as fh:
+            return json.load(fh)
+    except (OSError, ValueError):
+        return None
+
+
+def write_report(out_dir, quick=False, previous=None, **kwargs):
+    """Write ``report.html`` and ``results.json`` into ``out_dir`` (each atomically).
+
+    The previous ``results.json`` of that folder (if any) is the comparison base
+    for "change since previous" unless ``previous`` is given.
+    """
+    os.makedirs(out_dir, exist_ok=True)
+    if previous is None:
+        previous = read_results(os.path.join(out_dir, "results.json"))
+    results, html = build_report(quick=quick, previous=previous, **kwargs)
+    atomic_write_json(os.path.join(out_dir, "results.json"), results)
+    atomic_write_text(os.path.join(out_dir, "report.html"), html)
+    return results

@@ -1,0 +1,138 @@
+"""Report building blocks: sections, blocks, rendering, results.json.
+
+A section is computed by a function ``f(ctx) -> Section``.  Everything a page
+shows comes from the section's blocks, and every number in a table block is
+also stored in ``results.json`` (``numbers``), so the page and the JSON are
+one set of values.  ``tracked`` numbers carry a tolerance: ``nightly`` flags a
+regression when one moves by more than it between nights.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import math
+from dataclasses import dataclass, field
+
+import jinja2
+
+__all__ = [
+    "Section",
+    "Context",
+    "figure_block",
+    "table_block",
+    "text_block",
+    "checks_block",
+    "render_html",
+]
+
+
+@dataclass
+class Context:
+    quick: bool = False
+    previous: dict | None = None  # the previous results.json, if any
+    seed: int = 20261122
+    cache: dict = field(default_factory=dict)
+
+
+@dataclass
+class Section:
+    id: str
+    title: str
+    blocks: list = field(default_factory=list)
+    numbers: dict = field(default_factory=dict)
+    tracked: dict = field(default_factory=dict)  # key -> {"value": v, "tol": t}
+    checks: list = field(default_factory=list)  # Check.as_dict() entries
+    seconds: float = 0.0
+    error: str | None = None
+
+    def as_json(self):
+        return {
+            "id": self.id,
+            "title": self.title,
+            "numbers": self.numbers,
+            "tracked": self.tracked,
+            "checks": self.checks,
+            "seconds": self.seconds,
+            "error": self.error,
+        }
+
+
+def _clean(v):
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+def figure_block(fig, caption, dpi=90):
+    """A matplotlib figure embedded as a PNG data URI (no external file, no fetch)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return {
+        "type": "figure",
+        "src": "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode(),
+        "caption": caption,
+    }
+
+
+def table_block(section, key, columns, rows, caption="", fmt=None):
+    """A table whose cells are also stored in ``section.numbers[key]`` (list of row dicts)."""
+    fmt = fmt or {}
+    clean_rows = [{c: _clean(r.get(c)) for c in columns} for r in rows]
+    section.numbers[key] = clean_rows
+    shown = []
+    for r in clean_rows:
+        cells = []
+        for c in columns:
+            v = r[c]
+            if v is None:
+                cells.append("—")
+            elif isinstance(v, float):
+                cells.append(format(v, fmt.get(c, ".4g")))
+            else:
+                cells.append(str(v))
+        shown.append(cells)
+    return {"type": "table", "key": key, "columns": list(columns), "rows": shown, "caption": caption}
+
+
+def text_block(text):
+    return {"type": "text", "text": text}
+
+
+def checks_block(checks, previous=None):
+    """Checks with measured value, tolerance, status and change since the previous run."""
+    prev = {c["name"]: c for c in (previous or [])}
+    rows = []
+    for c in checks:
+        p = prev.get(c["name"])
+        if p is None:
+            change = "new"
+        elif p["status"] != c["status"]:
+            change = f"{p['status']} -> {c['status']}"
+        else:
+            dm = (c["measured"] or 0.0) - (p["measured"] or 0.0)
+            change = "unchanged" if dm == 0 else f"{dm:+.3g}"
+        rows.append({**c, "change": change})
+    return {"type": "checks", "rows": rows}
+
+
+_ENV = None
+
+
+def _env():
+    global _ENV
+    if _ENV is None:
+        _ENV = jinja2.Environment(
+            loader=jinja2.PackageLoader("validation.report", "templates"),
+            autoescape=jinja2.select_autoescape(enabled_extensions=("html", "j2"), default=True),
+            undefined=jinja2.StrictUndefined,
+        )
+        _ENV.filters["g"] = lambda v, spec=".4g": "—" if v is None else format(v, spec)
+    return _ENV
+
+
+def render_html(meta, sections, summary):
+    return _env().get_template("report.html.j2").render(meta=meta, sections=sections, summary=summary)
