@@ -66,3 +66,6 @@ from .stroke_slopes import StrokeSlopes  # noqa: E402
 from .varnished import VarnishedCookTorranceBRDF  # noqa: E402
 
 __all__ += ["CookTorranceBRDF", "VarnishedCookTorranceBRDF", "StrokeSlopes", "fresnel_real"]
+from .point_source import PointSourceBRDF  # noqa: E402
+
+__all__ += ["PointSourceBRDF"]

@@ -79,6 +79,9 @@ def fresnel_real(cos_i, n, k=0.0):
     s2 = 1.0 - c * c
     A = (n * n - k * k) - s2
     nk2 = (n * k) ** 2
+    if nk2 == 0.0 and n >= 1.0:
+        # Transparent, optically denser medium: A >= 0 everywhere, b = 0, a^2 = A.
+        return _fs_fp(c, s2, A, np.sqrt(A))
     root = np.sqrt(A * A + 4.0 * nk2)  # = a^2 + b^2 = |N^2 - sin^2|
     big = 0.5 * (root + np.abs(A))  # the larger of a^2, b^2: no cancellation
     if nk2 > 0.0:

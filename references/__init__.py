@@ -82,3 +82,9 @@ def table1_scatmech() -> dict:
         key = (r["substrate"], float(r["coating"]), float(r["sigma"]))
         out[key] = {"value": float(r["reflectance"]), "grid_change": float(r["grid_change"])}
     return out
+
+
+# --- issue 4 (seed 001): the iron-plate preset -------------------------------------
+from .presets_seed001 import IRON_PLATE, iron_plate_models, point_source_geometry  # noqa: E402
+
+__all__ += ["IRON_PLATE", "iron_plate_models", "point_source_geometry"]
