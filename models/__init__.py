@@ -62,10 +62,14 @@ def list_models():
 
 # --- issue 4 (seed 001: varnished metal) -------------------------------------------
 from .cook_torrance import CookTorranceBRDF, fresnel_real  # noqa: E402
+from .point_source import PointSourceBRDF  # noqa: E402
 from .stroke_slopes import StrokeSlopes  # noqa: E402
 from .varnished import VarnishedCookTorranceBRDF  # noqa: E402
 
-__all__ += ["CookTorranceBRDF", "VarnishedCookTorranceBRDF", "StrokeSlopes", "fresnel_real"]
-from .point_source import PointSourceBRDF  # noqa: E402
-
-__all__ += ["PointSourceBRDF"]
+__all__ += [
+    "CookTorranceBRDF",
+    "VarnishedCookTorranceBRDF",
+    "StrokeSlopes",
+    "PointSourceBRDF",
+    "fresnel_real",
+]
