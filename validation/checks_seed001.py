@@ -379,8 +379,8 @@ def anisotropy_comparison(m_par=0.05, m_perp=0.25, ti_deg=(0.0, 30.0, 60.0)):
     eq19 = models.StrokeSlopes(m_par, m_perp, 0.0)
     beta = np.linspace(0, 2 * math.pi, 4096, endpoint=False)
     mb2 = eq19.m_of_beta(beta) ** 2
-    rms_u = math.sqrt(np.mean(mb2 * np.cos(beta) ** 2) / 2)  # <u^2> = <m(beta)^2 cos^2> / 2
-    rms_v = math.sqrt(np.mean(mb2 * np.sin(beta) ** 2) / 2)
+    rms_u = math.sqrt(np.mean(mb2 * np.cos(beta) ** 2))  # <u^2> = mean_beta m(beta)^2 cos^2 beta
+    rms_v = math.sqrt(np.mean(mb2 * np.sin(beta) ** 2))
     dists = {
         "Eq. 19 (StrokeSlopes)": lambda a: models.StrokeSlopes(m_par, m_perp, a),
         "AnisotropicGaussian(m_par, m_perp)": lambda a: models.AnisotropicGaussianSlopes(m_par, m_perp, a),
