@@ -438,6 +438,7 @@ def extreme_seed001_models():
             models.VarnishedCookTorranceBRDF(m_parallel=mp, m_perpendicular=mq, stroke_angle=0.3, varnish=2.2)
         )
     out.append(models.PointSourceBRDF(model=base, distance=math.inf, resolution=2))
+    out.append(models.PointSourceBRDF(model=base, distance=1e12, resolution=2))
     out.append(models.PointSourceBRDF(model=base, distance=1.0, sample_radius=1.0, resolution=3))
     out.append(
         models.PointSourceBRDF(model=base, distance=1.0, sample_radius=1.0, resolution=3, method="shift")
@@ -469,7 +470,7 @@ def extremes_count():
 def check_extremes():
     bad, warned, n = extremes_count()
     return _le(
-        "seed001: extremes (m 1e-6..2, m_par/m_perp 100, 89.99 deg, d = R, d = inf)",
+        "seed001: extremes (m 1e-6..2, m_par/m_perp 100, 89.99 deg, d = R, 1e12 R, inf)",
         bad + warned,
         0,
         f"{n} evaluations: {bad} non-finite or negative, {warned} warnings",
@@ -544,6 +545,39 @@ def check_point_source():
     ]
 
 
+def cauchy_disc_integrals(radii=(10.0, 100.0, 1000.0), d=1.0):
+    """Integrals over discs of radius X (centred below the source) of Eq. 25's
+    ``d / (pi (d^2 + x^2))`` and of a point source's irradiance on the plane,
+    ``d / (2 pi (d^2 + x^2)^{3/2})`` (per unit emitted power), by quadrature."""
+    from scipy import integrate
+
+    out = {}
+    for X in radii:
+        a = integrate.quad(lambda x: d / (math.pi * (d * d + x * x)) * 2 * math.pi * x, 0, X, limit=200)[0]
+        b = integrate.quad(
+            lambda x: d / (2 * math.pi * (d * d + x * x) ** 1.5) * 2 * math.pi * x, 0, X, limit=200
+        )[0]
+        out[X] = (a, b)
+    return out
+
+
+def check_cauchy():
+    ci = cauchy_disc_integrals()
+    grow = ci[1000.0][0] - ci[100.0][0]
+    return Check(
+        "seed001: Eq. 25 weight integrated over the plane",
+        grow,
+        0.0,
+        "finding" if grow > 1.0 else "fail",
+        "Eq. 25 is the 1-D Cauchy density: its integral over a disc of radius X (d = 1) is "
+        + ", ".join(f"{a:.3f}" for a, _ in ci.values())
+        + f" for X = {', '.join(f'{X:g}' for X in ci)} (grows like 2 ln X, never 1); a point source's "
+        "irradiance d / (2 pi (d^2+x^2)^1.5) gives "
+        + ", ".join(f"{b:.4f}" for _, b in ci.values())
+        + " -> 1. PointSourceBRDF weights by the irradiance (cos^3 psi / d^2) over the sample area",
+    )
+
+
 def check_preset():
     worst = 0.0
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
@@ -589,6 +623,7 @@ CHECKS = [
     check_anisotropy,
     check_extremes,
     check_point_source,
+    check_cauchy,
     check_preset,
 ]
 
