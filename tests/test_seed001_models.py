@@ -299,3 +299,17 @@ def test_bad_input_names_parameter(make, name):
 def test_bad_angles():
     with pytest.raises(ValueError, match="theta_r"):
         models.CookTorranceBRDF().brdf(0.1, 2.0, 0.0)
+
+
+def test_varnish_energy_form_still_creates_energy():
+    """Eq. 24 with 1/(4 pi) on a perfect conductor: albedo ~2.08 at normal incidence
+    although the varnish transmits 0.96 each way -- the missing refraction Jacobian.
+    With solid_angle='refracted' it is T_in T_out = 0.9216 (m -> 0 limit)."""
+    kw = dict(m_parallel=0.03, m_perpendicular=0.03, substrate=math.inf, normalization="energy")
+    pub = integrated_reflectance(models.VarnishedCookTorranceBRDF(**kw), 0.0, tol=1e-4)
+    ref = integrated_reflectance(
+        models.VarnishedCookTorranceBRDF(solid_angle="refracted", **kw), 0.0, tol=1e-4
+    )
+    assert pub.value > 2.0
+    assert abs(ref.value - 0.96**2) < 2e-3  # slope spread loses a little through the varnish
+    assert ref.value - ref.error <= 0.96

@@ -615,10 +615,53 @@ def _preset_section(results):
     return ("Seed 001: iron-plate preset", "\n".join(lines))
 
 
+def varnish_albedos(tol=1e-4):
+    """``[(m, solid_angle, ti_deg, value, error, T_in)]`` for the energy-normalized
+    varnished model on a perfect conductor (F = 1, so all loss is the varnish's)."""
+    out = []
+    for m in (0.03, 0.1, 0.5):
+        for sa in ("published", "refracted"):
+            model = models.VarnishedCookTorranceBRDF(
+                m_parallel=m, m_perpendicular=m, substrate=math.inf, normalization="energy", solid_angle=sa
+            )
+            for ti in (0.0, 30.0, 60.0, 80.0, 89.0):
+                r = integrated_reflectance(model, math.radians(ti), tol=tol)
+                rs, rp = models.fresnel_reflectance(math.cos(math.radians(ti)), 1.0, 1.5)
+                out.append((m, sa, ti, r.value, r.error, 1.0 - 0.5 * float(rs + rp)))
+    return out
+
+
+def check_varnish_energy():
+    rows = varnish_albedos()
+    pub = [r for r in rows if r[1] == "published"]
+    ref = [r for r in rows if r[1] == "refracted"]
+    worst_pub = max(pub, key=lambda r: r[3])
+    normal = [r for r in pub if r[0] == 0.03 and r[2] == 0.0][0]
+    excess = max(v - e - t for *_, v, e, t in ref)
+    return [
+        Check(
+            "seed001: energy-normalized Eq. 24 albedo, perfect conductor",
+            worst_pub[3],
+            1.0,
+            "finding" if worst_pub[3] > 1.0 else "fail",
+            f"{normal[3]:.3f} at normal incidence (m = 0.03; the varnish alone transmits {normal[5]:.2f}), "
+            f"{worst_pub[3]:.2f} at {worst_pub[2]:g} deg (m = {worst_pub[0]}): even with 1/(4 pi) the varnish "
+            "extension creates energy -- the missing refraction Jacobian n_v^2 cos Psi cos Theta / (cos psi cos theta)",
+        ),
+        _le(
+            "seed001: refracted varnish albedo - error - T_in (perfect conductor)",
+            excess,
+            0.0,
+            "m 0.03..0.5, ti 0..89 deg: never above the light the varnish lets in",
+        ),
+    ]
+
+
 CHECKS = [
     check_ct_vs_facet,
     check_fresnel,
     check_energy,
+    check_varnish_energy,
     check_reciprocity,
     check_varnish_vs_subsurface,
     check_anisotropy,
