@@ -409,7 +409,8 @@ def _anisotropy_section(results):
         f"(anisotropic Gaussian with the same exponent: {m_par / math.sqrt(2):.4f}, {m_perp / math.sqrt(2):.4f}).",
         "D(Eq. 19) / D(anisotropic Gaussian) = (m_perp/m_par) cos^2 beta + (m_par/m_perp) sin^2 beta: "
         f"{m_perp / m_par:.2f} along the strokes, {m_par / m_perp:.2f} across.",
-        "FacetBRDF(slopes, iron): integrated reflectance at ti = 0, 30, 60 deg and peak in-plane BRDF at 30 deg,",
+        "FacetBRDF(slopes, iron): integrated reflectance at ti = 0, 30, 60 deg and peak in-plane BRDF at 30 deg"
+        " (0.22 deg grid),",
         "strokes along x (in the plane of incidence) and along y:",
     ]
     for r in rows:
