@@ -58,3 +58,18 @@ __all__ = [
 def list_models():
     """Names and parameter listings of every model class (like SCATMECH's model lists)."""
     return "\n\n".join(c.info() for c in Model.registry)
+
+
+# --- issue 4 (seed 001: varnished metal) -------------------------------------------
+from .cook_torrance import CookTorranceBRDF, fresnel_real  # noqa: E402
+from .point_source import PointSourceBRDF  # noqa: E402
+from .stroke_slopes import StrokeSlopes  # noqa: E402
+from .varnished import VarnishedCookTorranceBRDF  # noqa: E402
+
+__all__ += [
+    "CookTorranceBRDF",
+    "VarnishedCookTorranceBRDF",
+    "StrokeSlopes",
+    "PointSourceBRDF",
+    "fresnel_real",
+]

@@ -88,3 +88,9 @@ def scene_paths() -> list[str]:
     """Paths of the example scene files shipped with scatterbench (one per preset)."""
     folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenes")
     return sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".toml"))
+
+
+# --- issue 4 (seed 001): the iron-plate preset -------------------------------------
+from .presets_seed001 import IRON_PLATE, iron_plate_models, point_source_geometry  # noqa: E402
+
+__all__ += ["IRON_PLATE", "iron_plate_models", "point_source_geometry"]

@@ -1,0 +1,242 @@
+"""The Cook-Torrance BRDF of seed 001 (Hebert, Emmel & Hersch), Eq. 7-18.
+
+    BRDF = D(alpha, m) G(psi, theta) F(psi', N) / (cos theta cos psi)        (Eq. 7)
+    D    = exp(-(tan alpha / m)^2) / (m^2 cos^4 alpha)                       (Eq. 8)
+    G    = min(1, 2 cos alpha cos theta / cos psi', 2 cos alpha cos psi / cos psi')   (Eq. 18, Blinn)
+    F    = (F_s + F_p) / 2 at the facet's local angle psi'                   (Eq. 11-17)
+
+with ``H`` the bisector of the light and view directions (Eq. 5), ``alpha`` the
+angle between ``H`` and the mean normal and ``cos psi' = L . H``.
+
+Normalization.  As printed, Eq. 8 has no ``1/pi`` and Eq. 7 no factor 4 in the
+denominator.  The normalized microfacet BRDF (Torrance-Sparrow / Walter et al.)
+is ``D F G / (4 pi m^2 ...)``-i.e. Eq. 7 divided by ``4 pi``: its ``D/pi`` is
+the Beckmann density of facet normals per projected area
+(``int D/pi cos alpha dOmega = 1``) and the ``1/4`` is the Jacobian
+``dOmega_h / dOmega_r = 1 / (4 cos psi')`` times the ``cos psi'`` projected facet
+area.  ``normalization="published"`` keeps the printed form (it is ``4 pi``
+times the normalized BRDF and its albedo exceeds 1 -- a property of the paper);
+``"energy"`` is the normalized form, which equals the M00 of
+:class:`models.FacetBRDF` with ``GaussianSlopes(sigma=m)`` when there is no
+shadowing.
+
+Fresnel.  ``F`` is computed with the real-valued form Eq. 13-16
+(:func:`fresnel_real`), tested equal to the complex Born & Wolf form
+(:func:`models.fresnel.fresnel_reflectance`, Eq. 11-12) to 1e-12.  Two slips of
+the printed Eq. 13-16 are fixed there (see :func:`fresnel_real`), and the labels
+of Eq. 11/13 (``parallel``) and 12/14 (``perpendicular``) are swapped in the
+paper: Eq. 11 and 13 are the s (perpendicular, TE) reflectance.  The average
+Eq. 17 does not depend on the labels.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .base import Model
+from .params import param
+
+__all__ = [
+    "CookTorranceBRDF",
+    "fresnel_real",
+    "fresnel_real_printed",
+    "fresnel_average",
+    "ct_kernel",
+]
+
+_INV_4PI = 1.0 / (4.0 * math.pi)
+
+
+def _exp_neg(x):
+    """``exp(-x)`` for ``x >= 0``; exactly 0 beyond 700 (no underflow, no subnormals)."""
+    return np.exp(-np.minimum(x, 700.0)) * (x < 700.0)
+
+
+def fresnel_real(cos_i, n, k=0.0):
+    """``(F_s, F_p)`` from the real-valued form, seed 001 Eq. 13-16 (corrected).
+
+    ``cos_i`` is the cosine of the local angle ``psi'``; ``n + ik`` the relative
+    index ``N`` (Eq. 10).  With ``A = n^2 - k^2 - sin^2``:
+
+        a^2 = (sqrt(A^2 + 4 n^2 k^2) + A) / 2,   b^2 = (sqrt(A^2 + 4 n^2 k^2) - A) / 2  (Eq. 15-16)
+        F_s = (a^2 + b^2 - 2 a cos + cos^2) / (a^2 + b^2 + 2 a cos + cos^2)              (Eq. 13)
+        F_p = F_s (a^2 + b^2 - 2 a sin tan + sin^2 tan^2) / (... + ...)                 (Eq. 14)
+
+    Slips of the printed Eq. 15-16 fixed here: the second term is printed
+    ``(n0^2 + k0^2 - sin^2)^2``; it is ``(n0^2 - k0^2 - sin^2)``, neither squared
+    nor with ``+k0^2`` (``a + ib = N cos(eta)``, so ``a^2 - b^2 = Re(N^2) - sin^2``
+    and ``a b = n0 k0``).  The paper labels Eq. 13 ``parallel``; it is ``F_s``.
+
+    Numerics: ``a^2`` and ``b^2`` are formed without cancellation (the smaller
+    one from ``a^2 b^2 = n^2 k^2``), and Eq. 14 is multiplied through by
+    ``cos^2`` so grazing incidence needs no ``tan``.  Transparent media beyond
+    the critical angle (``A < 0``, ``k = 0``) give ``a = 0`` and ``F_s = F_p = 1``.
+    """
+    c = np.asarray(cos_i, dtype=float)
+    s2 = 1.0 - c * c
+    A = (n * n - k * k) - s2
+    nk2 = (n * k) ** 2
+    if nk2 == 0.0 and n >= 1.0:
+        # Transparent, optically denser medium: A >= 0 everywhere, b = 0, a^2 = A.
+        return _fs_fp(c, s2, A, np.sqrt(A))
+    root = np.sqrt(A * A + 4.0 * nk2)  # = a^2 + b^2 = |N^2 - sin^2|
+    big = 0.5 * (root + np.abs(A))  # the larger of a^2, b^2: no cancellation
+    if nk2 > 0.0:
+        small = nk2 / big  # big > 0 whenever n k > 0
+    else:
+        small = np.zeros_like(big)
+    a2 = np.where(A >= 0.0, big, small)
+    return _fs_fp(c, s2, root, np.sqrt(a2))
+
+
+def fresnel_real_printed(cos_i, n, k=0.0, variant="printed"):
+    """Eq. 13-16 exactly as printed (``variant="printed"``: second term
+    ``(n0^2 + k0^2 - sin^2)^2``) or with only the square removed
+    (``variant="unsquared"``: ``n0^2 + k0^2 - sin^2``).  For the report of how
+    far the printed form is off; not used by any model."""
+    c = np.asarray(cos_i, dtype=float)
+    s2 = 1.0 - c * c
+    A = (n * n - k * k) - s2
+    root = np.sqrt(A * A + 4.0 * (n * k) ** 2)
+    B = (n * n + k * k) - s2
+    second = B * B if variant == "printed" else B
+    # a^2 + b^2 = root in every variant (the second terms cancel); only a changes.
+    a = np.sqrt(np.maximum(0.5 * (root + second), 0.0))
+    return _fs_fp(c, s2, root, a)
+
+
+def _fs_fp(c, s2, root, a):
+    two_ac = 2.0 * a * c
+    base = root + c * c
+    num_s = base - two_ac
+    den_s = base + two_ac
+    # Eq. 14 times cos^2: (a^2+b^2) cos^2 - 2 a sin^2 cos + sin^4 over the same with +.
+    u = root * c * c + s2 * s2
+    v = two_ac * s2
+    num_p = u - v
+    den_p = u + v
+    # den = 0 only for N = 1 at exactly grazing incidence (0/0): give 0, the N = 1 value.
+    fs = np.divide(num_s, den_s, out=np.zeros_like(num_s), where=den_s > 0)
+    ratio = np.divide(num_p, den_p, out=np.zeros_like(num_p), where=den_p > 0)
+    return fs, fs * ratio
+
+
+def fresnel_average(cos_i, index):
+    """Natural-light reflectance ``F = (F_s + F_p) / 2`` (Eq. 17) of relative index ``index``."""
+    if index == math.inf:
+        return np.ones_like(np.asarray(cos_i, dtype=float))
+    z = complex(index)
+    fs, fp = fresnel_real(cos_i, z.real, z.imag)
+    return 0.5 * (fs + fp)
+
+
+def _grazing_safe(ti, tr):
+    """``cos ti``, ``cos tr`` with exactly grazing rays (``theta = pi/2``: no
+    projected area, as in the facet models) replaced by 1, and the mask of live
+    geometries (``None`` when all are live)."""
+    ci, cr = np.cos(ti), np.cos(tr)
+    if ti.max() < 0.5 * math.pi and tr.max() < 0.5 * math.pi:
+        return ci, cr, None
+    live = (ti < 0.5 * math.pi) & (tr < 0.5 * math.pi)
+    return np.where(live, ci, 1.0), np.where(live, cr, 1.0), live
+
+
+def ct_kernel(ci, cr, cp, sp, d_fn, index, shadowing):
+    """``D G F`` of Eq. 7 (published D, Eq. 8) for cosines of the two polar
+    angles ``ci``, ``cr`` (both > 0) and the azimuth's ``cp``, ``sp``.
+
+    ``d_fn(hx, hy, hz2)`` returns ``exp(-tan^2 alpha / m^2) / m^2`` for the
+    (unnormalized) bisector ``h = L + E``; the ``1/cos^4 alpha`` is applied here.
+    """
+    si = np.sqrt(1.0 - ci * ci)
+    sr = np.sqrt(1.0 - cr * cr)
+    # h = L + E with L = (-sin psi, 0, cos psi) toward the source, E toward the viewer.
+    hx = sr * cp - si
+    hy = sr * sp
+    hz = ci + cr
+    hz2 = hz * hz
+    g = hx * hx + hy * hy + hz2  # |h|^2 = 4 cos^2 psi'
+    q = g / hz2  # 1 / cos^2 alpha
+    val = d_fn(hx, hy, hz2) * (q * q)  # Eq. 8
+    c_loc = 0.5 * np.sqrt(g)  # cos psi' = L . H
+    val *= fresnel_average(c_loc, index)
+    if shadowing == "blinn":
+        # Eq. 18: 2 cos(alpha) cos(theta) / cos(psi') = 4 hz cos(theta) / |h|^2
+        t = (4.0 / g) * hz
+        val *= np.minimum(1.0, t * np.minimum(ci, cr))
+    return val
+
+
+def isotropic_d(m):
+    inv_m2 = 1.0 / (m * m)
+
+    def d_fn(hx, hy, hz2):
+        return _exp_neg((hx * hx + hy * hy) * inv_m2 / hz2) * inv_m2
+
+    return d_fn
+
+
+class _CookTorranceBase(Model):
+    """Shared parts of the scalar Cook-Torrance models (depolarizing, M00 only)."""
+
+    depolarizing = True
+
+    def _brdf_flat(self, ti, tr, pr):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _mueller16(self, ti, tr, pr):
+        out = np.zeros((16, ti.size))
+        out[0] = self._brdf_flat(ti, tr, pr)
+        return out
+
+    def mueller(self, theta_i, theta_r, phi_r=0.0):
+        """Mueller BRDF ``(..., 4, 4)``: the ideal depolarizer ``diag(f, 0, 0, 0)``
+        with ``M00 = f`` the scalar BRDF.  The model is scalar (natural light,
+        Eq. 17): it predicts no polarization, so only ``M00`` carries information."""
+        return super().mueller(theta_i, theta_r, phi_r)
+
+
+@dataclass(frozen=True)
+class CookTorranceBRDF(_CookTorranceBase):
+    """Cook-Torrance BRDF of a rough metal in air, seed 001 Eq. 7-18.
+
+    Scalar model for natural light: :meth:`mueller` returns the depolarizing
+    matrix ``diag(BRDF, 0, 0, 0)`` (``M00 = BRDF``).
+
+    Parameters
+    ----------
+    m : float
+        rms facet slope (Eq. 3, 8); the Beckmann ``alpha`` and the ``sigma`` of
+        :class:`models.GaussianSlopes`.
+    substrate : complex or math.inf
+        Metal index ``n + ik`` relative to the ambient (Eq. 10); ``inf``: ``F = 1``.
+    normalization : "published" | "energy"
+        ``published``: Eq. 7-8 as printed (no ``1/pi`` in D, no 4 in the
+        denominator; ``4 pi`` times the normalized BRDF, albedo > 1).
+        ``energy``: divided by ``4 pi``, the normalized microfacet BRDF.
+    shadowing : "blinn" | "none"
+        Eq. 18 (Blinn's V-groove ``G``) or ``G = 1``.
+    """
+
+    m: float = param(0.03, "rms facet slope m (Eq. 8)", low=0.0, low_open=True)
+    substrate: complex = param(2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", kind="index")
+    normalization: str = param(
+        "published", "Eq. 7-8 as printed or energy-normalized", kind="choice", choices=("published", "energy")
+    )
+    shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=("blinn", "none"))
+
+    def _brdf_flat(self, ti, tr, pr):
+        ci, cr, live = _grazing_safe(ti, tr)
+        val = ct_kernel(ci, cr, np.cos(pr), np.sin(pr), isotropic_d(self.m), self.substrate, self.shadowing)
+        scale = _INV_4PI if self.normalization == "energy" else 1.0
+        val *= scale / (ci * cr)
+        if live is not None:
+            val[~live] = 0.0
+        return val
+
+    def lobe(self, theta_i):
+        """Specular lobe: centre ``(theta_i, 0)``, width ``~ 2 m`` in theta_r."""
+        return (theta_i, 0.0, 2.0 * self.m)
