@@ -111,12 +111,16 @@ def fresnel_real_printed(cos_i, n, k=0.0, variant="printed"):
 def _fs_fp(c, s2, root, a):
     two_ac = 2.0 * a * c
     base = root + c * c
-    num_s = base - two_ac
+    # Numerators as sums of squares ((a - cos)^2 + b^2, with b^2 = root - a^2 >= 0) so
+    # that rounding can never make a reflectance negative (it did, at -4e-54, for
+    # N = 1 near grazing, where a = cos exactly).
+    b2 = np.maximum(root - a * a, 0.0)
+    num_s = (a - c) ** 2 + b2
     den_s = base + two_ac
     # Eq. 14 times cos^2: (a^2+b^2) cos^2 - 2 a sin^2 cos + sin^4 over the same with +.
     u = root * c * c + s2 * s2
     v = two_ac * s2
-    num_p = u - v
+    num_p = (a * c - s2) ** 2 + b2 * c * c
     den_p = u + v
     # den = 0 only for N = 1 at exactly grazing incidence (0/0): give 0, the N = 1 value.
     fs = np.divide(num_s, den_s, out=np.zeros_like(num_s), where=den_s > 0)

@@ -65,7 +65,8 @@ def facet_jones(ti, tr, pr, n, substrate, slopes):
         sin_int, cos_int = sin_ext, cos_ext
     else:
         sin_int = sin_ext * (1.0 / n)  # Eq. 2-3
-        cos_int = np.sqrt(1.0 - sin_int * sin_int)
+        # cos' = sqrt(n^2 - 1 + cos^2) / n: no cancellation at grazing incidence
+        cos_int = np.sqrt(n * n - 1.0 + cos_ext * cos_ext) * (1.0 / n)
     si, sr = sin_int
     ci, cr = cos_int
     # h = k_r' - k_i' bisects the internal directions: facet normal h/|h| (Eq. 5-7).

@@ -104,8 +104,9 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
         nv = self.varnish
         ext = np.stack([ci, cr])
         # Eq. 20-21: internal cosines (no TIR entering from air).
-        s_int2 = (1.0 - ext * ext) * (1.0 / (nv * nv))
-        c_int = np.sqrt(1.0 - s_int2)
+        # cos' = sqrt(n_v^2 - 1 + cos^2) / n_v: exact for n_v = 1 and free of the
+        # cancellation of sqrt(1 - sin^2/n_v^2) at grazing incidence.
+        c_int = np.sqrt(nv * nv - 1.0 + ext * ext) * (1.0 / nv)
         index = self.substrate if self.substrate == math.inf else complex(self.substrate) / nv  # Eq. 22
         d_fn = stroke_d(self.m_parallel, self.m_perpendicular, self.stroke_angle)
         val = ct_kernel(c_int[0], c_int[1], np.cos(pr), np.sin(pr), d_fn, index, self.shadowing)

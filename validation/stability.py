@@ -15,7 +15,9 @@ same angles as float32.  It records
 * ``negative-M00``: a negative BRDF,
 * ``unphysical``: a coherency-matrix eigenvalue below ``-1e-9 M00``,
 * ``reciprocity``: a relative violation above 1e-9 (reciprocal models),
-* ``energy``: an integrated reflectance above ``1 + error`` at 0, 57 or 89.99 deg.
+* ``energy``: an integrated reflectance above ``1 + error`` at 0, 57 or 89.99 deg,
+  ``energy-unresolved`` where that integral did not reach its tolerance within
+  the evaluation budget (the check would otherwise be vacuous).
 
 Findings that physics explains are listed, each with its reason, in
 ``accepted_findings.toml`` beside this module; anything else is a failure of
@@ -65,6 +67,12 @@ _NAMED_EDGES = {
     "n": (1.0, 1.0 + 1e-9, 1.5, 3.0),
     "g": (-0.99, 0.0, 0.99),
     "rho": (0.0, 1.0),
+    # Cook-Torrance rms slopes (seed 001): m -> 0 and m = 2, and a 100:1 (and 2e4:1) anisotropy
+    "m": (1e-4, 0.5, 2.0),
+    "m_parallel": (1e-4, 0.3, 2.0),
+    "m_perpendicular": (1e-4, 0.3, 2.0),
+    "varnish": (1.0, 1.0 + 1e-9, 1.5, 3.0),
+    "stroke_angle": (0.0, 1.0, -math.pi),
 }
 _INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
 
@@ -118,13 +126,32 @@ def _one_at_a_time(base):
     return out
 
 
+def _choice_combinations(base):
+    """Every combination of the ``choice`` parameters (few: normalizations, methods)."""
+    import itertools
+
+    infos = [i for i in type(base).parameters() if i.kind == "choice"]
+    out = []
+    for combo in itertools.product(*(i.low for i in infos)):
+        try:
+            out.append(dataclasses.replace(base, **{i.name: v for i, v in zip(infos, combo, strict=True)}))
+        except ValueError:
+            continue
+    return out
+
+
 def edge_instances(cls):
-    """Model instances at the edges of each declared parameter (one at a time)."""
+    """Model instances at the edges of each declared parameter (one at a time from the
+    defaults), plus every combination of the choice parameters at the defaults."""
     try:
         base = cls()
     except ValueError:
         return []  # compositions without a default (Sum): their terms are swept
-    return _one_at_a_time(base)
+    out = _one_at_a_time(base)
+    for inst in _choice_combinations(base):
+        if inst not in out:
+            out.append(inst)
+    return out
 
 
 def _real_indices(obj, out=None):
@@ -204,17 +231,54 @@ def _check_reciprocity(model, ti, tr, pr, found, name, params):
         found.append(Finding(name, params, "reciprocity", float(worst), "edge geometries"))
 
 
+def _scalar_params(model):
+    """Declared scalar parameters (for accepted-finding conditions)."""
+    out = {}
+    for info in type(model).parameters():
+        v = getattr(model, info.name)
+        if isinstance(v, (str, bool, int, float)):
+            out[info.name] = v
+    return out
+
+
+def _slopes_of(model):
+    """The facet slope distribution a model uses, for the hit-fraction bound."""
+    if getattr(model, "slopes", None) is not None:
+        return model.slopes
+    if hasattr(model, "m"):  # Cook-Torrance: Beckmann with rms slope m
+        return models.GaussianSlopes(sigma=model.m)
+    if hasattr(model, "m_parallel") and hasattr(models, "StrokeSlopes"):
+        return models.StrokeSlopes(
+            m_parallel=model.m_parallel,
+            m_perpendicular=model.m_perpendicular,
+            stroke_angle=model.stroke_angle,
+        )
+    return None
+
+
 def _check_energy(model, found, name, params):
     if model.transmission:
         return
-    slopes = getattr(model, "slopes", None)
-    coating = float(getattr(model, "coating", 1.0))
+    slopes = _slopes_of(model)
+    coating = float(getattr(model, "coating", getattr(model, "varnish", 1.0)))
     for ti in (0.0, 1.0, math.radians(89.99)):
         with np.errstate(divide="ignore", over="ignore", invalid="ignore", under="ignore"):
             r = integrated_reflectance(model, ti, tol=1e-3, max_evaluations=2_000_000)
+        if not r.converged:
+            found.append(
+                Finding(
+                    name,
+                    params,
+                    "energy-unresolved",
+                    r.error,
+                    f"theta_i = {math.degrees(ti):.4g} deg",
+                    _scalar_params(model),
+                )
+            )
+            continue
         excess = r.value - 1.0 - r.error
         if excess > 0:
-            fields = {"excess": excess, "value": r.value, "theta_i": ti}
+            fields = {"excess": excess, "value": r.value, "theta_i": ti, **_scalar_params(model)}
             if slopes is not None:
                 fields["hit_fraction"] = hit_fraction(slopes, ti, coating)
             found.append(
