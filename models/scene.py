@@ -147,7 +147,44 @@ class Scene:
         out = []
         coat_n = self.coating["index"] if self.coating else None
         rough_top = self.coating.get("roughness") if self.coating else None
-        if self.substrate is not None and self.substrate.get("slopes") is not None:
+        if self.substrate is not None and self.substrate.get("model") == "cook-torrance":
+            from .cook_torrance import CookTorranceBRDF
+            from .varnished import VarnishedCookTorranceBRDF
+
+            ct = self.substrate["ct"]
+            iso = ct["m_parallel"] == ct["m_perpendicular"]
+            if coat_n is None and iso:
+                out.append(
+                    Mechanism(
+                        "Cook-Torrance reflection",
+                        CookTorranceBRDF(
+                            m=ct["m_parallel"],
+                            substrate=self.substrate["index"],
+                            normalization=ct["normalization"],
+                            shadowing=ct["shadowing"],
+                        ),
+                        "a bare rough metal described by seed 001 (Eq. 7-18)",
+                    )
+                )
+            else:
+                out.append(
+                    Mechanism(
+                        "varnished Cook-Torrance reflection",
+                        VarnishedCookTorranceBRDF(
+                            m_parallel=ct["m_parallel"],
+                            m_perpendicular=ct["m_perpendicular"],
+                            varnish=coat_n if coat_n is not None else 1.0,
+                            substrate=self.substrate["index"],
+                            stroke_angle=ct["stroke_angle"],
+                            normalization=ct["normalization"],
+                            shadowing=ct["shadowing"],
+                            solid_angle=ct["solid_angle"],
+                        ),
+                        "seed 001's varnish extension (Eq. 19-24)"
+                        + ("" if iso else " with brushed (anisotropic) roughness"),
+                    )
+                )
+        elif self.substrate is not None and self.substrate.get("slopes") is not None:
             if coat_n is not None:
                 out.append(
                     Mechanism(
@@ -180,8 +217,18 @@ class Scene:
             )
         return out
 
-    def build(self) -> Model:
-        """The incoherent sum of :meth:`mechanisms` (a single model when there is one)."""
+    def build(self, tol: float = 1e-3) -> Model:
+        """The incoherent sum of :meth:`mechanisms` (a single model when there is one),
+        under a point source when the scene declares one and it matters: the point
+        source is kept only if it changes the in-plane BRDF by more than ``tol``
+        (relative to the peak), measured at this scene's incidence."""
+        return self._build(tol)[0]
+
+    def source_decision(self, tol: float = 1e-3) -> str:
+        """Why the source is evaluated as it is (measured, see :meth:`build`)."""
+        return self._build(tol)[1]
+
+    def _build(self, tol):
         mech = self.mechanisms()
         if not mech:
             raise SceneError(
@@ -191,12 +238,34 @@ class Scene:
         total = mech[0].model
         for m in mech[1:]:
             total = total + m.model
-        return total
+        if self.source != "point":
+            return total, "collimated source"
+        from .point_source import PointSourceBRDF
 
-    def describe(self) -> str:
+        wrapped = PointSourceBRDF(model=total, distance=self.distance_mm, sample_radius=self.sample_radius_mm)
+        import numpy as np
+
+        x = np.radians(np.linspace(-85.0, 85.0, 69))
+        tr, pr = np.abs(x), np.where(x >= 0, 0.0, math.pi)
+        f_c = total.brdf(self.theta_i, tr, pr)
+        f_p = wrapped.brdf(self.theta_i, tr, pr)
+        dev = float(np.max(np.abs(f_p - f_c)) / max(np.max(f_c), 1e-300))
+        if dev <= tol:
+            return total, (
+                f"point source at d/R = {self.distance_mm / self.sample_radius_mm:g} evaluated as collimated: "
+                f"measured max deviation {dev:.2g} of the peak <= tol {tol:g}"
+            )
+        return wrapped, (
+            f"point source at d/R = {self.distance_mm / self.sample_radius_mm:g} kept (seed 001 Eq. 28): "
+            f"it changes the in-plane BRDF by {dev:.2g} of the peak > tol {tol:g}"
+        )
+
+    def describe(self, tol: float = 1e-3) -> str:
         lines = [f"scene {self.name!r} ({self.path})"]
         for m in self.mechanisms():
             lines.append(f"  - {m.name}: {type(m.model).__name__} — {m.why}")
+        if self.mechanisms():
+            lines.append(f"  - source: {self.source_decision(tol)}")
         lines.extend(f"  note: {n}" for n in self.notes)
         return "\n".join(lines)
 
@@ -257,6 +326,48 @@ def _distribution(path, section, table):
         raise _err(path, f"{section}{kind}", str(exc)) from exc
 
 
+_CT_KEYS = (
+    "m",
+    "m_parallel",
+    "m_perpendicular",
+    "stroke_angle_deg",
+    "normalization",
+    "shadowing",
+    "solid_angle",
+)
+
+
+def _cook_torrance(path, s):
+    """Seed 001 roughness: ``m`` (isotropic) or ``m_parallel``/``m_perpendicular`` and
+    ``stroke_angle_deg`` (brushed); normalization, shadowing and the varnish's
+    solid-angle convention default to the energy-consistent choices."""
+    out = {}
+    if "m" in s:
+        if "m_parallel" in s or "m_perpendicular" in s:
+            raise _err(path, "[substrate] m", "give either m or m_parallel and m_perpendicular, not both")
+        out["m_parallel"] = out["m_perpendicular"] = _number(
+            path, "[substrate] m", s["m"], 0.0, low_open=True
+        )
+    else:
+        for k in ("m_parallel", "m_perpendicular"):
+            if k not in s:
+                raise _err(path, f"[substrate] {k}", "required for model = 'cook-torrance' (or give m)")
+            out[k] = _number(path, f"[substrate] {k}", s[k], 0.0, low_open=True)
+    out["stroke_angle"] = math.radians(
+        _number(path, "[substrate] stroke_angle_deg", s.get("stroke_angle_deg", 0.0))
+    )
+    for key, allowed, default in (
+        ("normalization", ("energy", "published"), "energy"),
+        ("shadowing", ("blinn", "none"), "blinn"),
+        ("solid_angle", ("refracted", "published"), "refracted"),
+    ):
+        v = s.get(key, default)
+        if v not in allowed:
+            raise _err(path, f"[substrate] {key}", f"must be one of {', '.join(allowed)}; got {v!r}")
+        out[key] = v
+    return out
+
+
 def loads(text: str, path: str = "<scene>") -> Scene:
     """Parse and validate scene TOML text."""
     try:
@@ -312,12 +423,24 @@ def from_dict(data: dict, path: str = "<scene>") -> Scene:
     substrate = None
     if "substrate" in data:
         s = data["substrate"]
-        allowed = {"index", "distribution"} | {k for _, ks in DISTRIBUTIONS.values() for k in ks}
+        allowed = {"index", "distribution", "model"} | {k for _, ks in DISTRIBUTIONS.values() for k in ks}
+        allowed |= set(_CT_KEYS)
         _unknown(path, "[substrate] ", s, allowed)
         if "index" not in s:
             raise _err(path, "[substrate] index", 'required: n, [n, k] or "inf"')
         substrate = {"index": _index(path, "[substrate] index", s["index"])}
-        substrate["slopes"] = _distribution(path, "[substrate] ", s) if "distribution" in s else None
+        kind = s.get("model", "facet")
+        if kind not in ("facet", "cook-torrance"):
+            raise _err(path, "[substrate] model", f"must be 'facet' or 'cook-torrance'; got {kind!r}")
+        substrate["model"] = kind
+        if kind == "cook-torrance":
+            substrate["slopes"] = None
+            substrate["ct"] = _cook_torrance(path, s)
+        else:
+            for k in _CT_KEYS:
+                if k in s:
+                    raise _err(path, f"[substrate] {k}", "only for model = 'cook-torrance'")
+            substrate["slopes"] = _distribution(path, "[substrate] ", s) if "distribution" in s else None
     volume = data.get("volume")
     detector = data.get("detector")
     if detector is not None:
@@ -328,10 +451,6 @@ def from_dict(data: dict, path: str = "<scene>") -> Scene:
             )
         }
     notes = []
-    if source == "point":
-        notes.append(
-            "point source declared; evaluated as collimated by this build (no point-source wrapper available)"
-        )
     return Scene(
         name=name,
         path=path,

@@ -1,6 +1,7 @@
 """Scene files: loading, validation errors naming file and key, mechanisms, evaluation."""
 
 import csv
+import math
 import os
 
 import pytest
@@ -102,3 +103,44 @@ def test_with_values_rebuilds_and_revalidates():
         sc.with_values({"substrate.sigma": -1.0})
     with pytest.raises(ValueError, match="not set"):
         sc.with_values({"substrate.nothing": 1.0})
+
+
+def _ct_scene(extra_illum="", extra_sub=""):
+    return (
+        'name = "plate"\n[illumination]\ntheta_i_deg = 45\n' + extra_illum + "[coating]\nindex = 1.5\n"
+        '[substrate]\nindex = [2.29, 3.37]\nmodel = "cook-torrance"\n' + extra_sub
+    )
+
+
+def test_cook_torrance_scenes_and_point_source_decision():
+    near = scene.loads(
+        _ct_scene('source = "point"\ndistance_mm = 100\nsample_radius_mm = 10\n', "m = 0.03\n"), "p.toml"
+    )
+    m = near.build()
+    assert isinstance(m, models.PointSourceBRDF) and isinstance(m.model, models.VarnishedCookTorranceBRDF)
+    assert "kept" in near.source_decision()
+    far = scene.loads(
+        _ct_scene('source = "point"\ndistance_mm = 1e7\nsample_radius_mm = 1\n', "m = 0.03\n"), "f.toml"
+    )
+    assert isinstance(far.build(), models.VarnishedCookTorranceBRDF)
+    assert "collimated" in far.source_decision()
+    brushed = scene.loads(
+        _ct_scene("", "m_parallel = 0.03\nm_perpendicular = 0.3\nstroke_angle_deg = 30\n"), "b.toml"
+    )
+    b = brushed.build()
+    assert b.m_perpendicular == 0.3 and abs(b.stroke_angle - math.radians(30)) < 1e-15
+
+
+@pytest.mark.parametrize(
+    "extra_sub, key",
+    [
+        ("", "m_parallel"),
+        ("m = 0.1\nm_parallel = 0.2\n", "[substrate] m"),
+        ('m = 0.1\nnormalization = "unit"\n', "normalization"),
+        ("m = -1\n", "[substrate] m"),
+    ],
+)
+def test_cook_torrance_scene_errors(extra_sub, key):
+    with pytest.raises(ValueError) as exc:
+        scene.loads(_ct_scene("", extra_sub), "ct.toml")
+    assert key in str(exc.value) and str(exc.value).startswith("ct.toml")

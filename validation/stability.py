@@ -80,7 +80,9 @@ _NAMED_EDGES = {
 
 # Classes whose defaults cannot be built alone (wrappers): a representative instance.
 _BASES = {
-    "PointSourceBRDF": lambda: models.PointSourceBRDF(model=models.CookTorranceBRDF(normalization="energy"), distance=100.0, sample_radius=1.0),
+    "PointSourceBRDF": lambda: models.PointSourceBRDF(
+        model=models.CookTorranceBRDF(normalization="energy"), distance=100.0, sample_radius=1.0
+    ),
 }
 _INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
 
