@@ -58,3 +58,12 @@ __all__ = [
 def list_models():
     """Names and parameter listings of every model class (like SCATMECH's model lists)."""
     return "\n\n".join(c.info() for c in Model.registry)
+
+
+# --- issue 3: seed 003 diffuse-paint models -------------------------------------------
+from .diffuse_subsurface import DiffuseSubsurfaceBRDF  # noqa: E402
+from .facet_btdf import FacetBTDF  # noqa: E402
+from .phase import HenyeyGreenstein  # noqa: E402
+from .single_scatter import SingleScatterBRDF  # noqa: E402
+
+__all__ += ["HenyeyGreenstein", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF", "FacetBTDF"]
