@@ -67,3 +67,6 @@ from .phase import HenyeyGreenstein  # noqa: E402
 from .single_scatter import SingleScatterBRDF  # noqa: E402
 
 __all__ += ["HenyeyGreenstein", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF", "FacetBTDF"]
+from .rough_diffuse import RoughDiffuseBRDF  # noqa: E402
+
+__all__ += ["RoughDiffuseBRDF"]
