@@ -70,3 +70,6 @@ __all__ += ["HenyeyGreenstein", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF", "F
 from .rough_diffuse import RoughDiffuseBRDF  # noqa: E402
 
 __all__ += ["RoughDiffuseBRDF"]
+from .combination import mueller_with_error  # noqa: E402
+
+__all__ += ["mueller_with_error"]

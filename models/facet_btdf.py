@@ -49,7 +49,7 @@ from .params import param
 from .polarization import mueller16_from_jones
 from .slopes import GaussianSlopes, SlopeDistribution
 
-__all__ = ["FacetBTDF", "facet_transmission_jones", "ray_basis"]
+__all__ = ["FacetBTDF", "facet_transmission_jones", "ray_basis", "angle_basis", "projected_area"]
 
 
 def _dot(a, b):
@@ -68,6 +68,12 @@ def ray_basis(k):
     along = norm <= 1e-15
     inv = 1.0 / np.where(along, 1.0, norm)
     s = np.stack([np.where(along, 0.0, sx * inv), np.where(along, 1.0, sy * inv), np.zeros_like(norm)])
+    return s, _cross(k, s)
+
+
+def angle_basis(k, sx, sy):
+    """``(s, p)`` with ``s = (sx, sy, 0)`` given from the ray's azimuth and ``p = k x s``."""
+    s = np.stack([sx, sy, np.zeros_like(sx)])
     return s, _cross(k, s)
 
 
@@ -113,6 +119,27 @@ def facet_transmission_jones(k_in, k_out, m, n1, n2, e_in, e_out):
     return (ss, ps, sp, pp), c, c_out
 
 
+def projected_area(slopes, cos_theta, quantiles=2048):
+    """``N = <(cos theta - k_xy . zeta)_+>`` over ``P3^xy / C`` for rays at ``cos_theta``.
+
+    Isotropic slopes: the azimuthal average of ``(a - b cos phi)_+`` is
+    ``a`` for ``b <= a`` and ``(a (pi - phi0) + b sin phi0) / pi``,
+    ``phi0 = arccos(a / b)``, otherwise (``a = cos theta``, ``b = sin theta
+    |zeta|``); the radial average uses midpoint quantiles of the slope
+    magnitude.  Vectorized over ``cos_theta``.
+    """
+    c = np.asarray(cos_theta, dtype=float)
+    u = (np.arange(quantiles) + 0.5) / quantiles
+    z = slopes._sample_radius_unit(u)
+    a = c[..., None]
+    b = np.sqrt(np.maximum(1.0 - c * c, 0.0))[..., None] * z
+    big = b > a
+    ratio = np.where(big, a / np.where(big, b, 1.0), 1.0)
+    phi0 = np.arccos(np.clip(ratio, -1.0, 1.0))
+    val = np.where(big, (a * (math.pi - phi0) + b * np.sqrt(1.0 - ratio * ratio)) / math.pi, a)
+    return val.mean(axis=-1)
+
+
 @dataclass(frozen=True)
 class FacetBTDF(Model):
     """Facet-model transmission (BTDF, 1/sr) into a rough dielectric (seed 003 Eq. 43).
@@ -128,10 +155,21 @@ class FacetBTDF(Model):
         Facet slope distribution ``P3^xy``.
     substrate : float
         Real index ``n > 1`` of the substrate.
+    normalization : str
+        ``"paper"``: Eq. 37, the slope distribution seen by the incident ray
+        normalized by ``cos(theta_i)`` (assumes ``<cos i_t> ~ cos theta_i``;
+        SCATMECH's choice).  Its integrated transmittance exceeds 1 for wide
+        distributions at oblique incidence (``validate`` reports it).
+        ``"exact"``: Eq. 36 normalized exactly, by ``N = <(cos theta_i -
+        k_xy . zeta)_+>`` (:func:`projected_area`): every incident ray meets
+        one facet, and reflection plus transmission integrate to 1.
     """
 
     slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", kind="object")
     substrate: float = param(1.5, "substrate index (real, > 1)", kind="real_index", low=1.0)
+    normalization: str = param(
+        "paper", "Eq. 37 (paper, SCATMECH) or exact Eq. 36", kind="choice", choices=("paper", "exact")
+    )
 
     transmission = True
     _angle_names = ("theta_i", "theta_t", "phi_t")
@@ -164,14 +202,18 @@ class FacetBTDF(Model):
         hz = np.where(live, h[2], 1.0)
         m = h / D
         m = np.where(live, m, np.array([0.0, 0.0, 1.0])[:, None])
-        e_in = ray_basis(k_in)
-        e_out = ray_basis(k_out)
+        # Bases from the angles (the theta -> 0 limit along the ray's azimuth at the
+        # pole, as SCATMECH and the other models do): s = (-sin phi, cos phi, 0).
+        e_in = angle_basis(k_in, zero, zero + 1.0)
+        e_out = angle_basis(k_out, -sp, cp)
         jones, c_in, c_out = facet_transmission_jones(k_in, k_out, m, 1.0, n, e_in, e_out)
         p3 = self.slopes.p3(h[0] / hz, h[1] / hz)
         mz_l = np.where(live, mz, 1.0)
         inv_cc = 1.0 / np.where(live, ci * ct, 1.0)
         # Eq. 43 (with cos t_t) and the Jacobian n^2 cos(iota_t)/D^2 (Eq. 39)
         S = p3 * n * c_out * inv_cc / mz_l**4 * (n * n * c_out / np.where(live, D2, 1.0))
+        if self.normalization == "exact":
+            S = S * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))
         S = np.where(live, S, 0.0)
         root = np.sqrt(S)
         return tuple((j * root, zero) for j in jones)

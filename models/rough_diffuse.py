@@ -57,7 +57,7 @@ import numpy as np
 
 from .base import Model
 from .facet import FacetBRDF
-from .facet_btdf import _dot, facet_transmission_jones, ray_basis
+from .facet_btdf import _dot, angle_basis, facet_transmission_jones, projected_area, ray_basis
 from .params import param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
@@ -68,27 +68,6 @@ __all__ = ["RoughDiffuseBRDF", "sample_normals_seen_by", "projected_area"]
 
 #: (geometry, pair) entries evaluated per block: keeps the temporaries in cache-sized arrays
 BLOCK = 1 << 15
-
-
-def projected_area(slopes, cos_theta, quantiles=2048):
-    """``N = <(cos theta - k_xy . zeta)_+>`` over ``P3^xy / C`` for rays at ``cos_theta``.
-
-    Isotropic slopes: the azimuthal average of ``(a - b cos phi)_+`` is
-    ``a`` for ``b <= a`` and ``(a (pi - phi0) + b sin phi0) / pi``,
-    ``phi0 = arccos(a / b)``, otherwise (``a = cos theta``, ``b = sin theta
-    |zeta|``); the radial average uses midpoint quantiles of the slope
-    magnitude.  Vectorized over ``cos_theta``.
-    """
-    c = np.asarray(cos_theta, dtype=float)
-    u = (np.arange(quantiles) + 0.5) / quantiles
-    z = slopes._sample_radius_unit(u)
-    a = c[..., None]
-    b = np.sqrt(np.maximum(1.0 - c * c, 0.0))[..., None] * z
-    big = b > a
-    ratio = np.where(big, a / np.where(big, b, 1.0), 1.0)
-    phi0 = np.arccos(np.clip(ratio, -1.0, 1.0))
-    val = np.where(big, (a * (math.pi - phi0) + b * np.sqrt(1.0 - ratio * ratio)) / math.pi, a)
-    return val.mean(axis=-1)
 
 
 def sample_normals_seen_by(slopes, k, size, seed=None, max_rounds=100_000):
@@ -231,8 +210,11 @@ class RoughDiffuseBRDF(Model):
         c2z = k2[2]
         live = (w1 > 0) & (w2 > 0) & (c1 > 0) & (c2 > 0) & (c1z > 0) & (c2z > 0)
         live &= (ti < 0.5 * math.pi)[:, None] & (tr < 0.5 * math.pi)[:, None]
-        (jin, ci_in, ct_in) = facet_transmission_jones(k_i, k1, m1, 1.0, n, ray_basis(k_i), ray_basis(k1))
-        (jout, ci_out, ct_out) = facet_transmission_jones(k2, k_r, -m2, n, 1.0, ray_basis(k2), ray_basis(k_r))
+        # external bases from the angles (pole limit along the azimuth, as the other models)
+        e_i = angle_basis(k_i, zero, zero + 1.0)
+        e_r = angle_basis(k_r, -sp, cp)
+        (jin, ci_in, ct_in) = facet_transmission_jones(k_i, k1, m1, 1.0, n, e_i, ray_basis(k1))
+        (jout, ci_out, ct_out) = facet_transmission_jones(k2, k_r, -m2, n, 1.0, ray_basis(k2), e_r)
         f_in = n * ct_in / np.where(ci_in > 0, ci_in, 1.0)
         f_out = ct_out / (n * np.where(ci_out > 0, ci_out, 1.0))
         base = np.where(live, w1 * w2 * f_in * f_out / (n * n), 0.0)
