@@ -93,7 +93,7 @@ def sample_normals_seen_by(slopes, k, size, seed=None, max_rounds=100_000):
         r = np.interp(rng.random(todo.size), cdf, grid)
         phi = rng.random(todo.size) * 2.0 * math.pi
         x, y = r * np.cos(phi), r * np.sin(phi)
-        proj = -(k[0] * x + k[1] * y - k[2]) / np.sqrt(1.0 + r * r)  # -k . n
+        proj = -(k[0] * x + k[1] * y + k[2]) / np.sqrt(1.0 + r * r)  # -k . n, n = (x, y, 1)/|.|
         keep = rng.random(todo.size) < proj
         zx[todo[keep]] = x[keep]
         zy[todo[keep]] = y[keep]

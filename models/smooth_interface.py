@@ -32,6 +32,9 @@ _TINY = 1e-300
 def interface_amplitudes(cos_ext, n):
     """``(sin_int, cos_int, a_s, a_p)`` for external cosines ``cos_ext`` (any shape)."""
     c = np.asarray(cos_ext, dtype=float)
+    # np.cos(pi/2) = 6e-17: cosines below 1e-15 (within ~1e-15 rad of grazing, a few
+    # ulps of pi/2) are exactly grazing, so theta = pi/2 gives exact zeros.
+    c = np.where(c < 1e-15, 0.0, c)
     s_int = np.sqrt(1.0 - c * c) * (1.0 / n)
     c_int = np.sqrt(1.0 - s_int * s_int)
     root = 2.0 * np.sqrt(c * c_int)
