@@ -73,3 +73,6 @@ __all__ += ["RoughDiffuseBRDF"]
 from .combination import mueller_with_error  # noqa: E402
 
 __all__ += ["mueller_with_error"]
+from .maxwell_beard import MaxwellBeardBRDF  # noqa: E402
+
+__all__ += ["MaxwellBeardBRDF"]

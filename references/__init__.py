@@ -87,10 +87,10 @@ def table1_scatmech() -> dict:
 # --- issue 3 (seed 003) -------------------------------------------------------------
 def scatmech_seed003(kind: str) -> dict:
     """SCATMECH Mueller BSDFs for the seed 003 models; ``kind`` is ``diffuse``,
-    ``single`` or ``btdf``.  Parameter columns (floats; ``sdf`` a string) and
+    ``single``, ``btdf`` or ``mb`` (Maxwell-Beard specular term).  Parameter columns (floats; ``sdf`` a string) and
     ``mueller`` ``(N, 4, 4)``."""
-    if kind not in ("diffuse", "single", "btdf"):
-        raise ValueError(f"kind must be 'diffuse', 'single' or 'btdf'; got {kind!r}")
+    if kind not in ("diffuse", "single", "btdf", "mb"):
+        raise ValueError(f"kind must be 'diffuse', 'single', 'btdf' or 'mb'; got {kind!r}")
     rows = read_csv(f"scatmech_seed003_{kind}.csv")
     out = {}
     for k in rows[0]:

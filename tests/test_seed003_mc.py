@@ -123,3 +123,23 @@ def test_combination_errors():
     np.testing.assert_allclose(M, 0.5 * Mm + 2.0 * det.mueller(*G), rtol=1e-13, atol=1e-16)
     np.testing.assert_allclose(E, 0.5 * Em, rtol=1e-13)
     np.testing.assert_allclose(s.mueller(*G), M, rtol=1e-13, atol=1e-16)
+
+
+def test_maxwell_beard_against_scatmech_and_terms():
+    e, lit = c3.scatmech_seed003_errors("mb")
+    assert len(e) == 100 and lit > 80 and e.max() < 1e-6
+    s = models.GaussianSlopes(0.2)
+    mb = models.MaxwellBeardBRDF(slopes=s, substrate=1.5, rho_d=0.1, rho_v=0.05, tau=0.3, omega=0.6)
+    ti, tr, pr = G
+    so = models.maxwell_beard.maxwell_beard_shadow(ti, tr, pr, 0.3, 0.6)
+    assert np.all((so > 0) & (so <= 1))
+    want = (
+        models.FacetBRDF(slopes=s, substrate=1.5).brdf(ti, tr, pr) * so
+        + 0.1
+        + 0.1 / (np.cos(ti) + np.cos(tr))
+    )
+    np.testing.assert_allclose(mb.brdf(ti, tr, pr), want, rtol=1e-13)
+    M = mb.mueller(ti, tr, pr)
+    assert np.all(M[..., 1:, :] == 0) and np.all(M[..., :, 1:] == 0)  # published form: scalar
+    with pytest.raises(ValueError, match="tau"):
+        models.MaxwellBeardBRDF(tau=0.0)

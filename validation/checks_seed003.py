@@ -41,6 +41,14 @@ def _model_for(kind, ref, i):
             n=ref["n"][i], phase=models.HenyeyGreenstein(ref["g"][i], polarized=False)
         )
     cls = models.GaussianSlopes if ref["sdf"][i] == "Gaussian" else models.ExponentialSlopes
+    if kind == "mb":
+        return models.MaxwellBeardBRDF(
+            slopes=cls(sigma=ref["sigma"][i]),
+            substrate=complex(ref["n"][i], ref["k"][i]),
+            tau=ref["tau"][i],
+            omega=ref["omega"][i],
+            polarized=True,
+        )
     return models.FacetBTDF(slopes=cls(sigma=ref["sigma"][i]), substrate=ref["n"][i])
 
 
@@ -79,6 +87,7 @@ def check_scatmech_seed003():
         ("diffuse", "DiffuseSubsurfaceBRDF", 2e-3),
         ("single", "SingleScatterBRDF (depolarizing HG)", 1e-6),
         ("btdf", "FacetBTDF", 1e-6),
+        ("mb", "MaxwellBeardBRDF specular (Shadowed_Facet + MB shadow)", 1e-6),
     )
     for kind, label, tol in spec:
         e, lit = scatmech_seed003_errors(kind)
@@ -359,6 +368,9 @@ def deterministic_reciprocity():
     ti, tr, pr = _random_geometries(400)
     worst = {}
     for m in (
+        models.MaxwellBeardBRDF(
+            slopes=models.ExponentialSlopes(0.3), substrate=1.5, rho_d=0.05, rho_v=0.1, polarized=True
+        ),
         models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.6, polarized=True)),
         models.SingleScatterBRDF(n=2.3, phase=models.HenyeyGreenstein(-0.4, polarized=False)),
         models.DiffuseSubsurfaceBRDF(n=1.7, rho=0.8),
@@ -372,7 +384,7 @@ def check_reciprocity_seed003():
     w = deterministic_reciprocity()
     out = [
         _le(
-            "reciprocity: Single (both phases), DiffuseSubsurface",
+            "reciprocity: Single (both phases), DiffuseSubsurface, MaxwellBeard",
             max(w.values()),
             1e-12,
             "400 random geometries; scalar, Mueller D M^T D, Jones Z J^T Z (polarized single)",
@@ -465,6 +477,9 @@ def check_extremes_seed003():
                 ms.append(models.SingleScatterBRDF(n=n, phase=models.HenyeyGreenstein(g, polarized=pol)))
         for rho in (0.0, 1.0):
             ms.append(models.DiffuseSubsurfaceBRDF(n=n, rho=rho))
+        ms.append(
+            models.MaxwellBeardBRDF(slopes=models.GaussianSlopes(0.3), substrate=n, rho_d=0.1, rho_v=0.05)
+        )
     for s in (1e-4, 5.0):
         for norm in ("paper", "exact"):
             ms.append(models.FacetBTDF(slopes=models.ExponentialSlopes(s), substrate=1.5, normalization=norm))
