@@ -24,8 +24,11 @@ facet slopes ``(zeta_1, zeta_2)``:
 * Volume: single scattering, phase matrix of Eq. 7 (or depolarizing) times the
   depth factor ``1 / (cos theta_1' + cos theta_2')`` of Eq. 18-20 (depths along
   the mean normal); totally diffuse, Eq. 21 ``D rho / pi`` with the multiple
-  reflection factor ``1 / (1 - rho R-bar)`` of Eq. 23 (R-bar of the *flat*
-  interface: an approximation under a rough one; exact in the sigma -> 0 limit).
+  reflection factor ``1 / (1 - rho R-bar)`` of Eq. 23, with R-bar the internal
+  reflectance of the *rough* interface estimated from the model's exit facets
+  (``feedback="rough"``, default; it tends to the flat R-bar as sigma -> 0) or
+  Sec. 2.3's flat R-bar (``feedback="flat"``, which gains energy under a rough
+  interface: the rough surface lets more internal light out than the flat one).
 * The exit uses radiance conservation ``L / n^2`` (BTDF reciprocity), hence the
   overall ``1 / n^2``.
 
@@ -111,6 +114,12 @@ def _area_cdf(slopes):
     return grid, c / c[-1]
 
 
+def _normals(z):
+    """Upward unit facet normals ``(3, 1, p)`` of slopes ``z`` ``(2, p)``."""
+    inv = 1.0 / np.sqrt(1.0 + z[0] * z[0] + z[1] * z[1])
+    return np.stack([z[0] * inv, z[1] * inv, inv])[:, None, :]
+
+
 @dataclass(frozen=True)
 class RoughDiffuseBRDF(Model):
     """Monte Carlo: volume scattering (single, Eq. 7, and totally diffuse, Eq. 21) beneath a
@@ -134,6 +143,17 @@ class RoughDiffuseBRDF(Model):
         Add the direct reflective facet term of the exposed surface.
     single : float
         Weight of the single-scattering term (1; 0 leaves the diffuse term alone).
+    feedback : str
+        ``"rough"``: the internal reflectance R-bar of Eq. 23 is that of the rough
+        interface, ``1 - (1/(pi n^2)) int <w_r T_out> cos dOmega`` estimated with the
+        model's own exit facets (then the diffuse term alone conserves energy:
+        ``rho = 1`` returns everything that entered).  ``"flat"``: Sec. 2.3's flat R-bar
+        (what Eq. 21 + 23 say literally; then light is gained under rough interfaces).
+    surface_normalization : str
+        ``"paper"``: the surface term is :class:`models.FacetBRDF` (Eq. 37-style
+        ``1/cos(theta_i)`` normalization, as the paper and SCATMECH); ``"exact"``:
+        scaled by ``cos(theta_i) / N(theta_i)`` to the exact Eq. 36 normalization that
+        the volume terms use (energy then stays <= 1 for rms slopes ~ 1 at grazing).
     """
 
     slopes: SlopeDistribution = param(
@@ -148,6 +168,18 @@ class RoughDiffuseBRDF(Model):
         True, "add the exposed surface's facet reflection", kind="choice", choices=(True, False)
     )
     single: float = param(1.0, "weight of the single-scattering term", low=0.0)
+    feedback: str = param(
+        "rough",
+        "R-bar of Eq. 23: of the rough interface (MC) or of the flat one",
+        kind="choice",
+        choices=("rough", "flat"),
+    )
+    surface_normalization: str = param(
+        "paper",
+        "surface term: FacetBRDF as printed (Eq. 37) or exact Eq. 36",
+        kind="choice",
+        choices=("paper", "exact"),
+    )
 
     depolarizing = True
 
@@ -170,7 +202,45 @@ class RoughDiffuseBRDF(Model):
 
     @cached_property
     def _rbar(self):
-        return internal_hemispherical_reflectance(self.n)
+        if self.feedback == "flat" or self.rho == 0.0:
+            return internal_hemispherical_reflectance(self.n)
+        return self._rough_rbar()
+
+    def _exit_transmittance(self, tr, pr):
+        """``<w_r M_out[0, 0]>`` over the exit facets, ``(g,)`` for flat ``tr``, ``pr``."""
+        n = self.n
+        z2 = self._z2
+        cr, sr = np.cos(tr)[:, None], np.sin(tr)[:, None]
+        cp, sp = np.cos(pr)[:, None], np.sin(pr)[:, None]
+        k_r = np.stack([sr * cp, sr * sp, cr])
+        m2 = _normals(z2)
+        w2 = np.maximum(cr + (sr * cp) * z2[0][None, :] + (sr * sp) * z2[1][None, :], 0.0) / self._norm(cr)
+        eta = 1.0 / n
+        c2 = _dot(k_r, m2)
+        ct2 = np.sqrt(np.maximum(1.0 - eta * eta * (1.0 - c2 * c2), 0.0))
+        k2 = -(eta * (-k_r) + (eta * c2 - ct2) * m2)
+        live = (w2 > 0) & (c2 > 0) & (k2[2] > 0)
+        jout, ci_out, ct_out = facet_transmission_jones(k2, k_r, -m2, n, 1.0, ray_basis(k2), ray_basis(k_r))
+        f_out = ct_out / (n * np.where(ci_out > 0, ci_out, 1.0))
+        t00 = 0.5 * sum(j * j for j in jout) * f_out * w2
+        return np.where(live, t00, 0.0).mean(axis=-1)
+
+    def _rough_rbar(self, n_u=32, n_phi=16):
+        """R-bar of the rough interface: one minus the fraction of internal Lambertian light
+        that leaves, ``(1/(pi n^2)) int <w_r T_out> cos(tr) dOmega_r`` (``u = cos tr``
+        Gauss-Legendre, uniform azimuth; the flat limit is exact)."""
+        x, w = np.polynomial.legendre.leggauss(n_u)
+        u = 0.5 * (x + 1.0)
+        wu = 0.5 * w
+        phi = (np.arange(n_phi) + 0.5) * (2.0 * math.pi / n_phi)
+        U, P = np.meshgrid(u, phi, indexing="ij")
+        tr, pr = np.arccos(U).ravel(), P.ravel()
+        per = max(1, BLOCK // self.pairs)
+        t = np.concatenate(
+            [self._exit_transmittance(tr[k : k + per], pr[k : k + per]) for k in range(0, tr.size, per)]
+        )
+        total = np.sum(t.reshape(U.shape) * (wu * u)[:, None]) * (2.0 * math.pi / n_phi)
+        return 1.0 - total / (math.pi * self.n * self.n)
 
     @cached_property
     def _surface_model(self):
@@ -188,12 +258,7 @@ class RoughDiffuseBRDF(Model):
         k_i = np.stack([si, zero, -ci])  # (3, g, 1)
         k_r = np.stack([sr * cp, sr * sp, cr])
 
-        # facet normals (3, 1, p), upward
-        def normals(z):
-            inv = 1.0 / np.sqrt(1.0 + z[0] * z[0] + z[1] * z[1])
-            return np.stack([z[0] * inv, z[1] * inv, inv])[:, None, :]
-
-        m1, m2 = normals(z1), normals(z2)
+        m1, m2 = _normals(z1), _normals(z2)
         # Eq. 36 weights, normalized exactly: (cos - k_xy . zeta)_+ / N
         w1 = np.maximum(ci - si * z1[0][None, :], 0.0) / self._norm(ci)
         w2 = np.maximum(cr + (sr * cp) * z2[0][None, :] + (sr * sp) * z2[1][None, :], 0.0) / self._norm(cr)
@@ -278,10 +343,17 @@ class RoughDiffuseBRDF(Model):
             err[:, sl] = x.std(axis=-1, ddof=1) / math.sqrt(self.pairs)
         return mean, err
 
+    def _surface16(self, ti, tr, pr):
+        out = self._surface_model._mueller16(ti, tr, pr)
+        if self.surface_normalization == "exact":
+            ci = np.cos(ti)
+            out = out * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))
+        return out
+
     def _mueller16(self, ti, tr, pr):
         mean, _ = self._estimate(ti, tr, pr)
         if self.surface:
-            mean += self._surface_model._mueller16(ti, tr, pr)
+            mean += self._surface16(ti, tr, pr)
         return mean
 
     def mueller_with_error(self, theta_i, theta_r, phi_r=0.0):
@@ -290,7 +362,7 @@ class RoughDiffuseBRDF(Model):
         shape, (ti, tr, pr) = self._angles(theta_i, theta_r, phi_r)
         mean, err = self._estimate(ti, tr, pr)
         if self.surface and ti.size:
-            mean += self._surface_model._mueller16(ti, tr, pr)
+            mean += self._surface16(ti, tr, pr)
 
         def shaped(a):
             return np.moveaxis(a.reshape((4, 4) + shape), (0, 1), (-2, -1))
