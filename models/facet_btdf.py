@@ -216,7 +216,7 @@ class FacetBTDF(Model):
             S = S * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))
         S = np.where(live, S, 0.0)
         root = np.sqrt(S)
-        return tuple((j * root, zero) for j in jones)
+        return tuple((j * root, 0.0) for j in jones)  # real Jones matrix
 
     def _mueller16(self, ti, tr, pr):
         return mueller16_from_jones(*self._parts(ti, tr, pr))

@@ -314,7 +314,7 @@ class RoughDiffuseBRDF(Model):
             tot = [[jo[a][0] * tmp[0][b] + jo[a][1] * tmp[1][b] for b in range(2)] for a in range(2)]
             wgt = self.single * base * dens * depth * 2.0 / (1.0 + cos_scat * cos_scat)
             root = np.sqrt(wgt)
-            zr = np.zeros_like(root)
+            zr = 0.0  # real Jones matrix
             parts = [
                 (tot[0][0] * root, zr),
                 (tot[0][1] * root, zr),

@@ -79,7 +79,7 @@ class SingleScatterBRDF(Model):
     def _jones_parts(self, ti, tr, pr):
         si, sr, ci, cr, cp, sp, cos_scat, asi, asr, api, apr, K = self._parts(ti, tr, pr)
         root = np.sqrt(2.0 * K / (1.0 + cos_scat * cos_scat))  # Eq. 6-7 normalization
-        zero = np.zeros_like(root)
+        zero = 0.0  # real Jones matrix: a scalar imaginary part saves array work in the map
         ss = asr * asi * root * cp
         ps = -(asr * api * root) * sp * ci
         sp_ = -(apr * asi * root) * sp * cr
