@@ -186,6 +186,10 @@ class RoughDiffuseBRDF(Model):
     def _validate(self):
         if not isinstance(self.slopes, SlopeDistribution) or not self.slopes.isotropic:
             raise ValueError(f"slopes must be an isotropic slope distribution; got {self.slopes!r}")
+        if getattr(self.slopes, "coverage", 1.0) != 1.0:
+            raise ValueError(
+                "slopes must have coverage 1 (a continuous interface: every path crosses it twice)"
+            )
         if not isinstance(self.phase, HenyeyGreenstein):
             raise ValueError(f"phase must be a models.HenyeyGreenstein; got {self.phase!r}")
         s = self.seed

@@ -88,6 +88,7 @@ def test_acceptance_generator_matches_weights():
         (dict(rho=2.0), "rho"),
         (dict(slopes=models.AnisotropicGaussianSlopes(sigma_x=0.1, sigma_y=0.2)), "slopes"),
         (dict(phase="hg"), "phase"),
+        (dict(slopes=models.GaussianSlopes(0.3, coverage=0.5)), "slopes"),
     ],
 )
 def test_bad_input(kw, name):
