@@ -153,7 +153,12 @@ class RoughDiffuseBRDF(Model):
         ``"paper"``: the surface term is :class:`models.FacetBRDF` (Eq. 37-style
         ``1/cos(theta_i)`` normalization, as the paper and SCATMECH); ``"exact"``:
         scaled by ``cos(theta_i) / N(theta_i)`` to the exact Eq. 36 normalization that
-        the volume terms use (energy then stays <= 1 for rms slopes ~ 1 at grazing).
+        the volume terms use (energy then stays <= 1 for wide slopes at grazing), at
+        the price of reciprocity: without shadowing, ``1/N(theta_i)`` is not symmetric
+        in the two directions (``reciprocal`` is then False).  The volume terms are
+        reciprocal either way: their weight ``w_i w_r / (N(theta_i) N(theta_r))`` is
+        symmetric, and with the exact normalization each incident ray, and each line
+        of sight of the detector, meets exactly one facet.
     """
 
     slopes: SlopeDistribution = param(
@@ -182,6 +187,10 @@ class RoughDiffuseBRDF(Model):
     )
 
     depolarizing = True
+
+    @property
+    def reciprocal(self):  # type: ignore[override]
+        return not (self.surface and self.surface_normalization == "exact")
 
     def _validate(self):
         if not isinstance(self.slopes, SlopeDistribution) or not self.slopes.isotropic:
