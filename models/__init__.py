@@ -73,3 +73,20 @@ __all__ += [
     "PointSourceBRDF",
     "fresnel_real",
 ]
+
+# --- issue 3: seed 003 diffuse-paint models -------------------------------------------
+from .diffuse_subsurface import DiffuseSubsurfaceBRDF  # noqa: E402
+from .facet_btdf import FacetBTDF  # noqa: E402
+from .phase import HenyeyGreenstein  # noqa: E402
+from .single_scatter import SingleScatterBRDF  # noqa: E402
+
+__all__ += ["HenyeyGreenstein", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF", "FacetBTDF"]
+from .rough_diffuse import RoughDiffuseBRDF  # noqa: E402
+
+__all__ += ["RoughDiffuseBRDF"]
+from .combination import mueller_with_error  # noqa: E402
+
+__all__ += ["mueller_with_error"]
+from .maxwell_beard import MaxwellBeardBRDF  # noqa: E402
+
+__all__ += ["MaxwellBeardBRDF"]

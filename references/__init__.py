@@ -94,3 +94,22 @@ def scene_paths() -> list[str]:
 from .presets_seed001 import IRON_PLATE, iron_plate_models, point_source_geometry  # noqa: E402
 
 __all__ += ["IRON_PLATE", "iron_plate_models", "point_source_geometry"]
+
+
+# --- issue 3 (seed 003) -------------------------------------------------------------
+def scatmech_seed003(kind: str) -> dict:
+    """SCATMECH Mueller BSDFs for the seed 003 models; ``kind`` is ``diffuse``,
+    ``single``, ``btdf`` or ``mb`` (Maxwell-Beard specular term).  Parameter columns (floats; ``sdf`` a string) and
+    ``mueller`` ``(N, 4, 4)``."""
+    if kind not in ("diffuse", "single", "btdf", "mb"):
+        raise ValueError(f"kind must be 'diffuse', 'single', 'btdf' or 'mb'; got {kind!r}")
+    rows = read_csv(f"scatmech_seed003_{kind}.csv")
+    out = {}
+    for k in rows[0]:
+        if k.startswith("m") and len(k) == 3 and k[1:].isdigit():
+            continue
+        out[k] = np.array([r[k] for r in rows]) if k == "sdf" else np.array([float(r[k]) for r in rows])
+    out["mueller"] = np.array(
+        [[float(r[f"m{i}{j}"]) for i in range(4) for j in range(4)] for r in rows]
+    ).reshape(-1, 4, 4)
+    return out

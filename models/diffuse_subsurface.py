@@ -1,0 +1,82 @@
+"""Totally diffuse scattering beneath a smooth interface (seed 003 Sec. 2.3, Eq. 21-28).
+
+A Lambertian, totally depolarizing reflector of reflectance ``rho`` sits under
+a smooth interface of real index ``n``; light diffusely reflected back by the
+interface's underside returns to the diffuser (Eq. 23, geometric series with
+the internal hemispherical reflectance ``R-bar``).  The Mueller BRDF (Eq. 27-28)
+is
+
+    f = (rho / pi) / (1 - rho R-bar) * cos ti' cos tr' / (cos ti cos tr) * M_diff
+
+with ``M_diff`` built from ``|t|^2`` of both passes (four non-zero elements).
+``R-bar`` uses the ``1/pi`` normalization (seed 003 Eq. 22 prints
+``1/(2 pi)``; see :func:`models.smooth_interface.internal_hemispherical_reflectance`),
+computed to ~1e-15 rather than with SCATMECH's 0.2-degree rectangle rule.  With
+it, at ``rho = 1`` the specular reflectance plus the integrated diffuse BRDF is
+exactly 1 (derivation: the diffuse term integrates to ``T(ti)``; tests check it
+numerically).  SCATMECH: ``Diffuse_Subsurface_BRDF_Model``
+(``reflectance.table = rho``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from .base import Model
+from .params import param
+from .smooth_interface import interface_amplitudes, internal_hemispherical_reflectance
+
+__all__ = ["DiffuseSubsurfaceBRDF"]
+
+
+@dataclass(frozen=True)
+class DiffuseSubsurfaceBRDF(Model):
+    """Lambertian diffuser under a smooth interface, multiple internal reflections (Eq. 27).
+
+    Parameters
+    ----------
+    n : float
+        Real index of the medium above the diffuser (``n = 1``: bare Lambertian).
+    rho : float
+        Diffuse reflectance of the underlying material, in [0, 1].
+    """
+
+    n: float = param(1.5, "index of the medium (real, non-absorbing)", kind="real_index", low=1.0)
+    rho: float = param(0.93, "diffuse reflectance of the material under the interface", low=0.0, high=1.0)
+
+    depolarizing = True
+
+    @cached_property
+    def rbar(self) -> float:
+        """Internal hemispherical reflectance ``R-bar`` (Eq. 22 with 1/pi)."""
+        return internal_hemispherical_reflectance(self.n)
+
+    @cached_property
+    def _scale(self) -> float:
+        return (self.rho / math.pi) / (1.0 - self.rho * self.rbar)
+
+    def _amps(self, ti, tr):
+        _, _, a_s, a_p = interface_amplitudes(np.cos(np.stack([ti, tr])), self.n)
+        a2, b2 = a_s * a_s, a_p * a_p
+        S = 0.5 * (a2 + b2)  # (|t_s|^2 + |t_p|^2)/2 * cos'/cos, row i then row r
+        Dd = 0.5 * (a2 - b2)
+        return S, Dd
+
+    def _mueller16(self, ti, tr, pr):
+        (Si, Sr), (Di, Dr) = self._amps(ti, tr)
+        Sr = Sr * self._scale
+        Dr = Dr * self._scale
+        out = np.zeros((16, ti.size))
+        out[0] = Sr * Si
+        out[1] = Sr * Di
+        out[4] = Dr * Si
+        out[5] = Dr * Di
+        return out
+
+    def _brdf_flat(self, ti, tr, pr):
+        (Si, Sr), _ = self._amps(ti, tr)
+        return self._scale * Sr * Si

@@ -1,0 +1,119 @@
+"""The Maxwell-Beard BRDF (Maxwell, Beard, Weiner, Ladd & Ladd, ERIM 1973), the model
+seed 003 compares its combination with (Sec. 4).
+
+Published form: a specular facet term with the Fresnel ratio and the empirical
+shadowing/obscuration function, a Lambertian term and a volumetric term,
+
+    f = [R(beta)/R(0)] f_facet^(0)(theta_N) SO(theta_N, beta) + rho_D + 2 rho_V / (cos ti + cos tr),
+    SO = (1 + (theta_N / Omega) exp(-2 beta / tau)) / (1 + theta_N / Omega),
+
+with ``beta`` half the angle between the directions to the source and to the
+detector (the facet's local angle of incidence) and ``theta_N`` the polar
+angle of their bisector (the facet normal).  Maxwell-Beard's measured
+``f_facet^(0)`` (the facet distribution at the Fresnel reference) is here the
+facet model's, so ``R(0) f_facet^(0) [R(beta)/R(0)]`` is the unpolarized
+:class:`models.FacetBRDF` and the specular term is ``FacetBRDF x SO``: the same
+as SCATMECH's ``Shadowed_Facet_BRDF_Model`` with
+``Maxwell_Beard_Shadow_Function`` (tests compare with it).  ``rho_D`` and
+``rho_V`` are BRDF values (1/sr).
+
+``polarized=False`` (the published, scalar form): every term is depolarizing and
+only ``M00`` is non-zero.  ``polarized=True`` (the extension seed 003 discusses):
+the specular term carries the facet's Mueller matrix (Jones x sqrt(SO)); the
+Lambertian and volumetric terms stay depolarizing.  As seed 003 notes, the model
+has no refraction into the material and no interface on the diffuse terms.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from .base import Model
+from .facet import FacetBRDF
+from .params import param
+from .slopes import GaussianSlopes, SlopeDistribution
+
+__all__ = ["MaxwellBeardBRDF", "maxwell_beard_shadow"]
+
+
+def maxwell_beard_shadow(ti, tr, pr, tau, omega):
+    """Shadowing/obscuration ``SO(theta_N, beta)`` of Maxwell-Beard (flat arrays)."""
+    si, ci, sr, cr = np.sin(ti), np.cos(ti), np.sin(tr), np.cos(tr)
+    cp = np.cos(pr)
+    t = si * si - 2.0 * si * sr * cp + sr * sr  # |k_i,xy + k_r,xy|^2 (bisector, unnormalized)
+    den = ci + cr
+    slope = np.sqrt(np.maximum(t, 0.0)) / np.where(den > 0, den, 1.0)
+    theta_n = np.arctan(slope)
+    cos_beta = np.sqrt(np.clip(0.5 * (1.0 - si * sr * cp + ci * cr), 0.0, 1.0))
+    beta = np.arccos(np.minimum(cos_beta, 1.0))
+    x = theta_n / omega
+    return (1.0 + x * np.exp(-2.0 * beta / tau)) / (1.0 + x)
+
+
+@dataclass(frozen=True)
+class MaxwellBeardBRDF(Model):
+    """Maxwell-Beard BRDF: shadowed specular facet term + Lambertian + volumetric.
+
+    Parameters
+    ----------
+    slopes : SlopeDistribution
+        Facet slope distribution of the specular term.
+    substrate : complex
+        Index of the material (Fresnel reflectance of the facets).
+    rho_d : float
+        Lambertian BRDF (1/sr).
+    rho_v : float
+        Volumetric BRDF coefficient (1/sr); the term is ``2 rho_v / (cos ti + cos tr)``.
+    tau, omega : float
+        Shadowing/obscuration parameters (radians).
+    polarized : bool
+        False: the published scalar form; True: facet Mueller matrix on the specular term.
+    """
+
+    slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", kind="object")
+    substrate: complex = param(1.5 + 0j, "material index n + ik", kind="index")
+    rho_d: float = param(0.0, "Lambertian BRDF (1/sr)", low=0.0)
+    rho_v: float = param(0.0, "volumetric BRDF coefficient (1/sr)", low=0.0)
+    tau: float = param(0.25, "shadowing parameter tau (rad)", low=0.0, low_open=True)
+    omega: float = param(0.7, "obscuration parameter Omega (rad)", low=0.0, low_open=True)
+    polarized: bool = param(
+        False, "facet Mueller matrix on the specular term", kind="choice", choices=(True, False)
+    )
+
+    depolarizing = True
+
+    def _validate(self):
+        if not isinstance(self.slopes, SlopeDistribution):
+            raise ValueError(f"slopes must be a slope distribution; got {self.slopes!r}")
+
+    @cached_property
+    def _facet(self):
+        return FacetBRDF(slopes=self.slopes, substrate=self.substrate)
+
+    def _mueller16(self, ti, tr, pr):
+        so = maxwell_beard_shadow(ti, tr, pr, self.tau, self.omega)
+        if self.polarized:
+            out = self._facet._mueller16(ti, tr, pr) * so
+        else:
+            out = np.zeros((16, ti.size))
+            out[0] = self._facet._brdf_flat(ti, tr, pr) * so
+        ci, cr = np.cos(ti), np.cos(tr)
+        den = ci + cr
+        vol = 2.0 * self.rho_v / np.where(den > 0, den, 1.0)
+        grazing = (ti >= 0.5 * math.pi) | (tr >= 0.5 * math.pi)
+        out[0] += np.where(grazing, 0.0, self.rho_d + vol)
+        return out
+
+    def rotated(self, angle):
+        return self.replace(slopes=self.slopes.rotated(angle))
+
+    @property
+    def mirror_symmetric(self):  # type: ignore[override]
+        return self.slopes.isotropic
+
+    def lobe(self, theta_i):
+        return self._facet.lobe(theta_i)

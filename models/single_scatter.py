@@ -1,0 +1,122 @@
+"""Single volume scattering beneath a smooth interface (seed 003 Sec. 2.2, Eq. 8-20).
+
+A ray refracts into a half-space of real index ``n``, scatters once with the
+phase function of :mod:`models.phase` at a depth with the exponential
+probability of Eq. 16-19, and refracts out.  The Mueller BRDF (Eq. 20) is
+
+    f = P(k_i', k_r') (x) [diag(t_r) J diag(t_i)] * cos ti' cos tr' / (cos ti cos tr (cos ti' + cos tr'))
+
+where the first factor is the phase matrix in the internal rays' bases.  The
+Jones matrix of Eq. 12-13 is evaluated directly from the dyadics in the
+repository's bases (``s = unit(z x k)``, ``p = k x s``, SCATMECH's;
+seed 003 Eq. 8 writes ``s = k x n``, the opposite sign for both ``s`` and ``p``
+of every ray, which leaves Jones matrices unchanged).  With the projection
+dyadic of Eq. 4 the internal Jones elements are ``e_a(out') . e_b(in')``:
+
+    ss = cos(phi_r),  ps = -sin(phi_r) cos(ti'),  sp = -sin(phi_r) cos(tr'),
+    pp = sin(ti') sin(tr') - cos(ti') cos(tr') cos(phi_r).
+
+Printed Eq. 13 has the opposite sign on ``q_ps`` and on the ``cos cos cos``
+term of ``q_pp``; those signs do not follow from Eq. 12 in either basis
+(``q_ps`` and ``q_sp`` must have the same sign for ``M = D M^T D``, Helmholtz
+reciprocity, which the tests check).  With the depolarizing phase
+only ``|t|^2`` enter and the model is SCATMECH's ``First_Diffuse_BRDF_Model``
+(with ``Unpolarized_Phase_Function``, no absorption), which it matches to
+1e-12.  The ``cos'/cos`` factors are carried by the amplitudes of
+:func:`models.smooth_interface.interface_amplitudes`, so grazing geometries give
+exact zeros.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .base import Model
+from .params import param
+from .phase import HenyeyGreenstein
+from .polarization import mueller16_from_jones
+from .smooth_interface import interface_amplitudes
+
+__all__ = ["SingleScatterBRDF"]
+
+
+@dataclass(frozen=True)
+class SingleScatterBRDF(Model):
+    """Single scattering by a volume diffuser beneath a smooth interface (seed 003 Eq. 20).
+
+    SCATMECH: ``First_Diffuse_BRDF_Model`` (depolarizing phase function only).
+
+    Parameters
+    ----------
+    n : float
+        Real index of the medium (``n = 1``: no interface).
+    phase : HenyeyGreenstein
+        Phase function (polarized Eq. 7 or depolarizing).
+    """
+
+    n: float = param(1.5, "index of the scattering medium (real, non-absorbing)", kind="real_index", low=1.0)
+    phase: HenyeyGreenstein = param(HenyeyGreenstein(0.3), "volume phase function", kind="object")
+
+    def _validate(self):
+        if not isinstance(self.phase, HenyeyGreenstein):
+            raise ValueError(f"phase must be a models.HenyeyGreenstein; got {self.phase!r}")
+
+    @property
+    def depolarizing(self):  # type: ignore[override]
+        return not self.phase.polarized
+
+    def _parts(self, ti, tr, pr):
+        """Internal geometry, the amplitude factors and the scalar weight ``K``."""
+        (si, sr), (ci, cr), (asi, asr), (api, apr) = interface_amplitudes(np.cos(np.stack([ti, tr])), self.n)
+        cp, sp = np.cos(pr), np.sin(pr)
+        cos_scat = si * sr * cp - ci * cr  # k_i' . k_r'
+        # Eq. 19-20: p4 / cos(tr) with the solid-angle factor, cos'/cos carried by the amplitudes.
+        K = self.phase.density(cos_scat) / np.maximum(ci + cr, 1e-300)
+        return si, sr, ci, cr, cp, sp, cos_scat, asi, asr, api, apr, K
+
+    def _jones_parts(self, ti, tr, pr):
+        si, sr, ci, cr, cp, sp, cos_scat, asi, asr, api, apr, K = self._parts(ti, tr, pr)
+        root = np.sqrt(2.0 * K / (1.0 + cos_scat * cos_scat))  # Eq. 6-7 normalization
+        zero = 0.0  # real Jones matrix: a scalar imaginary part saves array work in the map
+        ss = asr * asi * root * cp
+        ps = -(asr * api * root) * sp * ci
+        sp_ = -(apr * asi * root) * sp * cr
+        pp = apr * api * root * (si * sr - ci * cr * cp)
+        return (ss, zero), (ps, zero), (sp_, zero), (pp, zero)
+
+    def _mueller16(self, ti, tr, pr):
+        if self.phase.polarized:
+            return mueller16_from_jones(*self._jones_parts(ti, tr, pr))
+        _, _, _, _, _, _, _, asi, asr, api, apr, K = self._parts(ti, tr, pr)
+        # D between the two transmissions: M(t_r)[:, 0] (x) M(t_i)[0, :] (Eq. 28 structure).
+        out = np.zeros((16, ti.size))
+        a, b = asr * asr, apr * apr
+        c, d = asi * asi, api * api
+        Sr, Dr = 0.5 * (a + b) * K, 0.5 * (a - b) * K
+        Si, Di = 0.5 * (c + d), 0.5 * (c - d)
+        out[0] = Sr * Si
+        out[1] = Sr * Di
+        out[4] = Dr * Si
+        out[5] = Dr * Di
+        return out
+
+    def _brdf_flat(self, ti, tr, pr):
+        _, _, _, _, _, _, _, asi, asr, api, apr, K = self._parts(ti, tr, pr)
+        return 0.25 * K * (asr * asr + apr * apr) * (asi * asi + api * api)
+
+    def _jones_flat(self, ti, tr, pr):
+        if not self.phase.polarized:
+            return Model._jones_flat(self, ti, tr, pr)
+        parts = self._jones_parts(ti, tr, pr)
+        J = np.empty(ti.shape + (4,), dtype=complex)
+        for k, (re, _) in enumerate(parts):
+            J[:, k] = re
+        return J.reshape(ti.shape + (2, 2))
+
+    def lobe(self, theta_i):
+        """Forward-peaked phase functions (g -> 1) scatter into a lobe around the
+        refracted-forward direction, which exits at grazing: no narrow lobe inside
+        the hemisphere for the integrator to find.  None."""
+        return None

@@ -1,0 +1,106 @@
+"""Seed 003 Sec. 2.4: FacetBTDF and the Fig. 1 Snell shift."""
+
+import math
+
+import numpy as np
+import pytest
+
+import models
+from validation import checks_seed003 as c3
+from validation.fig1_seed003 import effective_index, peak_angle
+from validation.integrate import integrated_reflectance
+
+
+def test_scatmech_btdf():
+    e, lit = c3.scatmech_seed003_errors("btdf")
+    assert len(e) >= 150 and lit >= 100 and e.max() < 1e-6
+
+
+def test_jacobian_compact_form_equals_scatmech_form(rng):
+    """dOmega_n/dOmega_t = n^2 cos(iota_t)/D^2 equals SCATMECH's jacobian (printed Eq. 39
+    with theta_i restored where it prints theta_t)."""
+    n = 1.7
+    ti, tt, pt = rng.uniform(0, 1.4, 50), rng.uniform(0, 1.4, 50), rng.uniform(-3, 3, 50)
+    c, s = np.cos, np.sin
+    D2 = 1 - 2 * n * c(ti) * c(tt) - 2 * n * c(pt) * s(ti) * s(tt) + n * n
+    sc = (
+        n**2
+        * (
+            -(n * c(ti) * (3 + c(2 * tt)))
+            + c(pt) * s(2 * ti) * s(tt)
+            + c(tt) * c(ti) ** 2
+            + c(tt) * (1 - 2 * n * c(pt) * s(ti) * s(tt) + 2 * n * n - s(ti) ** 2)
+        )
+        / (2 * (-c(ti) + n * c(tt)) * D2**1.5)
+    )
+    cg = s(ti) * s(tt) * c(pt) + c(ti) * c(tt)
+    np.testing.assert_allclose(np.abs(sc), n * n * (n - cg) / D2**1.5, rtol=1e-10)
+
+
+def test_unreachable_geometries_are_exact_zeros():
+    m = models.FacetBTDF(slopes=models.GaussianSlopes(0.3), substrate=1.5)
+    # transmitted beyond the incident direction on the forward side: n cos(gamma) < 1 or m_z < 0
+    ti = math.radians(30.0)
+    tt = np.radians([80.0, 89.0, 60.0])
+    M = m.mueller(ti, tt, 0.0)
+    assert np.all(M[0, ...] == 0.0) or np.all(M[1, ...] == 0.0)
+    assert np.all(m.mueller(math.pi / 2, 0.3, 0.0) == 0.0)
+    assert np.all(m.mueller(0.3, math.pi / 2, 0.0) == 0.0)
+
+
+def test_jones_consistent_with_mueller(rng):
+    m = models.FacetBTDF(slopes=models.ExponentialSlopes(0.4), substrate=2.0)
+    ti, tt, pt = rng.uniform(0, 1.4, 100), rng.uniform(0, 1.4, 100), rng.uniform(-1, 1, 100)
+    np.testing.assert_allclose(
+        models.jones_to_mueller(m.jones(ti, tt, pt)), m.mueller(ti, tt, pt), atol=1e-14
+    )
+
+
+def test_exact_normalization_conserves_energy_with_facet_reflection():
+    """Exact Eq. 36 normalization: FacetBRDF (same normalization) + FacetBTDF = 1 when no
+    ray is sent below the horizon (narrow slopes, moderate angle)."""
+    s = models.GaussianSlopes(0.05)
+    ti = math.radians(30.0)
+    t = integrated_reflectance(models.FacetBTDF(slopes=s, substrate=1.5, normalization="exact"), ti, tol=1e-7)
+    r = integrated_reflectance(models.FacetBRDF(slopes=s, substrate=1.5), ti, tol=1e-7)
+    N = models.facet_btdf.projected_area(s, np.array([math.cos(ti)]))[0]
+    assert abs(t.value + r.value * math.cos(ti) / N - 1.0) < 1e-5
+
+
+def test_paper_normalization_exceeds_one_for_wide_slopes():
+    assert c3.check_btdf_paper_normalization().measured > 1.0
+
+
+def test_fig1_peak_and_monotonic_shift():
+    sig = (0.05, 0.1, 0.3, 1.0)
+    peaks = [peak_angle(s) for s in sig]
+    assert abs(peaks[1] - 36.0) < 0.5  # the paper: ~36 deg for its narrowest distribution
+    assert 35.26 < peaks[0] < peaks[1]
+    assert np.all(np.diff(peaks) > 0) and peaks[-1] < 60.0
+
+
+def test_fig1_effective_index():
+    n_narrow, res = effective_index(0.05)
+    assert abs(n_narrow - 1.5) / 1.5 < 0.01 and res < 0.01
+    n_mid, _ = effective_index(0.3)
+    n_wide, _ = effective_index(1.0)
+    assert n_narrow > n_mid > n_wide and n_wide < 1.2
+
+
+@pytest.mark.parametrize(
+    "make, name",
+    [
+        (lambda: models.FacetBTDF(substrate=1.0), "substrate"),
+        (lambda: models.FacetBTDF(substrate=1.5 + 0.2j), "substrate"),
+        (lambda: models.FacetBTDF(slopes=0.1), "slopes"),
+        (lambda: models.FacetBTDF(normalization="approx"), "normalization"),
+    ],
+)
+def test_bad_input(make, name):
+    with pytest.raises(ValueError, match=name):
+        make()
+
+
+def test_angle_validation_names_theta_t():
+    with pytest.raises(ValueError, match="theta_t"):
+        models.FacetBTDF().mueller(0.1, 2.0, 0.0)
