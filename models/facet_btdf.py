@@ -105,7 +105,11 @@ def facet_transmission_jones(k_in, k_out, m, n1, n2, e_in, e_out):
     a_in = _cross(k_in, u)
     v = _cross(k_in, k_out)
     cg = _dot(k_in, k_out)
-    inv1 = 1.0 / (1.0 + cg)  # cg > -1 for any transmission (|gamma| < pi/2)
+    # cg > -1 for any transmission (|gamma| < pi/2); unreachable geometries (masked
+    # out by the caller) can reach cg = -1, where the rotation term is not needed.
+    one_cg = 1.0 + cg
+    alive = one_cg > 1e-300
+    inv1 = np.where(alive, 1.0 / np.where(alive, one_cg, 1.0), 0.0)
     out = []
     for ea in e_out:
         eav = _dot(ea, v)
