@@ -104,7 +104,11 @@ def _cmd_fit(args) -> int:
         f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
     )
     os.makedirs(args.out, exist_ok=True)
-    ck = os.path.join(args.out, "chain.npz")
+    # The running checkpoint is chain.partial.npz; it becomes chain.npz when the run
+    # ends, so a failed --force run never replaces a previous complete chain.
+    ck = os.path.join(args.out, "chain.partial.npz")
+    final = os.path.join(args.out, "chain.npz")
+    resume_from = ck if os.path.exists(ck) else final
     t0 = time.perf_counter()
     with make_executor(args.workers, args.scheduler) as ex:
         print(f"executor: {ex.describe()}")
@@ -120,11 +124,14 @@ def _cmd_fit(args) -> int:
                 executor=ex,
                 checkpoint=ck,
                 resume=args.resume,
+                resume_from=resume_from,
                 progress=not args.no_progress,
             )
         except ValueError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
+        if os.path.exists(ck):
+            os.replace(ck, final)
         post = write_fit(
             res,
             args.out,

@@ -64,6 +64,7 @@ def run_fit(
     checkpoint=None,
     resume=False,
     progress=False,
+    resume_from=None,
 ):
     ndim = len(lik.spec.free)
     if walkers < 2 * ndim or walkers % 2:
@@ -91,6 +92,7 @@ def run_fit(
         executor=executor,
         checkpoint=checkpoint,
         resume=resume,
+        resume_from=resume_from,
         fingerprint=fp,
         progress=progress,
     )
@@ -252,6 +254,7 @@ def _plots(fit, pp, out):
         labels=spec.names,
         truths=truths if any(t is not None for t in truths) else None,
         quantiles=[0.025, 0.16, 0.5, 0.84, 0.975],
+        title_quantiles=[0.16, 0.5, 0.84],
         show_titles=True,
         title_fmt=".4g",
     )

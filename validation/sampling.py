@@ -160,6 +160,16 @@ def _tau(chain):
     return emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
 
 
+def _converged(tau_history, tau_factor, tau_rtol):
+    """N >= tau_factor * max(tau), and max(tau) moved by < tau_rtol since the previous check."""
+    if len(tau_history) < 2:
+        return False
+    (steps, tau), (_, prev) = tau_history[-1], tau_history[-2]
+    if not (np.all(np.isfinite(tau)) and np.all(np.isfinite(prev))):
+        return False
+    return bool(steps >= tau_factor * tau.max() and abs(tau.max() - prev.max()) < tau_rtol * tau.max())
+
+
 def _save_checkpoint(path, fingerprint, chain, log_prob, accepted, state, tau_history, seconds, evaluations):
     rs = state.random_state
     buf = io.BytesIO()
@@ -226,12 +236,16 @@ def run_chain(
     resume=False,
     fingerprint="",
     progress=False,
+    resume_from=None,
 ):
-    """Run (or resume) the ensemble; see the module docstring.  ``p0``: (walkers, ndim)."""
+    """Run (or resume) the ensemble; see the module docstring.  ``p0``: (walkers, ndim).
+
+    ``checkpoint``: where checkpoints are written; ``resume``: continue from
+    ``resume_from`` (default: ``checkpoint``)."""
     if check_every < 1:
         raise ValueError(f"check_every must be >= 1; got {check_every}")
     if resume:
-        ck = load_checkpoint(checkpoint, fingerprint)
+        ck = load_checkpoint(resume_from or checkpoint, fingerprint)
         chain, lps, accepted, state = ck["chain"], ck["log_prob"], ck["accepted"], ck["state"]
         tau_history, seconds, evaluations = ck["tau_history"], ck["seconds"], ck["evaluations"]
         nwalkers, ndim = state.coords.shape
@@ -252,9 +266,10 @@ def run_chain(
     converged = False
     reason = ""
     try:
-        if chain.shape[0] >= max_steps:
-            reason = "step budget"
         while chain.shape[0] < max_steps:
+            if _converged(tau_history, tau_factor, tau_rtol):
+                converged = True
+                break
             done = chain.shape[0]
             n = min(check_every - done % check_every, max_steps - done)
             t0 = time.perf_counter()
@@ -271,19 +286,17 @@ def run_chain(
             lps = np.concatenate([lps, sampler.get_log_prob()])
             accepted = accepted + sampler.backend.accepted
             steps = chain.shape[0]
-            tau = _tau(chain)
-            prev = tau_history[-1][1] if tau_history else None
-            tau_history.append((steps, tau))
+            tau_history.append((steps, _tau(chain)))
             if checkpoint:
                 _save_checkpoint(
                     checkpoint, fingerprint, chain, lps, accepted, state, tau_history, seconds, evaluations
                 )
-            if np.all(np.isfinite(tau)) and steps >= tau_factor * tau.max() and prev is not None:
-                if np.all(np.isfinite(prev)) and abs(tau.max() - prev.max()) < tau_rtol * tau.max():
-                    converged = True
-                    reason = f"converged: N = {steps} >= {tau_factor:g} tau = {tau_factor * tau.max():.0f}"
-                    break
-        if not converged:
+        if not converged and _converged(tau_history, tau_factor, tau_rtol):
+            converged = True
+        if converged:
+            steps, tau = tau_history[-1]
+            reason = f"converged: N = {steps} >= {tau_factor:g} tau = {tau_factor * tau.max():.0f}"
+        else:
             tau = tau_history[-1][1] if tau_history else np.full(ndim, np.nan)
             reason = (
                 f"step budget reached: N = {chain.shape[0]} (max_steps), {tau_factor:g} tau = "
