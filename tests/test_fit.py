@@ -164,6 +164,8 @@ def test_same_seed_same_chain_whatever_the_executor(coated, data):
         with Client(cluster) as client, DaskExecutor(client) as ex:
             assert ex.workers == 2
             dask = run_fit(lik, executor=ex, **kw)
+        with DaskExecutor(cluster.scheduler_address) as ex:  # the --scheduler ADDRESS path
+            assert ex.map(abs, [-3, 1, -2]) == [3, 1, 2]
     assert np.array_equal(ref.chain.chain, procs.chain.chain)
     assert np.array_equal(ref.chain.chain, dask.chain.chain)
     assert np.array_equal(ref.chain.log_prob, dask.chain.log_prob)

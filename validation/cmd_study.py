@@ -65,6 +65,7 @@ def _cmd_recovery(args) -> int:
             starts=args.starts,
             executor=ex,
             noise_extra=extra,
+            progress=not args.no_progress,
         )
     seconds = time.perf_counter() - t0
     os.makedirs(args.out, exist_ok=True)
@@ -287,6 +288,7 @@ def register(sub):
     r.add_argument("--injections", type=int, default=50)
     r.add_argument("--out", required=True)
     r.add_argument("--force", action="store_true")
+    r.add_argument("--no-progress", action="store_true")
     _mcmc_args(r, walkers=16, max_steps=2000)
     _executor_args(r)
     r.set_defaults(func=_cmd_recovery)

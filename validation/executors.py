@@ -15,7 +15,9 @@ in the calling process), so results are identical whatever the executor.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import hashlib
 import multiprocessing
+import pickle
 
 __all__ = ["SerialExecutor", "ProcessExecutor", "DaskExecutor", "make_executor"]
 
@@ -33,6 +35,18 @@ def _chunks(items, n):
 
 
 def _run_chunk(fn, chunk):
+    return [fn(x) for x in chunk]
+
+
+_WORKER_FNS: dict = {}
+
+
+def _run_pickled_chunk(key, blob, chunk):
+    """Worker side: unpickle the function once per worker process and reuse it."""
+    fn = _WORKER_FNS.get(key)
+    if fn is None:
+        _WORKER_FNS.clear()
+        fn = _WORKER_FNS[key] = pickle.loads(blob)
     return [fn(x) for x in chunk]
 
 
@@ -64,10 +78,19 @@ class ProcessExecutor(SerialExecutor):
             raise ValueError(f"workers must be an integer >= 1; got {workers!r}")
         self.workers = workers
         # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
+        self._fn = self._blob = self._key = None
         self._pool = cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
 
     def map(self, fn, items):
-        futs = [self._pool.submit(_run_chunk, fn, c) for c in _chunks(items, self.workers)]
+        # The function (e.g. a likelihood holding the data) is pickled once per
+        # distinct function object, not once per call; workers unpickle it once.
+        if self._fn is not fn:
+            blob = pickle.dumps(fn)
+            self._fn, self._blob, self._key = fn, blob, hashlib.sha1(blob).hexdigest()
+        futs = [
+            self._pool.submit(_run_pickled_chunk, self._key, self._blob, c)
+            for c in _chunks(items, self.workers)
+        ]
         return [y for f in futs for y in f.result()]
 
     def close(self):

@@ -161,6 +161,7 @@ def recovery_study(
     starts=1,
     executor=None,
     noise_extra=None,
+    progress=False,
 ):
     """Cells (noise level x number of geometries), ``injections`` members each.
 
@@ -199,7 +200,19 @@ def recovery_study(
                     starts,
                 )
             )
-    results = executor.map(run_member, members)
+    # one map per cell: a progress bar that moves, and the same results (members are independent)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(members), unit="fit", desc="injections", mininterval=1.0)
+    results = []
+    for start in range(0, len(members), injections):
+        results.extend(executor.map(run_member, members[start : start + injections]))
+        if bar is not None:
+            bar.update(injections)
+    if bar is not None:
+        bar.close()
     k = 0
     for cell in cells:
         rs = results[k : k + injections]
