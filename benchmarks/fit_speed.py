@@ -43,9 +43,9 @@ def main():
     )
     lik = Likelihood(sc, spec, data)
     t0 = time.perf_counter()
-    u0, _, _ = optimize(lik, args.seed)
+    u0, _, info = optimize(lik, args.seed)
     t_opt = time.perf_counter() - t0
-    p0 = initial_ball(u0, 32, args.seed, spec.u_bounds())
+    p0 = initial_ball(u0, 32, args.seed, spec.u_bounds(), sd=info["sd_u"])
     with make_executor(args.workers) as ex:
         res = run_chain(
             lik, p0=p0, seed=args.seed, max_steps=20000, check_every=100, tau_factor=50, executor=ex

@@ -80,7 +80,7 @@ def run_fit(
     )
     fp = fingerprint(lik, settings)
     u_opt, lp_opt, info = optimize(lik, seed, n_starts=starts)
-    p0 = None if resume else initial_ball(u_opt, walkers, seed, lik.spec.u_bounds())
+    p0 = None if resume else initial_ball(u_opt, walkers, seed, lik.spec.u_bounds(), sd=info["sd_u"])
     chain = run_chain(
         lik,
         p0=p0,

@@ -92,10 +92,9 @@ def run_member(m: Member) -> dict:
     noise_seed, chain_seed = (int(s.generate_state(1)[0]) for s in ss.spawn(2))
     data = simulate(m.scene, m.spec, m.data, m.truth, m.noise, np.random.default_rng(noise_seed))
     lik = Likelihood(m.scene, m.spec, data)
-    u0, _, _ = optimize(
-        lik, chain_seed, n_starts=m.starts, start=[p.to_u(m.truth[p.key]) for p in m.spec.free]
-    )
-    p0 = initial_ball(u0, m.walkers, chain_seed, m.spec.u_bounds())
+    # the optimizer starts from the scene's values (the truth here) plus m.starts - 1 prior draws
+    u0, _, info = optimize(lik, chain_seed, n_starts=m.starts)
+    p0 = initial_ball(u0, m.walkers, chain_seed, m.spec.u_bounds(), sd=info["sd_u"])
     res = run_chain(
         lik, p0=p0, seed=chain_seed, max_steps=m.max_steps, check_every=m.check_every, tau_factor=m.tau_factor
     )

@@ -100,15 +100,53 @@ def optimize(lik, seed, n_starts=4, start=None):
         )
         if lik(r.x) > val:
             u, val = np.asarray(r.x, float), float(lik(r.x))
-    return u, float(val), {"starts": len(starts), "start_values": tried}
+    return u, float(val), {"starts": len(starts), "start_values": tried, "sd_u": _posterior_sd(lik, u)}
 
 
-def initial_ball(u0, nwalkers, seed, bounds, scale=1e-3):
-    """Walkers in a small Gaussian ball (``scale`` x the prior width) around ``u0``, inside the bounds."""
+def _posterior_sd(lik, u):
+    """Rough posterior standard deviations (sampling coordinates) at the optimum, to size
+    the walkers' starting ball: Gauss-Newton ``(J^T J)^-1`` of the whitened residuals for
+    scene parameters; ``1/sqrt(2N)`` in ln(level) for noise levels (the relative
+    spread of a variance estimated from ``N`` residuals)."""
+    spec = lik.spec
+    b = spec.u_bounds()
+    width = b[:, 1] - b[:, 0]
+    sd = 1e-3 * width
+    model_idx = [i for i, p in enumerate(spec.free) if not p.is_noise]
+    h = 1e-6 * width[model_idx]
+    r0 = lik.whitened(u)
+    J = []
+    for j, i in enumerate(model_idx):
+        v = u.copy()
+        v[i] = u[i] + h[j] if u[i] + h[j] <= b[i, 1] else u[i] - h[j]
+        J.append((lik.whitened(v) - r0) / (v[i] - u[i]))
+    J = np.array(J).T
+    try:
+        cov = np.linalg.inv(J.T @ J)
+        d = np.sqrt(np.diag(cov))
+        if np.all(np.isfinite(d)) and np.all(d > 0):
+            sd[model_idx] = np.minimum(d, width[model_idx])
+    except np.linalg.LinAlgError:
+        pass
+    n = lik.n_points
+    for i, p in enumerate(spec.free):
+        if p.is_noise:
+            rel = 1.0 / math.sqrt(2.0 * n)
+            sd[i] = rel if p.prior == "log" else rel * max(abs(p.from_u(u[i])), 1e-12)
+    return sd
+
+
+def initial_ball(u0, nwalkers, seed, bounds, sd=None, scale=0.5):
+    """Walkers in a Gaussian ball around ``u0`` inside the bounds: ``scale`` x the estimated
+    posterior standard deviations ``sd`` (default: 1e-3 of the prior width).
+
+    A ball much smaller than the posterior takes many autocorrelation times to
+    expand and, if the chain is short, gives intervals that are too narrow."""
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 2]))
     b = np.asarray(bounds, float)
     width = b[:, 1] - b[:, 0]
-    p = u0 + scale * width * rng.standard_normal((nwalkers, len(u0)))
+    step = scale * np.asarray(sd, float) if sd is not None else 1e-3 * width
+    p = u0 + step * rng.standard_normal((nwalkers, len(u0)))
     # reflect into the box (keeps the ball's spread next to a bound)
     p = np.where(p < b[:, 0], 2 * b[:, 0] - p, p)
     p = np.where(p > b[:, 1], 2 * b[:, 1] - p, p)
