@@ -151,9 +151,10 @@ class Dataset:
         return Dataset(path=self.path, meta=dict(self.meta), **kw)
 
     def replace(self, **changes) -> Dataset:
+        path = changes.pop("path", self.path)
         kw = {name: getattr(self, name) for name in self._ARRAYS}
         kw.update(changes)
-        return Dataset(path=changes.pop("path", self.path), meta=dict(self.meta), **kw)
+        return Dataset(path=path, meta=dict(self.meta), **kw)
 
 
 def _sidecar_path(path):
