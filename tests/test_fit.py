@@ -1,0 +1,228 @@
+"""Fit spec, likelihood, emcee sampling with resume, executors, recovery of the SCATMECH data set, CLI."""
+
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+import references
+from models import scene
+from validation.cli import main
+from validation.datafile import load_data
+from validation.executors import DaskExecutor, ProcessExecutor, SerialExecutor
+from validation.fit import run_fit
+from validation.fitspec import FitSpecError, fitspec_from, parse_free
+from validation.likelihood import Likelihood
+from validation.recovery import subsample
+from validation.sampling import CheckpointError, initial_ball, optimize, run_chain
+
+SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
+COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
+FITSCENE = os.path.join(SCENES, "aluminium_flakes_fit.toml")
+DATA = references.data_path("scatmech_flake_measurement.csv")
+
+
+@pytest.fixture(scope="module")
+def coated():
+    return scene.load(COATED)
+
+
+@pytest.fixture(scope="module")
+def data():
+    return load_data(DATA)
+
+
+# ----------------------------------------------------------------------------- spec
+def test_free_entries_aliases_priors_and_bounds(coated):
+    p = parse_free("sigma:0.01:1:log")
+    assert (p.key, p.low, p.high, p.prior) == ("substrate.sigma", 0.01, 1.0, "log")
+    assert parse_free("k:3:12").key == "substrate.index[1]" and parse_free("k:3:12").prior == "uniform"
+    with pytest.raises(FitSpecError, match="log-uniform prior needs low > 0"):
+        parse_free("sigma:0:1:log")
+    with pytest.raises(FitSpecError, match="low < high"):
+        parse_free("sigma:1:0.5")
+    with pytest.raises(FitSpecError, match="prior must be"):
+        parse_free("sigma:0.1:1:gauss")
+    with pytest.raises(FitSpecError, match=r"coating\.index: bound 0\.5 gives an invalid scene"):
+        fitspec_from(coated, ["coating:0.5:2"], ["brdf=0.1"])
+    with pytest.raises(FitSpecError, match="substrate.roughness: not set"):
+        fitspec_from(coated, ["substrate.roughness:0.1:1"], ["brdf=0.1"])
+    with pytest.raises(FitSpecError, match="unknown noise term"):
+        fitspec_from(coated, ["sigma:0.01:1"], ["speckle=0.1"])
+
+
+def test_scene_fit_table_and_log_prior_bounds():
+    sc = scene.load(FITSCENE)
+    spec = fitspec_from(sc)
+    assert spec.names == [
+        "substrate.sigma",
+        "coating.index",
+        "substrate.index[0]",
+        "substrate.index[1]",
+        "noise.brdf",
+    ]
+    assert spec.noise == {"eta_deg": 1.0, "P": 0.02, "P_C": 0.02}
+    u = np.array([math.log(0.1), 1.5, 1.37, 7.62, math.log(0.05)])
+    assert spec.log_prior(u) == 0.0
+    assert spec.log_prior(u + np.array([0, 0.6, 0, 0, 0])) == -math.inf  # coating 2.1 > 2
+    assert spec.physical(u)["substrate.sigma"] == pytest.approx(0.1)
+    # the command line replaces the scene's free list
+    assert fitspec_from(sc, ["sigma:0.05:0.2:log"]).names == ["substrate.sigma", "noise.brdf"]
+
+
+def test_masks_near_specular_and_boxes(coated, data):
+    spec = fitspec_from(coated, ["sigma:0.01:1:log"], ["brdf=0.05"], near_specular_deg=5.0)
+    keep = spec.mask(data)
+    from validation.fitspec import specular_distance
+
+    d = np.degrees(specular_distance(data.theta_i, data.theta_r, data.phi_r))
+    assert np.array_equal(keep, d > 5.0) and 0 < (~keep).sum() < 40
+    spec = fitspec_from(
+        coated, ["sigma:0.01:1:log"], ["brdf=0.05"], exclude=["theta_r_deg=53:67,phi_r_deg=180:180"]
+    )
+    gone = ~spec.mask(data)
+    tr, pr = np.degrees(data.theta_r), np.degrees(data.phi_r)
+    assert np.array_equal(gone, (tr >= 53 - 1e-9) & (tr <= 67 + 1e-9) & np.isclose(pr, 180.0))
+    assert gone.sum() > 5
+
+
+# ----------------------------------------------------------------------------- likelihood
+def test_likelihood_prefers_the_truth_and_uses_declared_terms(coated, data):
+    spec = fitspec_from(
+        coated, ["sigma:0.01:1:log", "coating:1.2:2"], ["brdf=0.05", "eta_deg=1", "P=0.02", "P_C=0.02"]
+    )
+    lik = Likelihood(coated, spec, data)
+    assert lik.terms == ("brdf", "eta", "P", "P_C")
+    at_truth = lik([math.log(0.1), 1.5])
+    assert at_truth > lik([math.log(0.11), 1.5]) + 50
+    assert at_truth > lik([math.log(0.1), 1.55]) + 50
+    assert lik([math.log(0.1), 2.5]) == -math.inf  # outside the bounds
+    # whitened residuals at the truth are unit-variance noise (what the data were made with)
+    w = lik.whitened([math.log(0.1), 1.5])
+    assert len(w) == 4 * len(data) and 0.85 < np.std(w) < 1.15
+    spec = fitspec_from(coated, ["sigma:0.01:1:log"], ["eta_deg=1"])
+    with pytest.raises(ValueError, match="noise.brdf"):
+        Likelihood(coated, spec, data)
+
+
+# ----------------------------------------------------------------------------- sampling
+def _small(coated, data, n=30):
+    spec = fitspec_from(coated, ["sigma:0.01:1:log", "coating:1.2:2"], ["brdf=0.05", "eta_deg=1"])
+    return Likelihood(coated, spec, subsample(data, n))
+
+
+class Crash:
+    """Log-probability that raises after ``after`` calls: a simulated interruption."""
+
+    def __init__(self, lik, after):
+        self.lik, self.after, self.calls = lik, after, 0
+
+    def __call__(self, u):
+        self.calls += 1
+        if self.calls > self.after:
+            raise KeyboardInterrupt("simulated interruption")
+        return self.lik(u)
+
+
+def test_resume_after_interruption_gives_the_same_chain_bit_for_bit(coated, data, tmp_path):
+    lik = _small(coated, data)
+    u0, _, _ = optimize(lik, 7, n_starts=1)
+    p0 = initial_ball(u0, 8, 7, lik.spec.u_bounds())
+    kw = dict(seed=7, max_steps=60, check_every=20, tau_factor=50)
+    full = run_chain(lik, p0=p0, checkpoint=str(tmp_path / "a.npz"), fingerprint="f", **kw)
+    ck = str(tmp_path / "b.npz")
+    with pytest.raises(KeyboardInterrupt):
+        run_chain(Crash(lik, 8 + 8 * 35), p0=p0, checkpoint=ck, fingerprint="f", **kw)  # dies in step ~35
+    with np.load(ck) as z:
+        assert z["chain"].shape[0] == 20  # the last complete segment survived
+    resumed = run_chain(lik, checkpoint=ck, resume=True, fingerprint="f", **kw)
+    assert np.array_equal(resumed.chain, full.chain)
+    assert np.array_equal(resumed.log_prob, full.log_prob)
+    assert np.array_equal(resumed.accepted, full.accepted)
+    # stopping early on a budget and continuing with a larger one is the same too
+    part = run_chain(
+        lik, p0=p0, checkpoint=str(tmp_path / "c.npz"), fingerprint="f", **dict(kw, max_steps=40)
+    )
+    assert part.steps == 40 and not part.converged and "step budget" in part.stop_reason
+    more = run_chain(lik, checkpoint=str(tmp_path / "c.npz"), resume=True, fingerprint="f", **kw)
+    assert np.array_equal(more.chain, full.chain)
+    with pytest.raises(CheckpointError, match="other data"):
+        run_chain(lik, checkpoint=ck, resume=True, fingerprint="other", **kw)
+
+
+def test_same_seed_same_chain_whatever_the_executor(coated, data):
+    from dask.distributed import Client, LocalCluster
+
+    lik = _small(coated, data, 20)
+    kw = dict(walkers=8, seed=3, max_steps=30, check_every=15, starts=1)
+    ref = run_fit(lik, executor=SerialExecutor(), **kw)
+    with ProcessExecutor(2) as ex:
+        procs = run_fit(lik, executor=ex, **kw)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with Client(cluster) as client, DaskExecutor(client) as ex:
+            assert ex.workers == 2
+            dask = run_fit(lik, executor=ex, **kw)
+        with DaskExecutor(cluster.scheduler_address) as ex:  # the --scheduler ADDRESS path
+            assert ex.map(abs, [-3, 1, -2]) == [3, 1, 2]
+    assert np.array_equal(ref.chain.chain, procs.chain.chain)
+    assert np.array_equal(ref.chain.chain, dask.chain.chain)
+    assert np.array_equal(ref.chain.log_prob, dask.chain.log_prob)
+    other = run_fit(lik, executor=SerialExecutor(), **dict(kw, seed=4))
+    assert not np.array_equal(ref.chain.chain, other.chain.chain)
+
+
+def test_recovers_the_scatmech_sample_within_95_percent(coated, data):
+    """Held-out SCATMECH data: sigma, coating index, n and k inside their 95% intervals.
+
+    A short chain (the full convergent run is the CLI run in the report); noise
+    levels fixed at the values the data were made with.
+    """
+    spec = fitspec_from(
+        coated,
+        ["sigma:0.01:1:log", "coating:1.2:2", "n:0.3:4", "k:3:12"],
+        ["brdf=0.05", "eta_deg=1", "P=0.02", "P_C=0.02"],
+    )
+    res = run_fit(
+        Likelihood(coated, spec, data), walkers=16, seed=11, max_steps=500, check_every=100, starts=2
+    )
+    truth = data.meta["truth"]
+    for key, v in truth.items():
+        p = res.summary["parameters"][key]
+        assert p["p2.5"] <= v <= p["p97.5"], (key, p)
+        lo, hi = p["bounds"]
+        assert p["p97.5"] - p["p2.5"] < 0.25 * (hi - lo)  # the data, not the prior, set the interval
+    s = res.summary["sampling"]
+    assert 0.2 < s["acceptance_mean"] < 0.8 and np.all(np.isfinite(s["tau_steps"]))
+
+
+# ----------------------------------------------------------------------------- CLI
+def test_fit_command_writes_results_refuses_overwrite_and_resumes(tmp_path, capsys):
+    out = str(tmp_path / "fit")
+    args = [
+        "fit", DATA, "--scene", COATED, "--free", "sigma:0.01:1:log", "--noise", "brdf:0.01:0.5:log",
+        "--walkers", "8", "--max-steps", "40", "--check-every", "20", "--starts", "1", "--no-progress",
+        "--out", out,
+    ]  # fmt: skip
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "step budget reached" in text and "evaluations/s" in text and "acceptance" in text
+    for f in ("posterior.json", "chain.npz", "corner.png", "predictive.png", "residuals.png"):
+        assert os.path.getsize(os.path.join(out, f)) > 0
+    post = json.load(open(os.path.join(out, "posterior.json")))
+    p = post["parameters"]["substrate.sigma"]
+    assert p["p2.5"] <= p["p16"] <= p["median"] <= p["p84"] <= p["p97.5"]
+    assert post["sampling"]["steps"] == 40 and post["sampling"]["converged"] is False
+    assert set(post["posterior_predictive"]) == {"brdf"}
+    assert main(args) == 2
+    assert "exists" in capsys.readouterr().err
+    args[args.index("40")] = "60"
+    assert main(args + ["--resume", "--no-plots"]) == 0
+    post = json.load(open(os.path.join(out, "posterior.json")))
+    assert post["sampling"]["steps"] == 60
+    assert (
+        main(["fit", DATA, "--scene", COATED, "--free", "sigma:0.01:1:log", "--out", str(tmp_path / "x")])
+        == 2
+    )
+    assert "noise.brdf" in capsys.readouterr().err

@@ -1,0 +1,192 @@
+"""``scatterbench fit`` (the study commands are in :mod:`validation.cmd_study`).
+
+Output folders are refused when they exist and are not empty, unless
+``--force`` (replace the results; files are replaced atomically, so a failed
+run leaves the previous ones intact) or, for ``fit``, ``--resume`` (continue
+the chain saved in ``DIR/chain.npz``).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+__all__ = ["register"]
+
+
+def _out_ok(out, force, resume=False):
+    if os.path.isdir(out) and os.listdir(out) and not (force or resume):
+        print(
+            f"error: {out} exists and is not empty; use --force to overwrite it"
+            + (" or --resume" if resume is not None else ""),
+            file=sys.stderr,
+        )
+        return False
+    return True
+
+
+def _executor_args(p):
+    p.add_argument("--workers", type=int, default=1, help="local processes (default 1: in-process)")
+    p.add_argument("--scheduler", default=None, help="dask.distributed scheduler ADDRESS (tcp://host:8786)")
+
+
+def _spec_args(p):
+    p.add_argument("--scene", required=True, help="scene TOML file (model, starting values, [fit] table)")
+    p.add_argument(
+        "--free",
+        action="append",
+        default=None,
+        metavar="KEY:LOW:HIGH[:PRIOR]",
+        help="free parameter (repeatable; replaces the scene's [fit] free list), e.g. substrate.sigma:0.01:1:log",
+    )
+    p.add_argument(
+        "--noise",
+        action="append",
+        default=None,
+        metavar="TERM=VALUE|TERM:LOW:HIGH[:PRIOR]",
+        help="noise term brdf (fractional), eta_deg, P, P_C: fixed value or free range",
+    )
+    p.add_argument(
+        "--near-specular-deg", type=float, default=None, help="mask rows within this angle of specular"
+    )
+    p.add_argument(
+        "--exclude",
+        action="append",
+        default=None,
+        metavar="AXIS=LO:HI[,AXIS=LO:HI]",
+        help="mask a box, e.g. theta_r_deg=53:67,phi_r_deg=180:180 (repeatable)",
+    )
+
+
+def _mcmc_args(p, walkers=32, max_steps=20000):
+    p.add_argument("--walkers", type=int, default=walkers)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--max-steps", type=int, default=max_steps, help="step budget")
+    p.add_argument("--check-every", type=int, default=100, help="steps between tau checks and checkpoints")
+    p.add_argument("--tau-factor", type=float, default=50.0, help="stop when steps >= this x tau")
+    p.add_argument("--starts", type=int, default=4, help="least-squares starts for the optimum")
+
+
+def _load(args):
+    from models import scene as scene_mod
+
+    from .datafile import load_data
+    from .fitspec import fitspec_from
+    from .likelihood import Likelihood
+
+    sc = scene_mod.load(args.scene)
+    data = load_data(args.data)
+    spec = fitspec_from(sc, args.free, args.noise, args.near_specular_deg, args.exclude)
+    wl_s, wl_d = sc.wavelength_nm, data.meta.get("wavelength_nm")
+    if wl_s is not None and wl_d is not None and abs(wl_s - wl_d) > 1e-9 * wl_s:
+        raise ValueError(
+            f"wavelength: the data ({wl_d:g} nm, {data.path}) and the scene ({wl_s:g} nm, {sc.path}) differ; "
+            "the scene's optical constants are for its wavelength"
+        )
+    return sc, data, spec, Likelihood(sc, spec, data)
+
+
+def _cmd_fit(args) -> int:
+    from .executors import make_executor
+    from .fit import run_fit, write_fit
+
+    if not _out_ok(args.out, args.force, args.resume):
+        return 2
+    try:
+        sc, data, spec, lik = _load(args)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(sc.describe())
+    print(spec.describe())
+    print(
+        f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
+    )
+    os.makedirs(args.out, exist_ok=True)
+    # The running checkpoint is chain.partial.npz; it becomes chain.npz when the run
+    # ends, so a failed --force run never replaces a previous complete chain.
+    ck = os.path.join(args.out, "chain.partial.npz")
+    final = os.path.join(args.out, "chain.npz")
+    resume_from = ck if os.path.exists(ck) else final
+    t0 = time.perf_counter()
+    with make_executor(args.workers, args.scheduler) as ex:
+        print(f"executor: {ex.describe()}")
+        try:
+            res = run_fit(
+                lik,
+                walkers=args.walkers,
+                seed=args.seed,
+                max_steps=args.max_steps,
+                check_every=args.check_every,
+                tau_factor=args.tau_factor,
+                starts=args.starts,
+                executor=ex,
+                checkpoint=ck,
+                resume=args.resume,
+                resume_from=resume_from,
+                progress=not args.no_progress,
+            )
+        except ValueError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
+        if os.path.exists(ck):
+            os.replace(ck, final)
+        post = write_fit(
+            res,
+            args.out,
+            data_path=args.data,
+            scene_path=args.scene,
+            executor_desc=ex.describe(),
+            plots=not args.no_plots,
+        )
+    s = post["sampling"]
+    print(f"\n{s['stop_reason']}")
+    print(
+        f"walkers {s['walkers']}, steps {s['steps']}, tau (steps) "
+        + ", ".join(f"{t:.1f}" for t in s["tau_steps"])
+        + f"; acceptance {s['acceptance_mean']:.3f} (min {s['acceptance_min']:.3f}); burn-in {s['burn_in']}, thin {s['thin']}"
+    )
+    print(
+        f"sampling time {s['seconds']:.1f} s, {s['log_prob_evaluations']} likelihood evaluations, "
+        f"{s['evaluations_per_second']:.0f} evaluations/s (total {time.perf_counter() - t0:.1f} s)"
+    )
+    print(
+        f"\n{'parameter':<22} {'2.5%':>10} {'16%':>10} {'50%':>10} {'84%':>10} {'97.5%':>10}"
+        + ("  truth" if "truth_check" in post else "")
+    )
+    for k, p in post["parameters"].items():
+        line = f"{k:<22} {p['p2.5']:>10.5g} {p['p16']:>10.5g} {p['p50']:>10.5g} {p['p84']:>10.5g} {p['p97.5']:>10.5g}"
+        tc = post.get("truth_check", {}).get(k)
+        if tc:
+            line += f"  {tc['true']:g} ({'inside' if tc['inside_95'] else 'OUTSIDE'} 95%, {'inside' if tc['inside_68'] else 'outside'} 68%)"
+        print(line)
+    ic = post["information_criteria"]
+    print(f"max ln L {ic['max_log_likelihood']:.2f}, AIC {ic['AIC']:.2f}, BIC {ic['BIC']:.2f}")
+    for t, c in post["posterior_predictive"].items():
+        print(
+            f"predictive check {t}: {c['inside_68']:.2f} of rows inside 68%, {c['inside_95']:.2f} inside 95%"
+        )
+    print(
+        f"wrote {args.out}/posterior.json, chain.npz"
+        + ("" if args.no_plots else ", corner.png, predictive.png, residuals.png")
+    )
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser("fit", help="emcee posterior of a scene's free parameters given a data file")
+    p.add_argument("data", help="data CSV (see validation/datafile.py; JSON sidecar beside it)")
+    _spec_args(p)
+    p.add_argument(
+        "--out", required=True, help="output folder (refused if it exists, unless --force/--resume)"
+    )
+    _mcmc_args(p)
+    _executor_args(p)
+    p.add_argument("--force", action="store_true", help="overwrite an existing output folder")
+    p.add_argument(
+        "--resume", action="store_true", help="continue the chain in OUT/chain.npz (same settings)"
+    )
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-plots", action="store_true")
+    p.set_defaults(func=_cmd_fit)

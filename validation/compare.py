@@ -1,0 +1,82 @@
+"""Model comparison on the same data: several scenes fitted, then ranked.
+
+For every scene: the maximum log-likelihood (best of the optimum and the
+chain), AIC ``= 2k - 2 ln L_max``, BIC ``= k ln N - 2 ln L_max``, WAIC
+(Watanabe; ``-2 (lppd - p_waic)`` from the per-row log-likelihood over
+posterior draws) and the posterior-predictive coverage of the rows (the
+fraction inside the 68% / 95% predictive intervals).  Lower AIC/BIC/WAIC is
+better; the table gives the differences from the best.  Scenes must use the
+same rows (same masks) or the numbers are not comparable, so that is checked.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.special import logsumexp
+
+from .fit import predictive, predictive_checks, run_fit
+
+__all__ = ["waic", "compare_fits", "format_comparison"]
+
+
+def waic(fit, n_draws=200, seed=0):
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 5]))
+    s = fit.chain.samples()
+    pick = rng.choice(len(s), size=min(n_draws, len(s)), replace=False)
+    ll = np.array([fit.lik.pointwise(u) for u in s[pick]])  # (draws, rows)
+    lppd = float(np.sum(logsumexp(ll, axis=0) - math.log(len(pick))))
+    p = float(np.sum(np.var(ll, axis=0, ddof=1)))
+    return {"WAIC": -2 * (lppd - p), "lppd": lppd, "p_waic": p}
+
+
+def compare_fits(liks, names, *, executor=None, **fit_kwargs):
+    """Fit every likelihood (same data, same used rows); return rows of the comparison."""
+    masks = [lk.mask for lk in liks]
+    for nm, m in zip(names[1:], masks[1:], strict=True):
+        if not np.array_equal(m, masks[0]):
+            raise ValueError(
+                f"scene {nm}: its mask uses other rows than {names[0]}'s; compare on the same rows"
+            )
+    rows = []
+    fits = []
+    for nm, lik in zip(names, liks, strict=True):
+        f = run_fit(lik, executor=executor, **fit_kwargs)
+        fits.append(f)
+        k, n = len(lik.spec.free), lik.n_points
+        ll_chain = float(np.max(f.chain.log_prob))  # flat prior inside bounds: log posterior = ln L + 0
+        ll = max(f.optimum["log_likelihood"], ll_chain)
+        pp = predictive(f, seed=fit_kwargs.get("seed", 0))
+        rows.append(
+            {
+                "scene": nm,
+                "k": k,
+                "n": n,
+                "max_log_likelihood": ll,
+                "AIC": 2 * k - 2 * ll,
+                "BIC": k * math.log(n) - 2 * ll,
+                **waic(f, seed=fit_kwargs.get("seed", 0)),
+                "predictive": predictive_checks(f, pp),
+                "tau_max": float(np.max(f.chain.tau)),
+                "acceptance": float(f.chain.acceptance.mean()),
+                "stop_reason": f.chain.stop_reason,
+                "medians": {kk: v["median"] for kk, v in f.summary["parameters"].items()},
+            }
+        )
+    for key in ("AIC", "BIC", "WAIC"):
+        best = min(r[key] for r in rows)
+        for r in rows:
+            r[f"d{key}"] = r[key] - best
+    return rows, fits
+
+
+def format_comparison(rows) -> str:
+    lines = [f"{'scene':<40} {'k':>2} {'ln L_max':>10} {'dAIC':>8} {'dBIC':>8} {'dWAIC':>8}  brdf in 68%/95%"]
+    for r in rows:
+        pc = r["predictive"].get("brdf", {})
+        lines.append(
+            f"{r['scene'][:40]:<40} {r['k']:>2} {r['max_log_likelihood']:>10.2f} {r['dAIC']:>8.2f} {r['dBIC']:>8.2f} "
+            f"{r['dWAIC']:>8.2f}  {pc.get('inside_68', float('nan')):.2f}/{pc.get('inside_95', float('nan')):.2f}"
+        )
+    return "\n".join(lines)

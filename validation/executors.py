@@ -1,0 +1,135 @@
+"""Executors: where likelihood evaluations and study members run.
+
+Every executor has ``map(fn, items) -> list`` (results in the order of
+``items``, as emcee's ``pool`` expects) and ``close()``.  Work is cut into one
+contiguous chunk per worker, so each call ships the function once per worker.
+Randomness never happens inside a mapped call (the sampler's random draws stay
+in the calling process), so results are identical whatever the executor.
+
+* :class:`SerialExecutor`: in-process (``--workers 1``).
+* :class:`ProcessExecutor`: local processes (``--workers N``), ``concurrent.futures``.
+* :class:`DaskExecutor`: a ``dask.distributed`` cluster (``--scheduler ADDRESS``,
+  or a ``Client``/``LocalCluster`` object in tests).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import hashlib
+import multiprocessing
+import pickle
+
+__all__ = ["SerialExecutor", "ProcessExecutor", "DaskExecutor", "make_executor"]
+
+
+def _chunks(items, n):
+    items = list(items)
+    k, r = divmod(len(items), n)
+    out, start = [], 0
+    for i in range(n):
+        stop = start + k + (1 if i < r else 0)
+        if stop > start:
+            out.append(items[start:stop])
+        start = stop
+    return out
+
+
+def _run_chunk(fn, chunk):
+    return [fn(x) for x in chunk]
+
+
+_WORKER_FNS: dict = {}
+
+
+def _run_pickled_chunk(key, blob, chunk):
+    """Worker side: unpickle the function once per worker process and reuse it."""
+    fn = _WORKER_FNS.get(key)
+    if fn is None:
+        _WORKER_FNS.clear()
+        fn = _WORKER_FNS[key] = pickle.loads(blob)
+    return [fn(x) for x in chunk]
+
+
+class SerialExecutor:
+    workers = 1
+    kind = "serial"
+
+    def map(self, fn, items):
+        return [fn(x) for x in items]
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def describe(self):
+        return "serial (in-process)"
+
+
+class ProcessExecutor(SerialExecutor):
+    kind = "processes"
+
+    def __init__(self, workers: int):
+        if not isinstance(workers, int) or workers < 1:
+            raise ValueError(f"workers must be an integer >= 1; got {workers!r}")
+        self.workers = workers
+        # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
+        self._fn = self._blob = self._key = None
+        self._pool = cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+
+    def map(self, fn, items):
+        # The function (e.g. a likelihood holding the data) is pickled once per
+        # distinct function object, not once per call; workers unpickle it once.
+        if self._fn is not fn:
+            blob = pickle.dumps(fn)
+            self._fn, self._blob, self._key = fn, blob, hashlib.sha1(blob).hexdigest()
+        futs = [
+            self._pool.submit(_run_pickled_chunk, self._key, self._blob, c)
+            for c in _chunks(items, self.workers)
+        ]
+        return [y for f in futs for y in f.result()]
+
+    def close(self):
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+    def describe(self):
+        return f"{self.workers} local processes"
+
+
+class DaskExecutor(SerialExecutor):
+    kind = "dask"
+
+    def __init__(self, address_or_client):
+        from dask.distributed import Client
+
+        if isinstance(address_or_client, Client):
+            self.client, self._own = address_or_client, False
+        else:
+            self.client, self._own = Client(address_or_client), True
+        self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+
+    def map(self, fn, items):
+        chunks = _chunks(items, self.workers)
+        # pure=False: every call runs (no result caching across identical inputs)
+        futs = [self.client.submit(_run_chunk, fn, c, pure=False) for c in chunks]
+        return [y for part in self.client.gather(futs) for y in part]
+
+    def close(self):
+        if self._own:
+            self.client.close()
+
+    def describe(self):
+        return f"dask.distributed at {self.client.scheduler.address} ({self.workers} workers)"
+
+
+def make_executor(workers: int = 1, scheduler: str | None = None):
+    """``--workers N`` / ``--scheduler ADDRESS`` -> an executor."""
+    if scheduler:
+        return DaskExecutor(scheduler)
+    if workers == 1:
+        return SerialExecutor()
+    return ProcessExecutor(workers)

@@ -1,0 +1,314 @@
+"""A fit from data file + scene + spec to a posterior: optimum, chain, summary, checks, plots.
+
+``run_fit`` does the work (no files except the checkpoint); ``write_fit`` writes
+``posterior.json``, ``chain.npz`` (the resumable checkpoint: chain, log
+posterior, acceptance counts, last ensemble and the sampler's random state) and
+the plots ``corner.png``, ``predictive.png``, ``residuals.png``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from .likelihood import Likelihood
+from .sampling import ChainResult, initial_ball, optimize, run_chain, summarize
+
+__all__ = ["FitResult", "run_fit", "predictive", "write_fit", "fingerprint"]
+
+
+@dataclass
+class FitResult:
+    lik: Likelihood
+    optimum: dict
+    chain: ChainResult
+    summary: dict
+    settings: dict
+
+    @property
+    def spec(self):
+        return self.lik.spec
+
+
+def fingerprint(lik, settings) -> str:
+    h = hashlib.sha256()
+    d = lik.data_all
+    for a in (d.theta_i, d.theta_r, d.phi_r, d.brdf, d.incident):
+        h.update(np.ascontiguousarray(a).tobytes())
+    for a in (d.eta, d.P, d.P_C, d.brdf_err):
+        if a is not None:
+            h.update(np.ascontiguousarray(a).tobytes())
+    h.update(json.dumps(lik.scene.raw, sort_keys=True, default=str).encode())
+    h.update(json.dumps(lik.spec.as_dict(), sort_keys=True).encode())
+    keep = {k: settings[k] for k in ("walkers", "seed", "check_every", "tau_factor", "tau_rtol", "starts")}
+    h.update(json.dumps(keep, sort_keys=True).encode())
+    return h.hexdigest()
+
+
+def run_fit(
+    lik: Likelihood,
+    *,
+    walkers=32,
+    seed=0,
+    max_steps=20000,
+    check_every=100,
+    tau_factor=50.0,
+    tau_rtol=0.05,
+    starts=4,
+    executor=None,
+    checkpoint=None,
+    resume=False,
+    progress=False,
+    resume_from=None,
+):
+    ndim = len(lik.spec.free)
+    if walkers < 2 * ndim or walkers % 2:
+        raise ValueError(f"walkers must be even and >= 2 x free parameters ({2 * ndim}); got {walkers}")
+    settings = dict(
+        walkers=walkers,
+        seed=seed,
+        max_steps=max_steps,
+        check_every=check_every,
+        tau_factor=tau_factor,
+        tau_rtol=tau_rtol,
+        starts=starts,
+    )
+    fp = fingerprint(lik, settings)
+    u_opt, lp_opt, info = optimize(lik, seed, n_starts=starts)
+    p0 = None if resume else initial_ball(u_opt, walkers, seed, lik.spec.u_bounds(), sd=info["sd_u"])
+    chain = run_chain(
+        lik,
+        p0=p0,
+        seed=seed,
+        max_steps=max_steps,
+        check_every=check_every,
+        tau_factor=tau_factor,
+        tau_rtol=tau_rtol,
+        executor=executor,
+        checkpoint=checkpoint,
+        resume=resume,
+        resume_from=resume_from,
+        fingerprint=fp,
+        progress=progress,
+    )
+    optimum = {
+        "values": lik.spec.physical(u_opt),
+        "log_posterior": lp_opt,
+        "log_likelihood": lik.loglike(u_opt),
+        "starts": info["starts"],
+    }
+    return FitResult(lik, optimum, chain, summarize(chain, lik.spec), settings)
+
+
+def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
+    """Posterior-predictive draws at the rows of ``data`` (default: every row of the file).
+
+    Returns ``{term: {"model": (n_draws, N), "replicated": (n_draws, N)}}`` with
+    ``term`` in brdf, eta, P, P_C (eta in radians) and the replicated data drawn
+    with the likelihood's noise model, plus the used-row mask.
+    """
+    lik = fit.lik
+    data = lik.data_all if data is None else data
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 3]))
+    samples = fit.chain.samples()
+    pick = rng.choice(len(samples), size=min(n_draws, len(samples)), replace=False)
+    out = {t: {"model": [], "replicated": []} for t in ("brdf", "eta", "P", "P_C")}
+    for u in samples[pick]:
+        values = lik.spec.physical(u)
+        noise = lik.spec.noise_values(values)
+        pred = lik.predict(lik.model(values), data)
+        f = noise.get("brdf", 0.0)
+        rel = 0.0 if data.brdf_err is None else (data.brdf_err / data.brdf) ** 2
+        sd = {
+            "brdf": np.sqrt(f * f + rel),
+            "eta": np.sqrt(
+                math.radians(noise.get("eta_deg", 0.0)) ** 2
+                + (0 if data.eta_err is None else data.eta_err**2)
+            ),
+            "P": np.sqrt(noise.get("P", 0.0) ** 2 + (0 if data.P_err is None else data.P_err**2)),
+            "P_C": np.sqrt(noise.get("P_C", 0.0) ** 2 + (0 if data.P_C_err is None else data.P_C_err**2)),
+        }
+        n = len(data)
+        for t in out:
+            m = pred[t]
+            z = rng.standard_normal(n)
+            rep = m * np.exp(sd[t] * z) if t == "brdf" else m + sd[t] * z
+            if t == "eta":
+                rep = 0.5 * np.angle(np.exp(2j * rep))
+            out[t]["model"].append(m)
+            out[t]["replicated"].append(rep)
+    res = {t: {k: np.array(v) for k, v in d.items()} for t, d in out.items()}
+    res["mask"] = lik.spec.mask(data)
+    return res
+
+
+def _observed(data, term):
+    return {"brdf": data.brdf, "eta": data.eta, "P": data.P, "P_C": data.P_C}[term]
+
+
+def predictive_checks(fit: FitResult, pp) -> dict:
+    """Fraction of used rows inside the 68% / 95% posterior-predictive intervals, per term."""
+    data = fit.lik.data_all
+    mask = pp["mask"]
+    out = {}
+    for t in fit.lik.terms:
+        obs = _observed(data, t)[mask]
+        rep = pp[t]["replicated"][:, mask]
+        if t == "eta":  # compare on the axis: centre the replicates on the observation
+            rep = obs + 0.5 * np.angle(np.exp(2j * (rep - obs)))
+        lo68, hi68, lo95, hi95 = np.percentile(rep, [16, 84, 2.5, 97.5], axis=0)
+        out[t] = {
+            "inside_68": float(np.mean((obs >= lo68) & (obs <= hi68))),
+            "inside_95": float(np.mean((obs >= lo95) & (obs <= hi95))),
+            "rows": int(mask.sum()),
+        }
+    return out
+
+
+def _scan_x(data):
+    """x coordinate for plots: signed theta_r (deg) in-plane, phi_r (deg) + 200 out-of-plane."""
+    ti, tr, pr = np.degrees(data.theta_i), np.degrees(data.theta_r), np.degrees(data.phi_r)
+    inplane = np.isclose(np.mod(pr, 180.0), 0.0)
+    x = np.where(inplane, np.where(np.isclose(np.mod(pr, 360.0), 180.0), -tr, tr), pr)
+    label = np.where(
+        inplane,
+        [f"in-plane ti={a:g}" for a in ti],
+        [f"out-of-plane ti={a:g} tr={b:g}" for a, b in zip(ti, tr, strict=True)],
+    )
+    return x, label
+
+
+def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", plots=True, n_draws=200):
+    """Write posterior.json and the plots into ``out`` (atomic writes)."""
+    from .atomic import atomic_write_json
+
+    os.makedirs(out, exist_ok=True)
+    pp = predictive(fit, n_draws=n_draws, seed=fit.settings["seed"])
+    checks = predictive_checks(fit, pp)
+    post = dict(fit.summary)
+    truth = fit.lik.data_all.meta.get("truth")
+    if truth:
+        tr = {}
+        for key, v in truth.items():
+            if key in post["parameters"]:
+                p = post["parameters"][key]
+                tr[key] = {
+                    "true": v,
+                    "inside_68": bool(p["p16"] <= v <= p["p84"]),
+                    "inside_95": bool(p["p2.5"] <= v <= p["p97.5"]),
+                    "z": (p["median"] - v) / p["std"] if p["std"] > 0 else None,
+                }
+        post["truth_check"] = tr
+    k = len(fit.spec.free)
+    n = fit.lik.n_points
+    ll = fit.optimum["log_likelihood"]
+    post.update(
+        {
+            "data": {
+                "path": data_path,
+                "rows": len(fit.lik.data_all),
+                "used_rows": n,
+                "terms": list(fit.lik.terms),
+            },
+            "scene": {"path": scene_path, "name": fit.lik.scene.name},
+            "spec": fit.spec.as_dict(),
+            "optimum": fit.optimum,
+            "information_criteria": {
+                "max_log_likelihood": ll,
+                "k": k,
+                "n": n,
+                "AIC": 2 * k - 2 * ll,
+                "BIC": k * math.log(n) - 2 * ll,
+            },
+            "posterior_predictive": checks,
+            "settings": dict(fit.settings, executor=executor_desc),
+        }
+    )
+    atomic_write_json(os.path.join(out, "posterior.json"), post)
+    if plots:
+        _plots(fit, pp, out)
+    return post
+
+
+def _plots(fit, pp, out):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import corner
+    import matplotlib.pyplot as plt
+
+    from .atomic import atomic_savefig
+
+    spec = fit.spec
+    u = fit.chain.samples()
+    x = np.column_stack([p.from_u(u[:, i]) for i, p in enumerate(spec.free)])
+    truth = fit.lik.data_all.meta.get("truth") or {}
+    truths = [truth.get(p.key) for p in spec.free]
+    fig = corner.corner(
+        x,
+        labels=spec.names,
+        truths=truths if any(t is not None for t in truths) else None,
+        quantiles=[0.025, 0.16, 0.5, 0.84, 0.975],
+        title_quantiles=[0.16, 0.5, 0.84],
+        show_titles=True,
+        title_fmt=".4g",
+    )
+    atomic_savefig(fig, os.path.join(out, "corner.png"), dpi=80)
+    plt.close(fig)
+
+    data = fit.lik.data_all
+    xs, labels = _scan_x(data)
+    groups = list(dict.fromkeys(labels))
+    terms = [t for t in ("brdf", "eta", "P", "P_C") if _observed(data, t) is not None]
+    fig, axes = plt.subplots(
+        len(terms), len(groups), figsize=(4.2 * len(groups), 2.8 * len(terms)), squeeze=False
+    )
+    mask = pp["mask"]
+    for j, g in enumerate(groups):
+        sel = labels == g
+        order = np.argsort(xs[sel])
+        xg = xs[sel][order]
+        for i, t in enumerate(terms):
+            ax = axes[i, j]
+            scale = 180 / math.pi if t == "eta" else 1.0
+            obs = _observed(data, t)[sel][order] * scale
+            for key, alpha in (("replicated", 0.2), ("model", 0.45)):
+                arr = pp[t][key][:, sel][:, order] * scale
+                lo, hi = np.percentile(arr, [2.5, 97.5], axis=0)
+                ax.fill_between(xg, lo, hi, alpha=alpha, lw=0, label=f"{key} 95%")
+            used = mask[sel][order]
+            ax.plot(xg[used], obs[used], "k.", ms=3, label="data")
+            ax.plot(xg[~used], obs[~used], "x", color="grey", ms=3, label="masked")
+            if t == "brdf":
+                ax.set_yscale("log")
+            ax.set_ylabel({"brdf": "BRDF (1/sr)", "eta": "eta (deg)", "P": "P", "P_C": "P_C"}[t])
+            if i == 0:
+                ax.set_title(g, fontsize=9)
+            if i == len(terms) - 1:
+                ax.set_xlabel("signed theta_r (deg)" if g.startswith("in") else "phi_r (deg)")
+    axes[0, 0].legend(fontsize=6)
+    fig.tight_layout()
+    atomic_savefig(fig, os.path.join(out, "predictive.png"), dpi=80)
+    plt.close(fig)
+
+    # whitened residuals at the posterior median
+    lik = fit.lik
+    med = np.array([p.to_u(fit.summary["parameters"][p.key]["median"]) for p in spec.free])
+    w = lik.whitened(med)
+    fig, ax = plt.subplots(figsize=(8, 3))
+    start = 0
+    for t in lik.terms:
+        ax.plot(np.arange(start, start + lik.n_points), w[start : start + lik.n_points], ".", ms=3, label=t)
+        start += lik.n_points
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_xlabel("used row (per term)")
+    ax.set_ylabel("residual / sigma at median")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    atomic_savefig(fig, os.path.join(out, "residuals.png"), dpi=80)
+    plt.close(fig)

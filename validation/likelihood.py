@@ -1,0 +1,155 @@
+"""Likelihood of polarized BRDF data given a scene and a fit spec.
+
+* BRDF: Gaussian in ``ln BRDF``.  Each row's variance is ``f^2 + (brdf_err /
+  brdf)^2`` with ``f`` the fractional (speckle) noise ``noise.brdf`` (fixed or
+  free).  Speckle is multiplicative, so a log-normal model fits it; the
+  ``brdf_err`` column adds the instrument's own relative error.
+* Principal angle ``eta``: Gaussian in the residual wrapped to (-90, 90] deg
+  (eta is an axis, defined modulo 180 deg), variance ``s_eta^2 + eta_err^2``.
+* ``P`` and ``P_C``: Gaussian, variance ``s^2 + err^2``.
+
+A polarization term is used when the data have the quantity and a noise level
+for it (``noise.eta_deg``, ``noise.P``, ``noise.P_C``, fixed or free) or the
+matching ``*_err`` column; :attr:`Likelihood.terms` lists what is used.  Rows
+removed by the spec's mask do not enter.  A model that predicts no light at a
+used row (unreachable geometry) has likelihood zero there.
+
+The log-likelihood omits the data-only Jacobian ``-sum ln brdf_obs`` (a
+constant for given data, the same for every model compared on them).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from models.polarization import ellipsometric
+
+from .fitspec import FitSpec
+
+__all__ = ["Likelihood"]
+
+_LOG2PI = math.log(2.0 * math.pi)
+
+
+class Likelihood:
+    """``L(u)``: the log posterior in the spec's sampling coordinates is ``self(u)``."""
+
+    def __init__(self, scene, spec: FitSpec, data):
+        self.scene = scene
+        self.spec = spec
+        self.data_all = data
+        self.mask = spec.mask(data)
+        if not self.mask.any():
+            raise ValueError("mask: every data row is masked out; nothing to fit")
+        self.data = data.subset(self.mask)
+        d = self.data
+        self._rel_err2 = None if d.brdf_err is None else (d.brdf_err / d.brdf) ** 2
+        self._log_obs = np.log(d.brdf)
+        self._same_incident = bool(np.all(d.incident == d.incident[0]))
+        free_noise = {p.key[6:] for p in spec.free if p.is_noise}
+        have = lambda t: t in spec.noise or t in free_noise  # noqa: E731
+        terms = ["brdf"]
+        if not (have("brdf") or d.brdf_err is not None):
+            raise ValueError(
+                "noise.brdf: the BRDF term needs a noise level (fixed or free: --noise brdf=0.05 or "
+                "--noise brdf:0.005:1:log) or a brdf_err column"
+            )
+        if d.eta is not None and (have("eta_deg") or d.eta_err is not None):
+            terms.append("eta")
+        if d.P is not None and (have("P") or d.P_err is not None):
+            terms.append("P")
+        if d.P_C is not None and (have("P_C") or d.P_C_err is not None):
+            terms.append("P_C")
+        self.terms = tuple(terms)
+        self.n_points = len(d)
+
+    # -- model ---------------------------------------------------------------------
+    def model(self, values: dict):
+        return self.scene.with_values(self.spec.scene_values(values)).build()
+
+    def predict(self, model, data=None) -> dict:
+        """Model ``brdf, eta, P, P_C`` at the rows of ``data`` (default: the fitted rows)."""
+        d = self.data if data is None else data
+        M = model.mueller(d.theta_i, d.theta_r, d.phi_r)
+        if self._same_incident and data is None:
+            S = M @ d.incident[0]
+        else:
+            S = np.einsum("nij,nj->ni", M, d.incident)
+        i, eta, pc, p = ellipsometric(S)
+        return {"brdf": i / d.incident[:, 0], "eta": eta, "P": p, "P_C": pc}
+
+    # -- likelihood ----------------------------------------------------------------
+    def _variances(self, noise):
+        d = self.data
+        out = {}
+        f = noise.get("brdf", 0.0)
+        out["brdf"] = f * f + (0.0 if self._rel_err2 is None else self._rel_err2)
+        if "eta" in self.terms:
+            s = math.radians(noise.get("eta_deg", 0.0))
+            out["eta"] = s * s + (0.0 if d.eta_err is None else d.eta_err**2)
+        if "P" in self.terms:
+            s = noise.get("P", 0.0)
+            out["P"] = s * s + (0.0 if d.P_err is None else d.P_err**2)
+        if "P_C" in self.terms:
+            s = noise.get("P_C", 0.0)
+            out["P_C"] = s * s + (0.0 if d.P_C_err is None else d.P_C_err**2)
+        return out
+
+    def residuals(self, pred) -> dict:
+        """Raw residuals (data - model) per term; ln BRDF for the BRDF, radians for eta."""
+        d = self.data
+        out = {}
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out["brdf"] = self._log_obs - np.log(pred["brdf"])
+        if "eta" in self.terms:
+            out["eta"] = 0.5 * np.angle(np.exp(2j * (d.eta - pred["eta"])))  # wrap to (-90, 90] deg
+        if "P" in self.terms:
+            out["P"] = d.P - pred["P"]
+        if "P_C" in self.terms:
+            out["P_C"] = d.P_C - pred["P_C"]
+        return out
+
+    def pointwise(self, u) -> np.ndarray:
+        """Per-row log-likelihood (all terms summed per row), ``-inf`` where impossible."""
+        values = self.spec.physical(u)
+        noise = self.spec.noise_values(values)
+        pred = self.predict(self.model(values))
+        res = self.residuals(pred)
+        var = self._variances(noise)
+        total = np.zeros(self.n_points)
+        for t in self.terms:
+            v = np.broadcast_to(var[t], total.shape)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ll = -0.5 * (res[t] ** 2 / v + _LOG2PI + np.log(v))
+            total += np.where(np.isfinite(ll), ll, -np.inf)
+        return total
+
+    def whitened(self, u) -> np.ndarray:
+        """Residuals divided by their standard deviations (for least squares); large
+        finite values where the model predicts no light."""
+        values = self.spec.physical(u)
+        noise = self.spec.noise_values(values)
+        res = self.residuals(self.predict(self.model(values)))
+        var = self._variances(noise)
+        out = []
+        for t in self.terms:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                w = res[t] / np.sqrt(np.broadcast_to(var[t], res[t].shape))
+            out.append(np.where(np.isfinite(w), w, 1e3))
+        return np.concatenate(out)
+
+    def loglike(self, u) -> float:
+        return float(np.sum(self.pointwise(u)))
+
+    def __call__(self, u) -> float:
+        lp = self.spec.log_prior(u)
+        if not math.isfinite(lp):
+            return -math.inf
+        try:
+            ll = self.loglike(u)
+        except ValueError:
+            # a parameter combination the model rejects (outside its declared range)
+            return -math.inf
+        return lp + ll if math.isfinite(ll) else -math.inf
