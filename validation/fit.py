@@ -19,7 +19,15 @@ import numpy as np
 from .likelihood import Likelihood
 from .sampling import ChainResult, initial_ball, optimize, run_chain, summarize
 
-__all__ = ["FitResult", "run_fit", "predictive", "write_fit", "fingerprint"]
+__all__ = [
+    "FitResult",
+    "run_fit",
+    "predictive",
+    "write_fit",
+    "fingerprint",
+    "corner_figure",
+    "predictive_figure",
+]
 
 
 @dataclass
@@ -235,21 +243,19 @@ def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", p
     return post
 
 
-def _plots(fit, pp, out):
+def corner_figure(fit: FitResult):
+    """Corner plot of the posterior (physical units), truths from the data's sidecar if any."""
     import matplotlib
 
     matplotlib.use("Agg")
     import corner
-    import matplotlib.pyplot as plt
-
-    from .atomic import atomic_savefig
 
     spec = fit.spec
     u = fit.chain.samples()
     x = np.column_stack([p.from_u(u[:, i]) for i, p in enumerate(spec.free)])
     truth = fit.lik.data_all.meta.get("truth") or {}
     truths = [truth.get(p.key) for p in spec.free]
-    fig = corner.corner(
+    return corner.corner(
         x,
         labels=spec.names,
         truths=truths if any(t is not None for t in truths) else None,
@@ -258,8 +264,14 @@ def _plots(fit, pp, out):
         show_titles=True,
         title_fmt=".4g",
     )
-    atomic_savefig(fig, os.path.join(out, "corner.png"), dpi=80)
-    plt.close(fig)
+
+
+def predictive_figure(fit: FitResult, pp):
+    """Posterior-predictive 95% bands (model and replicated data) with the data, per scan and term."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
 
     data = fit.lik.data_all
     xs, labels = _scan_x(data)
@@ -293,6 +305,23 @@ def _plots(fit, pp, out):
                 ax.set_xlabel("signed theta_r (deg)" if g.startswith("in") else "phi_r (deg)")
     axes[0, 0].legend(fontsize=6)
     fig.tight_layout()
+    return fig
+
+
+def _plots(fit, pp, out):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .atomic import atomic_savefig
+
+    spec = fit.spec
+    fig = corner_figure(fit)
+    atomic_savefig(fig, os.path.join(out, "corner.png"), dpi=80)
+    plt.close(fig)
+
+    fig = predictive_figure(fit, pp)
     atomic_savefig(fig, os.path.join(out, "predictive.png"), dpi=80)
     plt.close(fig)
 

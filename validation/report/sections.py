@@ -548,6 +548,13 @@ def section_provenance(ctx):
     return s
 
 
+from .sections_papers import (  # noqa: E402  (issue 7: the papers' figures, uncertainty)
+    section_seed001,
+    section_seed003_fig1,
+    section_seed003_presets,
+    section_uncertainty,
+)
+
 #: in page order; ``summary`` is computed last (it collects the others' checks)
 SECTION_FUNCS = [
     section_summary,
@@ -555,6 +562,10 @@ SECTION_FUNCS = [
     section_seed000,
     section_conservation,
     section_scatmech,
+    section_seed003_fig1,
+    section_seed003_presets,
+    section_seed001,
+    section_uncertainty,
     section_speed,
     section_stability,
     section_scenes,
