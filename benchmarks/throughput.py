@@ -47,8 +47,15 @@ print(json.dumps({"n": N, "seconds": dt, "us": dt / N * 1e6, "rss_mb": rss}))
 
 
 def run(name, n, what):
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.dirname(os.path.dirname(os.path.abspath(__file__))), os.environ.get("PYTHONPATH", "")]))
-    r = subprocess.run([sys.executable, "-c", CHILD, name, str(n), what], capture_output=True, text=True, env=env)
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join(
+            [os.path.dirname(os.path.dirname(os.path.abspath(__file__))), os.environ.get("PYTHONPATH", "")]
+        ),
+    )
+    r = subprocess.run(
+        [sys.executable, "-c", CHILD, name, str(n), what], capture_output=True, text=True, env=env
+    )
     if r.returncode != 0:
         raise RuntimeError(r.stderr)
     return json.loads(r.stdout)
