@@ -212,8 +212,64 @@ class Scene:
                 )
             )
         if self.volume is not None:
-            raise SceneError(
-                f"{self.path}: [volume]: volume scattering models are not available in this build"
+            out = self._volume_mechanisms(out, coat_n, rough_top)
+        return out
+
+    def _volume_mechanisms(self, out, n, rough_top):
+        """Seed 003: volume scattering in the binder (index = the coating's)."""
+        from .diffuse_subsurface import DiffuseSubsurfaceBRDF
+        from .phase import HenyeyGreenstein
+        from .rough_diffuse import RoughDiffuseBRDF
+        from .single_scatter import SingleScatterBRDF
+
+        v = self.volume
+        phase = HenyeyGreenstein(g=v["g"], polarized=v["polarized"])
+        if rough_top is not None and v["interface"] == "rough":
+            # The Monte Carlo model carries the direct reflection by the rough surface
+            # (surface=True), so the separate rough-surface facet term is replaced.
+            out = [m for m in out if m.name != "rough coating surface"]
+            out.append(
+                Mechanism(
+                    "volume under a rough interface (Monte Carlo)",
+                    RoughDiffuseBRDF(
+                        slopes=rough_top,
+                        n=n,
+                        phase=phase,
+                        rho=v["rho"],
+                        pairs=v["pairs"],
+                        seed=v["seed"],
+                        surface=True,
+                        single=v["single_weight"] if v["single"] else 0.0,
+                    ),
+                    "a volume scatterer under a rough interface: seed 003 Sec. 2.5 Monte Carlo (two facets "
+                    "per path), including the direct reflection by the rough surface",
+                )
+            )
+            return out
+        why = (
+            "under a smooth interface"
+            if rough_top is None
+            else (
+                "treated as under a smooth interface, as seed 003 does for the red paint (interface = 'smooth')"
+            )
+        )
+        if v["single"]:
+            out.append(
+                Mechanism(
+                    "single volume scattering",
+                    v["single_weight"] * SingleScatterBRDF(n=n, phase=phase)
+                    if v["single_weight"] != 1.0
+                    else SingleScatterBRDF(n=n, phase=phase),
+                    f"single scattering by the pigment {why} (seed 003 Eq. 8-20); no Monte Carlo needed",
+                )
+            )
+        if v["rho"] > 0:
+            out.append(
+                Mechanism(
+                    "totally diffuse volume",
+                    DiffuseSubsurfaceBRDF(n=n, rho=v["rho"]),
+                    f"multiply scattered light {why} (seed 003 Eq. 21-28)",
+                )
             )
         return out
 
@@ -368,6 +424,48 @@ def _cook_torrance(path, s):
     return out
 
 
+_VOLUME_KEYS = {"rho", "single", "single_weight", "g", "polarized", "interface", "pairs", "seed"}
+
+
+def _volume(path, v, coating):
+    """``[volume]``: a pigment in the binder (seed 003).  The binder's index is the
+    coating's, so a ``[coating]`` table is required."""
+    if not isinstance(v, dict):
+        raise _err(path, "[volume]", "must be a table")
+    _unknown(path, "[volume] ", v, _VOLUME_KEYS)
+    if coating is None:
+        raise _err(path, "[volume]", "needs a [coating] table: its index is the binder's index")
+    out = {
+        "rho": _number(path, "[volume] rho", v.get("rho", 0.0), 0.0, 1.0),
+        "g": _number(path, "[volume] g", v.get("g", 0.0), -0.999999, 0.999999),
+        "single_weight": _number(path, "[volume] single_weight", v.get("single_weight", 1.0), 0.0),
+    }
+    for key, default in (("single", True), ("polarized", True)):
+        val = v.get(key, default)
+        if not isinstance(val, bool):
+            raise _err(path, f"[volume] {key}", f"must be true or false; got {val!r}")
+        out[key] = val
+    interface = v.get("interface", "rough")
+    if interface not in ("rough", "smooth"):
+        raise _err(
+            path,
+            "[volume] interface",
+            f"must be 'rough' (Monte Carlo under a rough coating) or 'smooth'; got {interface!r}",
+        )
+    out["interface"] = interface
+    pairs = v.get("pairs", 5000)
+    if isinstance(pairs, bool) or not isinstance(pairs, int) or not 2 <= pairs <= 10**7:
+        raise _err(path, "[volume] pairs", f"must be an integer in [2, 10^7]; got {pairs!r}")
+    out["pairs"] = pairs
+    seed = v.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise _err(path, "[volume] seed", f"must be an integer >= 0; got {seed!r}")
+    out["seed"] = seed
+    if out["rho"] == 0 and not out["single"]:
+        raise _err(path, "[volume]", "declares no scattering: set rho > 0 or single = true")
+    return out
+
+
 def loads(text: str, path: str = "<scene>") -> Scene:
     """Parse and validate scene TOML text."""
     try:
@@ -441,7 +539,9 @@ def from_dict(data: dict, path: str = "<scene>") -> Scene:
                 if k in s:
                     raise _err(path, f"[substrate] {k}", "only for model = 'cook-torrance'")
             substrate["slopes"] = _distribution(path, "[substrate] ", s) if "distribution" in s else None
-    volume = data.get("volume")
+    volume = None
+    if "volume" in data:
+        volume = _volume(path, data["volume"], coating)
     detector = data.get("detector")
     if detector is not None:
         _unknown(path, "[detector] ", detector, {"aperture_deg"})

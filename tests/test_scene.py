@@ -4,6 +4,7 @@ import csv
 import math
 import os
 
+import numpy as np
 import pytest
 
 import models
@@ -144,3 +145,62 @@ def test_cook_torrance_scene_errors(extra_sub, key):
     with pytest.raises(ValueError) as exc:
         scene.loads(_ct_scene("", extra_sub), "ct.toml")
     assert key in str(exc.value) and str(exc.value).startswith("ct.toml")
+
+
+def _scene(name):
+    return scene.load(os.path.join(os.path.dirname(references.__file__), "scenes", name))
+
+
+def test_volume_scenes_build_only_what_they_declare():
+    white = _scene("glossy_white_paint.toml")
+    assert [type(m.model) for m in white.mechanisms()] == [models.DiffuseSubsurfaceBRDF]
+    red = _scene("red_pigmented_paint.toml")
+    assert [type(m.model) for m in red.mechanisms()] == [
+        models.FacetBRDF,
+        models.SingleScatterBRDF,
+        models.DiffuseSubsurfaceBRDF,
+    ]
+    carc = _scene("green_carc.toml")
+    assert [type(m.model) for m in carc.mechanisms()] == [models.RoughDiffuseBRDF]
+    mc = carc.build()
+    assert mc.surface and mc.pairs == 5000 and mc.slopes.sigma == 2.0 and mc.rho == 0.05 and mc.phase.g == 0.3
+
+
+def test_red_paint_scene_is_the_preset_combination():
+    from references import presets_seed003
+
+    a = _scene("red_pigmented_paint.toml").build()
+    b = presets_seed003.build("red_paint")
+    ti, tr, pr = 1.0, np.linspace(0, 1.4, 9), 0.3
+    np.testing.assert_allclose(a.mueller(ti, tr, pr), b.mueller(ti, tr, pr), rtol=1e-13, atol=0)
+
+
+def test_smooth_scenes_never_call_the_monte_carlo(monkeypatch):
+    def boom(*a, **k):
+        raise AssertionError("Monte Carlo called")
+
+    monkeypatch.setattr(models.RoughDiffuseBRDF, "_estimate", boom)
+    for path in references.scene_paths():
+        sc = scene.load(path)
+        if any(isinstance(m.model, models.RoughDiffuseBRDF) for m in sc.mechanisms()):
+            continue
+        sc.build().mueller(sc.theta_i, np.linspace(0, 1.4, 5), 0.4)
+    with pytest.raises(AssertionError, match="Monte Carlo called"):
+        _scene("green_carc.toml").build().mueller(1.0, 0.5, 0.0)
+
+
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        (BASE + "[volume]\nrho = 0.5\n", "[coating]"),
+        (BASE + "[coating]\nindex = 1.5\n[volume]\nrho = 1.5\n", "[volume] rho"),
+        (BASE + "[coating]\nindex = 1.5\n[volume]\nrho = 0.5\npairs = 1\n", "[volume] pairs"),
+        (BASE + '[coating]\nindex = 1.5\n[volume]\nrho = 0.5\ninterface = "wavy"\n', "[volume] interface"),
+        (BASE + "[coating]\nindex = 1.5\n[volume]\nrho = 0\nsingle = false\n", "no scattering"),
+        (BASE + "[coating]\nindex = 1.5\n[volume]\ncolour = 1\n", "colour"),
+    ],
+)
+def test_volume_errors(text, key):
+    with pytest.raises(ValueError) as exc:
+        scene.loads(text, "v.toml")
+    assert key in str(exc.value) and str(exc.value).startswith("v.toml")

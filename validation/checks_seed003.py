@@ -578,3 +578,8 @@ CHECKS = [
 ]
 
 SECTIONS = [_fig1_section]
+
+# Checks that take tens of seconds: skipped by the --quick report (and said so on its
+# page); `scatterbench validate` and the full report run them.
+for _fn in (check_mc_scaling, check_energy_seed003, check_mc_energy):
+    _fn.slow = True

@@ -106,7 +106,12 @@ def _cmd_scene(args) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     print(sc.describe())
-    csv_path, png_path = write_scene_outputs(sc, args.out)
+    if args.tol is None:
+        csv_path, png_path = write_scene_outputs(sc, args.out)
+    else:
+        csv_path, png_path, notes = write_scene_outputs(sc, args.out, tol=args.tol)
+        for n in notes:
+            print(f"  --tol: {n}")
     print(f"wrote {csv_path} and {png_path}")
     return 0
 
@@ -140,6 +145,12 @@ def main(argv=None) -> int:
     p = sub.add_parser("scene", help="evaluate a scene file: in-plane and out-of-plane scans (CSV + PNG)")
     p.add_argument("file", help="scene TOML file")
     p.add_argument("--out", default="reports/scenes", help="output folder")
+    p.add_argument(
+        "--tol",
+        type=float,
+        default=None,
+        help="pick grid, Monte Carlo pairs and point-source resolution from the measured curves",
+    )
     p.set_defaults(func=_cmd_scene)
     p = sub.add_parser("models", help="list the models and their declared parameters")
     p.set_defaults(func=_cmd_models)

@@ -22,8 +22,8 @@ from .atomic import atomic_savefig, atomic_write_text
 __all__ = ["scan", "write_scene_outputs"]
 
 
-def scan(scene, n_inplane=357, n_azimuth=181):
-    model = scene.build()
+def scan(scene, n_inplane=357, n_azimuth=181, model=None):
+    model = scene.build() if model is None else model
     s_in = np.asarray(scene.polarization, dtype=float)
     ti = scene.theta_i
     x = np.radians(np.linspace(-89.0, 89.0, n_inplane))
@@ -47,14 +47,60 @@ def scan(scene, n_inplane=357, n_azimuth=181):
     return model, rows
 
 
-def write_scene_outputs(scene, out_dir):
-    """Write ``<stem>.csv`` and ``<stem>.png``; returns their paths."""
+def choose_settings(scene, tol):
+    """Settings for ``tol`` from the measured speed/accuracy curves (validation.tradeoff).
+
+    Returns ``(model, n_inplane, notes)``: the cheapest in-plane grid, Monte Carlo
+    pair count and point-source resolution whose *measured* error meets ``tol``
+    (on the representative configurations of the tradeoff study), or the most
+    accurate measured setting, said so, when none does.
+    """
+    import dataclasses
+
+    from models import PointSourceBRDF, RoughDiffuseBRDF
+
+    from .tradeoff import KNOBS, choose
+
+    notes = []
+
+    def pick(knob):
+        r = KNOBS[knob](quick=True)
+        p = choose(r, tol)
+        if p is None:
+            p = min(r.points, key=lambda q: q.error)
+            notes.append(
+                f"{knob}: no measured setting reaches {tol:g}; using the most accurate, {p.setting:g} (error {p.error:.2g})"
+            )
+        else:
+            notes.append(f"{knob}: chose {p.setting:g} (measured error {p.error:.2g} <= {tol:g})")
+        return p.setting
+
+    n_inplane = int(pick("in-plane grid"))
+    model = scene.build()
+    inner = model.model if isinstance(model, PointSourceBRDF) else model
+    if isinstance(inner, RoughDiffuseBRDF):
+        pairs = int(pick("Monte Carlo pairs"))
+        inner = dataclasses.replace(inner, pairs=pairs)
+        model = dataclasses.replace(model, model=inner) if isinstance(model, PointSourceBRDF) else inner
+    if isinstance(model, PointSourceBRDF):
+        model = dataclasses.replace(model, resolution=int(pick("point-source resolution")))
+    return model, n_inplane, notes
+
+
+def write_scene_outputs(scene, out_dir, tol=None):
+    """Write ``<stem>.csv`` and ``<stem>.png``; returns their paths (and notes on the
+    settings chosen for ``tol``)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    model, rows = scan(scene)
+    notes = []
+    if tol is None:
+        model, rows = scan(scene)
+    else:
+        chosen, n_inplane, notes = choose_settings(scene, tol)
+        model, rows = scan(scene, n_inplane=max(n_inplane, 3), model=chosen)
     stem = os.path.splitext(os.path.basename(scene.path))[0]
     buf = io.StringIO()
     buf.write(f"# scene: {scene.name}\n# file: {scene.path}\n")
@@ -90,4 +136,6 @@ def write_scene_outputs(scene, out_dir):
     png_path = os.path.join(out_dir, f"{stem}.png")
     atomic_savefig(fig, png_path, dpi=100)
     plt.close(fig)
+    if tol is not None:
+        return csv_path, png_path, notes
     return csv_path, png_path
