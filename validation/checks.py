@@ -446,7 +446,7 @@ def all_sections():
 
 def run_checks(checks=None):
     out = []
-    for fn in all_checks() if checks is None else checks:
+    for fn in checks or all_checks():
         r = fn()
         out.extend(r if isinstance(r, list) else [r])
     return out
