@@ -352,9 +352,7 @@ def section_seed001(ctx):
     for ax, t in zip(axes[:2], (0.0, 60.0), strict=True):
         a, b = v.brdf(math.radians(t), T, P), sub.brdf(math.radians(t), T, P)
         r = np.where((a > 0) & (b > 0), a / np.where(b > 0, b, 1.0), np.nan)
-        im = ax.pcolormesh(
-            np.degrees(pr), np.degrees(tr), np.log10(r), shading="auto", cmap="RdBu_r", vmin=-1, vmax=1
-        )
+        im = ax.pcolormesh(np.degrees(pr), np.degrees(tr), np.log10(r), shading="auto", vmin=0.0, vmax=2.5)
         ax.set_title(f"log10 varnish(Eq. 24) / subsurface, theta_i = {t:g} deg", fontsize=8)
         ax.set_xlabel("phi_r (deg)")
         ax.set_ylabel("theta_r (deg)")
