@@ -478,8 +478,8 @@ def _recovery_settings(quick):
         noise_levels=(0.05, 0.1),
         n_geometries=(8, 32),
         injections=50,
-        walkers=8,
-        max_steps=1000,
+        walkers=4,  # one free parameter; 8 walkers x 1000 steps took ~590 s for these 4 cells
+        max_steps=600,
         check_every=100,
         starts=1,
     )
