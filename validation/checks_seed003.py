@@ -583,3 +583,18 @@ SECTIONS = [_fig1_section]
 # page); `scatterbench validate` and the full report run them.
 for _fn in (check_mc_scaling, check_energy_seed003, check_mc_energy):
     _fn.slow = True
+
+
+def _scatmech_error_distributions():
+    """Per-case errors against SCATMECH for the report's agreement section."""
+    labels = {
+        "diffuse": "DiffuseSubsurfaceBRDF",
+        "single": "SingleScatterBRDF (depolarizing)",
+        "btdf": "FacetBTDF",
+        "mb": "MaxwellBeardBRDF specular",
+    }
+    return {f"{label} (committed)": scatmech_seed003_errors(kind)[0] for kind, label in labels.items()}
+
+
+#: read by the report's "Agreement with SCATMECH" section
+SCATMECH_ERRORS = [_scatmech_error_distributions]
