@@ -1,7 +1,7 @@
 """The quick report opened in a real browser (headless Debian Chromium driven by Playwright).
 
 Skipped on a developer machine without Chromium or Playwright; in CI (CI set) their
-absence is a failure, since scripts/test.sh installs them.
+absence is a failure, since the README test command installs them (scripts/install_browser.sh).
 """
 
 import json
@@ -33,7 +33,7 @@ def _need_browser():
         pytest.skip("playwright is not installed")
     if not CHROMIUM:
         if os.environ.get("CI"):
-            pytest.fail("Chromium is not installed in CI (scripts/test.sh installs it)")
+            pytest.fail("Chromium is not installed in CI (scripts/install_browser.sh installs it)")
         pytest.skip("no Chromium on this machine")
 
 
