@@ -87,19 +87,40 @@ def _load(args):
     return sc, data, spec, Likelihood(sc, spec, data)
 
 
+def _load_and_describe(args):
+    """``_load`` for a command: prints the scene and fit spec, or the error (then ``None``)."""
+    try:
+        loaded = _load(args)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return None
+    print(loaded[0].describe())
+    print(loaded[2].describe())
+    return loaded
+
+
+def _mcmc_kwargs(args):
+    """The sampler settings shared by fit and the studies."""
+    return dict(
+        walkers=args.walkers,
+        seed=args.seed,
+        max_steps=args.max_steps,
+        check_every=args.check_every,
+        tau_factor=args.tau_factor,
+        starts=args.starts,
+    )
+
+
 def _cmd_fit(args) -> int:
     from .executors import make_executor
     from .fit import run_fit, write_fit
 
     if not _out_ok(args.out, args.force, args.resume):
         return 2
-    try:
-        sc, data, spec, lik = _load(args)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    loaded = _load_and_describe(args)
+    if loaded is None:
         return 2
-    print(sc.describe())
-    print(spec.describe())
+    sc, data, spec, lik = loaded
     print(
         f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
     )
@@ -115,12 +136,7 @@ def _cmd_fit(args) -> int:
         try:
             res = run_fit(
                 lik,
-                walkers=args.walkers,
-                seed=args.seed,
-                max_steps=args.max_steps,
-                check_every=args.check_every,
-                tau_factor=args.tau_factor,
-                starts=args.starts,
+                **_mcmc_kwargs(args),
                 executor=ex,
                 checkpoint=ck,
                 resume=args.resume,

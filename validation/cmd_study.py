@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from .cmd_fit import _executor_args, _load, _mcmc_args, _out_ok, _spec_args
+from .cmd_fit import _executor_args, _load_and_describe, _mcmc_args, _mcmc_kwargs, _out_ok, _spec_args
 
 __all__ = ["register"]
 
@@ -39,13 +39,10 @@ def _cmd_recovery(args) -> int:
 
     if not _out_ok(args.out, args.force, None):
         return 2
-    try:
-        sc, data, spec, _ = _load(args)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    loaded = _load_and_describe(args)
+    if loaded is None:
         return 2
-    print(sc.describe())
-    print(spec.describe())
+    sc, data, spec, _ = loaded
     extra = {k: v for k, v in spec.noise.items() if k != "brdf"}
     t0 = time.perf_counter()
     with make_executor(args.workers, args.scheduler) as ex:
@@ -57,13 +54,8 @@ def _cmd_recovery(args) -> int:
             noise_levels=_floats(args.noise_levels),
             n_geometries=_ints(args.n_geometries) if args.n_geometries else (None,),
             injections=args.injections,
-            seed=args.seed,
-            walkers=args.walkers,
-            max_steps=args.max_steps,
-            check_every=args.check_every,
-            tau_factor=args.tau_factor,
-            starts=args.starts,
             executor=ex,
+            **_mcmc_kwargs(args),
             noise_extra=extra,
             progress=not args.no_progress,
         )
@@ -256,12 +248,7 @@ def _cmd_compare(args) -> int:
             liks,
             names,
             executor=ex,
-            walkers=args.walkers,
-            seed=args.seed,
-            max_steps=args.max_steps,
-            check_every=args.check_every,
-            tau_factor=args.tau_factor,
-            starts=args.starts,
+            **_mcmc_kwargs(args),
         )
     os.makedirs(args.out, exist_ok=True)
     atomic_write_json(
