@@ -241,6 +241,13 @@ class CookTorranceBRDF(_CookTorranceBase):
             val[~live] = 0.0
         return val
 
+    @property
+    def slopes(self):
+        """The facet slope density D describes: Beckmann (Gaussian slopes) with rms ``m``."""
+        from .slopes import GaussianSlopes
+
+        return GaussianSlopes(sigma=self.m)
+
     def lobe(self, theta_i):
         """Specular lobe: centre ``(theta_i, 0)``, width ``~ 2 m`` in theta_r."""
         return (theta_i, 0.0, 2.0 * self.m)

@@ -94,6 +94,20 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
     def mirror_symmetric(self) -> bool:
         return self.m_parallel == self.m_perpendicular or math.sin(2.0 * self.stroke_angle) == 0.0
 
+    @property
+    def slopes(self):
+        """The brushed facet slope density of Eq. 19 (:class:`models.StrokeSlopes`)."""
+        from .stroke_slopes import StrokeSlopes
+
+        return StrokeSlopes(
+            m_parallel=self.m_parallel, m_perpendicular=self.m_perpendicular, stroke_angle=self.stroke_angle
+        )
+
+    @property
+    def coating(self):
+        """The varnish is the coating the light crosses (for coating-generic analyses)."""
+        return self.varnish
+
     def rotated(self, angle):
         if self.m_parallel == self.m_perpendicular:
             return self
