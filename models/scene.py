@@ -33,6 +33,18 @@ Schema (angles in degrees in files, as everywhere outside the Python API)::
     [volume]                       # optional volume scatterer (pigment) in the coating
     ...
 
+    # or, instead of the facet substrate: an empirical model with no interface
+    [substrate]
+    model = "maxwell-beard"        # facet (default) | cook-torrance | maxwell-beard
+    index = 1.5                    # Fresnel reflectance of the specular facets
+    distribution = "gaussian"      # facet slopes of the specular term
+    sigma = 0.05
+    rho_d = 0.02                   # Lambertian BRDF, 1/sr
+    rho_v = 0.01                   # volumetric coefficient, 1/sr: 2 rho_v / (cos ti + cos tr)
+    tau_deg = 15.0                 # shadowing/obscuration parameters (defaults: the model's)
+    omega_deg = 40.0
+    polarized = true               # facet Mueller matrix on the specular term (false: published scalar form)
+
     [detector]
     aperture_deg = 0.7
 """
@@ -184,6 +196,21 @@ class Scene:
                         + ("" if iso else " with brushed (anisotropic) roughness"),
                     )
                 )
+        elif self.substrate is not None and self.substrate.get("model") == "maxwell-beard":
+            from .maxwell_beard import MaxwellBeardBRDF
+
+            mb = self.substrate["mb"]
+            out.append(
+                Mechanism(
+                    "Maxwell-Beard",
+                    MaxwellBeardBRDF(
+                        slopes=self.substrate["slopes"], substrate=self.substrate["index"], **mb
+                    ),
+                    "the empirical Maxwell-Beard BRDF (shadowed specular facets + Lambertian + volumetric "
+                    "terms, no interface): the model seed 003 Sec. 4 compares its combination with"
+                    + ("" if mb["polarized"] else "; published scalar form, depolarizing"),
+                )
+            )
         elif self.substrate is not None and self.substrate.get("slopes") is not None:
             if coat_n is not None:
                 out.append(
@@ -424,6 +451,45 @@ def _cook_torrance(path, s):
     return out
 
 
+_SUBSTRATE_MODELS = ("facet", "cook-torrance", "maxwell-beard")
+_MB_KEYS = ("rho_d", "rho_v", "tau_deg", "omega_deg", "polarized")
+
+
+def _maxwell_beard(path, s, data):
+    """Maxwell-Beard's own parameters (:class:`models.MaxwellBeardBRDF`); the specular
+    term's slopes come from ``distribution``.  The model has no interface, so a
+    ``[coating]`` or ``[volume]`` beside it would be double counting: refused."""
+    from .maxwell_beard import MaxwellBeardBRDF
+
+    for table in ("coating", "volume"):
+        if table in data:
+            raise _err(
+                path,
+                f"[{table}]",
+                "not with [substrate] model = 'maxwell-beard': the model has no interface and carries its "
+                "own diffuse (rho_d) and volumetric (rho_v) terms",
+            )
+    if "distribution" not in s:
+        raise _err(
+            path, "[substrate] distribution", "required for model = 'maxwell-beard' (the specular facet term)"
+        )
+    fields = {p.name: p for p in MaxwellBeardBRDF.parameters()}
+    out = {}
+    for key in ("rho_d", "rho_v"):
+        out[key] = _number(path, f"[substrate] {key}", s.get(key, fields[key].default), 0.0)
+    for key in ("tau", "omega"):
+        deg = _number(
+            path, f"[substrate] {key}_deg", s.get(f"{key}_deg", math.degrees(fields[key].default)), 0.0,
+            low_open=True,
+        )  # fmt: skip
+        out[key] = math.radians(deg)
+    pol = s.get("polarized", True)
+    if not isinstance(pol, bool):
+        raise _err(path, "[substrate] polarized", f"must be true or false; got {pol!r}")
+    out["polarized"] = pol
+    return out
+
+
 _VOLUME_KEYS = {"rho", "single", "single_weight", "g", "polarized", "interface", "pairs", "seed"}
 
 
@@ -522,22 +588,28 @@ def from_dict(data: dict, path: str = "<scene>") -> Scene:
     if "substrate" in data:
         s = data["substrate"]
         allowed = {"index", "distribution", "model"} | {k for _, ks in DISTRIBUTIONS.values() for k in ks}
-        allowed |= set(_CT_KEYS)
+        allowed |= set(_CT_KEYS) | set(_MB_KEYS)
         _unknown(path, "[substrate] ", s, allowed)
         if "index" not in s:
             raise _err(path, "[substrate] index", 'required: n, [n, k] or "inf"')
         substrate = {"index": _index(path, "[substrate] index", s["index"])}
         kind = s.get("model", "facet")
-        if kind not in ("facet", "cook-torrance"):
-            raise _err(path, "[substrate] model", f"must be 'facet' or 'cook-torrance'; got {kind!r}")
+        if kind not in _SUBSTRATE_MODELS:
+            raise _err(
+                path, "[substrate] model", f"must be one of {', '.join(_SUBSTRATE_MODELS)}; got {kind!r}"
+            )
         substrate["model"] = kind
+        for keys, owner in ((_CT_KEYS, "cook-torrance"), (_MB_KEYS, "maxwell-beard")):
+            for k in keys:
+                if k in s and kind != owner:
+                    raise _err(path, f"[substrate] {k}", f"only for model = {owner!r}")
         if kind == "cook-torrance":
             substrate["slopes"] = None
             substrate["ct"] = _cook_torrance(path, s)
+        elif kind == "maxwell-beard":
+            substrate["mb"] = _maxwell_beard(path, s, data)
+            substrate["slopes"] = _distribution(path, "[substrate] ", s)
         else:
-            for k in _CT_KEYS:
-                if k in s:
-                    raise _err(path, f"[substrate] {k}", "only for model = 'cook-torrance'")
             substrate["slopes"] = _distribution(path, "[substrate] ", s) if "distribution" in s else None
     volume = None
     if "volume" in data:

@@ -105,6 +105,14 @@ def test_likelihood_prefers_the_truth_and_uses_declared_terms(coated, data):
     spec = fitspec_from(coated, ["sigma:0.01:1:log"], ["eta_deg=1"])
     with pytest.raises(ValueError, match="noise.brdf"):
         Likelihood(coated, spec, data)
+    # "off" drops a term the scene's [fit.noise] declares (a BRDF-only fit of polarimetric data)
+    sc = scene.load(os.path.join(SCENES, "aluminium_flakes_fit.toml"))
+    assert Likelihood(sc, fitspec_from(sc), data).terms == ("brdf", "eta", "P", "P_C")
+    off = fitspec_from(sc, None, ["eta_deg=off", "P=off"])
+    assert off.off == ("eta_deg", "P") and "eta_deg" not in off.noise
+    assert Likelihood(sc, off, data).terms == ("brdf", "P_C")
+    with pytest.raises(ValueError, match="brdf: the BRDF term cannot be off"):
+        fitspec_from(sc, None, ["brdf=off"])
 
 
 # ----------------------------------------------------------------------------- sampling

@@ -80,6 +80,7 @@ def test_quick_report_in_chromium(quick_report):
         "seed003_presets",
         "seed001",
         "uncertainty",
+        "model_comparison",
         "speed",
         "stability",
         "scenes",

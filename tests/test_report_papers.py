@@ -1,4 +1,5 @@
-"""The report sections of issue 7: seed 003 Fig. 1, seed 003 presets, seed 001, uncertainty.
+"""The report sections of issue 7: seed 003 Fig. 1, seed 003 presets, seed 001, uncertainty,
+and issue 6's model comparison.
 
 One quick build of the four sections (no check suite); each table on the page
 equals its ``numbers`` in results.json, and the physics the page shows holds.
@@ -13,7 +14,7 @@ import pytest
 
 from validation.report import build_report
 
-IDS = ("seed003_fig1", "seed003_presets", "seed001", "uncertainty")
+IDS = ("seed003_fig1", "seed003_presets", "seed001", "uncertainty", "model_comparison")
 
 
 @pytest.fixture(scope="module")
@@ -152,3 +153,18 @@ def test_uncertainty_posterior_and_coverage(papers):
         assert r["min N / tau"] > 8
     (chk,) = [c for c in results["checks"] if c["name"].startswith("uncertainty: recovery coverage")]
     assert chk["status"] == "pass"
+
+
+def test_model_comparison_table_and_check(papers):
+    results, page = papers
+    rows = results["sections"]["model_comparison"]["numbers"]["comparison"]
+    assert len(rows) == 8  # 2 data sets x 2 term choices x 2 hypotheses
+    for r in rows:
+        assert min(r["dAIC"], r["dBIC"], r["dWAIC"]) >= 0
+        best = r["dBIC"] == 0
+        # the hypothesis that made the data is the one with dBIC = 0
+        assert best == (r["hypothesis"] == r["data (generator)"]), r
+        # the winner's fitted speckle is near the 5% the data were made with; the loser's is not
+        assert (0.03 < r["fitted noise.brdf (median)"] < 0.08) == best, r
+    (chk,) = [c for c in results["checks"] if c["name"].startswith("model comparison:")]
+    assert chk["status"] == "pass" and chk["measured"] > 10

@@ -204,3 +204,45 @@ def test_volume_errors(text, key):
     with pytest.raises(ValueError) as exc:
         scene.loads(text, "v.toml")
     assert key in str(exc.value) and str(exc.value).startswith("v.toml")
+
+
+_MB = (
+    BASE + '[substrate]\nmodel = "maxwell-beard"\nindex = 1.5\ndistribution = "gaussian"\nsigma = 0.1\n'
+    "rho_d = 0.02\nrho_v = 0.01\n"
+)
+
+
+def test_maxwell_beard_scene_builds_the_model_with_degrees_converted():
+    sc = scene.loads(_MB + "tau_deg = 14.0\nomega_deg = 40.0\npolarized = false\n", "mb.toml")
+    (mech,) = sc.mechanisms()
+    m = sc.build()
+    assert isinstance(m, models.MaxwellBeardBRDF) and "Maxwell-Beard" in mech.why
+    assert m.rho_d == 0.02 and m.rho_v == 0.01 and m.slopes.sigma == 0.1 and not m.polarized
+    assert math.isclose(m.tau, math.radians(14.0)) and math.isclose(m.omega, math.radians(40.0))
+    # defaults are the model's own (tau 0.25 rad, Omega 0.7 rad, polarized specular term)
+    d = scene.loads(_MB, "mb.toml").build()
+    ref = models.MaxwellBeardBRDF(slopes=models.GaussianSlopes(0.1), substrate=1.5, rho_d=0.02, rho_v=0.01)
+    assert d == ref.replace(polarized=True)
+    # fits change its parameters through the dotted keys
+    assert sc.with_values({"substrate.rho_v": 0.05}).build().rho_v == 0.05
+
+
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        (_MB.replace("rho_d = 0.02", "rho_d = -0.1"), "rho_d"),
+        (_MB.replace('distribution = "gaussian"\nsigma = 0.1\n', ""), "distribution"),
+        (_MB + "tau_deg = 0\n", "tau_deg"),
+        (_MB + 'polarized = "yes"\n', "polarized"),
+        (_MB + "[coating]\nindex = 1.5\n", "[coating]"),
+        (
+            BASE + "[substrate]\nindex = 1.5\nrho_d = 0.1\n",
+            "rho_d",
+        ),  # a Maxwell-Beard key on a facet substrate
+        (BASE + '[substrate]\nindex = 1.5\nmodel = "lambert"\n', "model"),
+    ],
+)
+def test_maxwell_beard_scene_errors(text, key):
+    with pytest.raises(ValueError) as exc:
+        scene.loads(text, "mb.toml")
+    assert key in str(exc.value) and str(exc.value).startswith("mb.toml")

@@ -77,16 +77,18 @@ def _cmd_recovery(args) -> int:
     )
     print(
         f"\n{'noise':>6} {'geoms':>5} {'parameter':<20} {'cov68':>6} {'z68':>6} {'cov95':>6} {'z95':>6} "
-        f"{'bias':>10} {'width68':>10}  steps/tau(min)"
+        f"{'bias':>10} {'width68':>10} {'curv68':>6} {'curv95':>6}  steps/tau(min)"
     )
     for c in cells:
         for k, s in c["summary"].items():
             c68, c95 = s["coverage"]["68"], s["coverage"]["95"]
             print(
                 f"{c['noise_brdf']:>6g} {c['geometries']:>5} {k:<20} {c68['measured']:>6.3f} {c68['z']:>6.2f} "
-                f"{c95['measured']:>6.3f} {c95['z']:>6.2f} {s['bias']:>10.3g} {s['width68_mean']:>10.3g}  "
+                f"{c95['measured']:>6.3f} {c95['z']:>6.2f} {s['bias']:>10.3g} {s['width68_mean']:>10.3g} "
+                f"{c68['curvature']:>6.3f} {c95['curvature']:>6.3f}  "
                 f"{c['steps_over_tau_min']:.1f}"
             )
+    print("curv68/curv95: coverage of the optimum's curvature (Gauss-Newton) intervals on the same data sets")
     print(
         f"binomial standard errors over {args.injections} injections: 68%: "
         f"{math.sqrt(0.6827 * 0.3173 / args.injections):.3f}, 95%: {math.sqrt(0.9545 * 0.0455 / args.injections):.3f}"

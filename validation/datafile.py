@@ -17,7 +17,7 @@ column             required  meaning, allowed range
                              (``Q/I, U/I, V/I``, ``Q = I_s - I_p``), each in
                              [-1.5, 1.5]; all three or none
 ``eta_deg``        no        principal angle of polarization, [-90, 90]
-``P``              no        degree of polarization, [0, 1.5]
+``P``              no        degree of polarization, [-0.5, 1.5]
 ``P_C``            no        degree of circular polarization, [-1.5, 1.5]
 ``eta_err_deg``,   no        1-sigma uncertainties of those, > 0
 ``P_err``,
@@ -30,8 +30,10 @@ column             required  meaning, allowed range
 
 ``s1..s3`` and ``eta_deg/P/P_C`` are two spellings of the same thing: give one
 of them, not both.  Degrees of polarization above 1 are allowed up to 1.5
-because a noisy measurement of a fully polarized beam scatters around 1;
-larger values are rejected (a percent value given as a fraction's column, say).
+because a noisy measurement of a fully polarized beam scatters around 1, and
+``P`` down to -0.5 because, in the same additive noise model the likelihood
+uses, a nearly depolarized beam's estimate scatters around 0; values beyond
+are rejected (a percent value given as a fraction's column, say).
 
 Sidecar: ``NAME.json`` beside ``NAME.csv`` (optional), an object with the keys
 ``format`` (``"scatterbench-brdf/1"``), ``sample``, ``instrument``,
@@ -74,7 +76,7 @@ COLUMNS = {
     "s2": (-1.5, 1.5, False, False, False),
     "s3": (-1.5, 1.5, False, False, False),
     "eta_deg": (-90.0, 90.0, False, False, False),
-    "P": (0.0, 1.5, False, False, False),
+    "P": (-0.5, 1.5, False, False, False),
     "P_C": (-1.5, 1.5, False, False, False),
     "eta_err_deg": (0.0, math.inf, True, True, False),
     "P_err": (0.0, math.inf, True, True, False),

@@ -6,18 +6,20 @@ command line replaces the scene's entries of the same kind).  Scene form::
     [fit]
     free = ["substrate.sigma:0.01:1:log", "coating.index:1.2:2", "substrate.index[0]:0.5:3"]
 
-    [fit.noise]                 # a number: fixed; "low:high[:prior]": a free parameter
-    brdf = "0.005:1:log"        # fractional (speckle) noise: sigma of ln(BRDF)
+    [fit.noise]                 # a number: fixed; "low:high[:prior]": a free parameter;
+    brdf = "0.005:1:log"        # "off": the term is not used even if the data have it
     eta_deg = 1.0               # principal-angle noise, degrees
     P = 0.02                    # degree-of-polarization noise
-    # P_C = 0.02
+    P_C = "off"                 # degree of circular polarization: ignored
 
     [fit.mask]
     near_specular_deg = 2.0     # drop rows within 2 deg of the specular direction
     exclude = [{theta_r_deg = [53, 67], phi_r_deg = [180, 180]}]   # boxes, degrees, inclusive
 
 Command line: ``--free substrate.sigma:0.01:1:log`` (repeatable), ``--noise
-brdf=0.05`` or ``--noise brdf:0.005:1:log``, ``--near-specular-deg 2``,
+brdf=0.05``, ``--noise brdf:0.005:1:log`` or ``--noise eta_deg=off`` (a
+BRDF-only fit of polarimetric data: ``--noise eta_deg=off --noise P=off
+--noise P_C=off``), ``--near-specular-deg 2``,
 ``--exclude theta_r_deg=53:67,phi_r_deg=180:180``.
 
 A free entry is ``KEY:LOW:HIGH[:PRIOR]`` with ``PRIOR`` ``uniform`` (default)
@@ -95,6 +97,7 @@ class FitSpec:
     noise: dict = field(default_factory=dict)  # fixed noise values by term
     near_specular_deg: float = 0.0
     exclude: tuple = ()  # of {axis: (lo, hi)}
+    off: tuple = ()  # polarization terms not used, even where the data have them
 
     @property
     def names(self):
@@ -152,6 +155,8 @@ class FitSpec:
         lines += [f"  {p.key:<22} {p.prior:<8} [{p.low:g}, {p.high:g}]" for p in self.free]
         if self.noise:
             lines.append("fixed noise: " + ", ".join(f"{k}={v:g}" for k, v in self.noise.items()))
+        if self.off:
+            lines.append("terms off: " + ", ".join(self.off))
         if self.near_specular_deg or self.exclude:
             lines.append(f"mask: near_specular_deg={self.near_specular_deg:g}, exclude={list(self.exclude)}")
         return "\n".join(lines)
@@ -160,6 +165,7 @@ class FitSpec:
         return {
             "free": [p.as_text() for p in self.free],
             "noise": dict(self.noise),
+            "off": list(self.off),
             "near_specular_deg": self.near_specular_deg,
             "exclude": [{k: list(v) for k, v in b.items()} for b in self.exclude],
         }
@@ -216,6 +222,10 @@ def _free(where, key, low, high, prior):
 def _noise_entry(where, term, value):
     if term not in NOISE_TERMS:
         raise FitSpecError(f"{where}: unknown noise term {term!r}; allowed: {', '.join(NOISE_TERMS)}")
+    if isinstance(value, str) and value.strip() == "off":
+        if term == "brdf":
+            raise FitSpecError(f"{where} brdf: the BRDF term cannot be off (every fit uses it)")
+        return "off"
     if isinstance(value, str) and ":" in value:
         return parse_free(f"noise.{term}:{value}", where)
     v = _num(f"{where} {term}", value)
@@ -299,9 +309,12 @@ def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=N
                 raise FitSpecError(f"--noise: expected TERM=VALUE or TERM:LOW:HIGH[:PRIOR]; got {text!r}")
             items = [(k, v) for k, v in items if k != term.strip()]
             items.append((term.strip(), val))
+    off = []
     for term, value in items:
         e = _noise_entry(f"{where} noise" if not noise else "--noise", term, value)
-        if isinstance(e, FreeParam):
+        if e == "off":
+            off.append(term)
+        elif isinstance(e, FreeParam):
             params.append(e)
         else:
             noise_fixed[term] = e
@@ -346,4 +359,6 @@ def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=N
     boxes = [_exclude_box(f"{where} mask exclude", b) for b in mask.get("exclude", [])]
     if exclude:
         boxes = [parse_exclude(t) for t in exclude]
-    return FitSpec(free=tuple(params), noise=noise_fixed, near_specular_deg=ns, exclude=tuple(boxes))
+    return FitSpec(
+        free=tuple(params), noise=noise_fixed, near_specular_deg=ns, exclude=tuple(boxes), off=tuple(off)
+    )

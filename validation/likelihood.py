@@ -10,7 +10,7 @@
 
 A polarization term is used when the data have the quantity and a noise level
 for it (``noise.eta_deg``, ``noise.P``, ``noise.P_C``, fixed or free) or the
-matching ``*_err`` column; :attr:`Likelihood.terms` lists what is used.  Rows
+matching ``*_err`` column, unless the spec turns it off; :attr:`Likelihood.terms` lists what is used.  Rows
 removed by the spec's mask do not enter.  A model that predicts no light at a
 used row (unreachable geometry) has likelihood zero there.
 
@@ -50,17 +50,20 @@ class Likelihood:
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
         free_noise = {p.key[6:] for p in spec.free if p.is_noise}
         have = lambda t: t in spec.noise or t in free_noise  # noqa: E731
+        used = lambda t, col, err: (  # noqa: E731
+            t not in spec.off and col is not None and (have(t) or err is not None)
+        )
         terms = ["brdf"]
         if not (have("brdf") or d.brdf_err is not None):
             raise ValueError(
                 "noise.brdf: the BRDF term needs a noise level (fixed or free: --noise brdf=0.05 or "
                 "--noise brdf:0.005:1:log) or a brdf_err column"
             )
-        if d.eta is not None and (have("eta_deg") or d.eta_err is not None):
+        if used("eta_deg", d.eta, d.eta_err):
             terms.append("eta")
-        if d.P is not None and (have("P") or d.P_err is not None):
+        if used("P", d.P, d.P_err):
             terms.append("P")
-        if d.P_C is not None and (have("P_C") or d.P_C_err is not None):
+        if used("P_C", d.P_C, d.P_C_err):
             terms.append("P_C")
         self.terms = tuple(terms)
         self.n_points = len(d)

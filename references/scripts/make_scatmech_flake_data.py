@@ -66,6 +66,42 @@ def geometries():
     return np.array(rows)
 
 
+def observe(mueller, g, rng, noise):
+    """Noisy data columns at geometries ``g`` (rows ``theta_i, theta_r, phi_r, polarizer``,
+    degrees) from ``mueller(theta_i, theta_r, phi_r)`` (radians -> 4x4): the BRDF for the
+    linearly polarized incident light with log-normal speckle, and eta, P, P_C with
+    additive Gaussian noise, the noise levels ``noise`` drawn from ``rng`` in this order."""
+    brdf, eta, P, PC = [], [], [], []
+    for ti, tr, pr, pol in g:
+        M = mueller(math.radians(ti), math.radians(tr), math.radians(pr))
+        a = math.radians(pol)
+        s_in = np.array([1.0, math.cos(2 * a), math.sin(2 * a), 0.0])
+        S = M @ s_in
+        brdf.append(S[0])
+        eta.append(math.degrees(0.5 * math.atan2(S[2], S[1])))
+        P.append(math.sqrt(S[1] ** 2 + S[2] ** 2 + S[3] ** 2) / S[0])
+        PC.append(S[3] / S[0])
+    brdf, eta, P, PC = map(np.array, (brdf, eta, P, PC))
+    if not np.all(brdf > 0):
+        raise SystemExit("a geometry has zero BRDF in SCATMECH; choose others")
+    n = len(g)
+    brdf_obs = brdf * np.exp(noise["brdf_frac"] * rng.standard_normal(n))
+    eta_obs = eta + noise["eta_deg"] * rng.standard_normal(n)
+    eta_obs = (eta_obs + 90.0) % 180.0 - 90.0  # eta is an axis: keep it in [-90, 90)
+    P_obs = P + noise["P"] * rng.standard_normal(n)
+    PC_obs = PC + noise["P_C"] * rng.standard_normal(n)
+    return {
+        "theta_i_deg": g[:, 0],
+        "theta_r_deg": g[:, 1],
+        "phi_r_deg": g[:, 2],
+        "brdf": brdf_obs,
+        "eta_deg": eta_obs,
+        "P": P_obs,
+        "P_C": PC_obs,
+        "incident": [f"linear:{float(p)!r}" for p in g[:, 3]],
+    }
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=20261122)
@@ -82,37 +118,10 @@ def main(argv=None):
     )
     g = geometries()
     rng = np.random.default_rng(args.seed)
-    brdf, eta, P, PC = [], [], [], []
-    for ti, tr, pr, pol in g:
-        M = np.array(model.MuellerBRDF(math.radians(ti), math.radians(tr), math.radians(pr)), dtype=float)
-        a = math.radians(pol)
-        s_in = np.array([1.0, math.cos(2 * a), math.sin(2 * a), 0.0])
-        S = M @ s_in
-        brdf.append(S[0])
-        eta.append(math.degrees(0.5 * math.atan2(S[2], S[1])))
-        P.append(math.sqrt(S[1] ** 2 + S[2] ** 2 + S[3] ** 2) / S[0])
-        PC.append(S[3] / S[0])
-    brdf, eta, P, PC = map(np.array, (brdf, eta, P, PC))
-    if not np.all(brdf > 0):
-        raise SystemExit("a geometry has zero BRDF in SCATMECH; choose others")
+    columns = observe(lambda ti, tr, pr: np.array(model.MuellerBRDF(ti, tr, pr), dtype=float), g, rng, NOISE)
     n = len(g)
-    brdf_obs = brdf * np.exp(NOISE["brdf_frac"] * rng.standard_normal(n))
-    eta_obs = eta + NOISE["eta_deg"] * rng.standard_normal(n)
-    eta_obs = (eta_obs + 90.0) % 180.0 - 90.0  # eta is an axis: keep it in [-90, 90)
-    P_obs = P + NOISE["P"] * rng.standard_normal(n)
-    PC_obs = PC + NOISE["P_C"] * rng.standard_normal(n)
     version = metadata.version("pySCATMECH")
     when = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d")
-    columns = {
-        "theta_i_deg": g[:, 0],
-        "theta_r_deg": g[:, 1],
-        "phi_r_deg": g[:, 2],
-        "brdf": brdf_obs,
-        "eta_deg": eta_obs,
-        "P": P_obs,
-        "P_C": PC_obs,
-        "incident": [f"linear:{float(p)!r}" for p in g[:, 3]],
-    }
     meta = {
         "sample": "synthetic: aluminium flakes (1.37+7.62i) under a clear coat n=1.5, exponential slopes sigma=0.1",
         "instrument": f"SCATMECH Subsurface_Facet_BRDF_Model via pySCATMECH {version} (no instrument)",

@@ -591,6 +591,7 @@ def section_provenance(ctx):
     return s
 
 
+from .sections_compare import section_model_comparison  # noqa: E402  (issue 6 item 8)
 from .sections_papers import (  # noqa: E402  (issue 7: the papers' figures, uncertainty)
     section_seed001,
     section_seed003_fig1,
@@ -609,6 +610,7 @@ SECTION_FUNCS = [
     section_seed003_presets,
     section_seed001,
     section_uncertainty,
+    section_model_comparison,
     section_speed,
     section_stability,
     section_scenes,
