@@ -90,3 +90,6 @@ __all__ += ["mueller_with_error"]
 from .maxwell_beard import MaxwellBeardBRDF  # noqa: E402
 
 __all__ += ["MaxwellBeardBRDF"]
+from .aperture import DetectorAperture  # noqa: E402
+
+__all__ += ["DetectorAperture"]

@@ -25,6 +25,7 @@ __all__ = [
     "sp_basis",
     "refracted_cos",
     "broadcast_angles",
+    "disc_quadrature",
 ]
 
 
@@ -86,3 +87,19 @@ def broadcast_angles(*arrays):
     b = np.broadcast_arrays(*[np.asarray(a, dtype=float) for a in arrays])
     shape = b[0].shape
     return shape, [np.ascontiguousarray(x).reshape(-1) for x in b]
+
+
+def disc_quadrature(n, radius):
+    """Nodes ``(x, y)`` and weights ``w`` integrating over a disc of ``radius``
+    (``sum w f(x, y) ~ integral f dA``): Gauss-Legendre in the radius (``n`` nodes,
+    weight ``r dr``) times the periodic trapezoid rule in the azimuth (``2 n``
+    nodes), exact for polynomials of degree ``2n - 1`` in ``r`` times trigonometric
+    polynomials of degree ``2n - 1``.  Shared by the point source (a disc sample)
+    and the detector aperture (a cone of directions in equal-area coordinates)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    r = 0.5 * radius * (x + 1.0)
+    wr = 0.5 * radius * w * r  # r dr
+    chi = (np.arange(2 * n) + 0.5) * (np.pi / n)
+    px = (r[:, None] * np.cos(chi)[None, :]).ravel()
+    py = (r[:, None] * np.sin(chi)[None, :]).ravel()
+    return px, py, np.repeat(wr, 2 * n) * (np.pi / n)

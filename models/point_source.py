@@ -50,6 +50,7 @@ import numpy as np
 from scipy import signal
 
 from .base import Model
+from .geometry import disc_quadrature
 from .params import param
 
 __all__ = ["PointSourceBRDF"]
@@ -122,16 +123,7 @@ class PointSourceBRDF(Model):
 
     # -- source geometry ------------------------------------------------------------
     def _disc_nodes(self):
-        n = self.resolution
-        x, w = np.polynomial.legendre.leggauss(n)
-        R = self.sample_radius
-        rho = 0.5 * R * (x + 1.0)
-        wr = 0.5 * R * w * rho  # rho d rho
-        chi = (np.arange(2 * n) + 0.5) * (math.pi / n)
-        px = (rho[:, None] * np.cos(chi)[None, :]).ravel()
-        py = (rho[:, None] * np.sin(chi)[None, :]).ravel()
-        wa = np.repeat(wr, 2 * n) * (math.pi / n)
-        return px, py, wa
+        return disc_quadrature(self.resolution, self.sample_radius)
 
     def source_nodes(self, theta_i):
         """``(psi, Phi, w)``, each ``(n_geom, K)``: incidence polar angle and

@@ -136,6 +136,17 @@ class Scene:
                 node[last] = cur
         return from_dict(data, self.path)
 
+    def with_aperture(self, aperture_deg: float) -> Scene:
+        """The same scene seen by a detector of full aperture ``aperture_deg`` (0: a point
+        detector), e.g. the aperture a data file's sidecar records."""
+        data = copy.deepcopy(self.raw)
+        data.setdefault("detector", {})["aperture_deg"] = aperture_deg
+        return from_dict(data, self.path)
+
+    @property
+    def aperture_deg(self) -> float:
+        return float((self.detector or {}).get("aperture_deg", 0.0))
+
     def _locate(self, data, key):
         idx = None
         if key.endswith("]") and "[" in key:
@@ -302,14 +313,19 @@ class Scene:
 
     def build(self, tol: float = 1e-3) -> Model:
         """The incoherent sum of :meth:`mechanisms` (a single model when there is one),
-        under a point source when the scene declares one and it matters: the point
-        source is kept only if it changes the in-plane BRDF by more than ``tol``
-        (relative to the peak), measured at this scene's incidence."""
+        under a point source when the scene declares one and it matters, seen through
+        the detector's aperture when it matters: each is kept only if it changes the
+        in-plane BRDF by more than ``tol`` (relative to the peak), measured at this
+        scene's incidence."""
         return self._build(tol)[0]
 
     def source_decision(self, tol: float = 1e-3) -> str:
         """Why the source is evaluated as it is (measured, see :meth:`build`)."""
         return self._build(tol)[1]
+
+    def aperture_decision(self, tol: float = 1e-3) -> str:
+        """Why the detector aperture is or is not averaged over (measured, see :meth:`build`)."""
+        return self._build(tol)[2]
 
     def _build(self, tol):
         mech = self.mechanisms()
@@ -321,18 +337,35 @@ class Scene:
         total = mech[0].model
         for m in mech[1:]:
             total = total + m.model
+        total, why_source = self._source(total, tol)
+        total, why_aperture = self._aperture(total, tol)
+        return total, why_source, why_aperture
+
+    def _probe(self):
+        """In-plane probe geometries for the measured decisions: 69 angles from -85 to 85
+        deg plus 41 within 5 deg of the specular direction (where narrow peaks live)."""
+        import numpy as np
+
+        spec = math.degrees(self.theta_i)
+        x = np.concatenate([np.linspace(-85.0, 85.0, 69), np.linspace(spec - 5.0, spec + 5.0, 41)])
+        x = x[np.abs(x) <= 89.9]
+        return np.radians(np.abs(x)), np.where(x >= 0, 0.0, math.pi)
+
+    def _deviation(self, a, b):
+        """max |f_b - f_a| over the probe, relative to the peak of f_a."""
+        import numpy as np
+
+        tr, pr = self._probe()
+        fa, fb = a.brdf(self.theta_i, tr, pr), b.brdf(self.theta_i, tr, pr)
+        return float(np.max(np.abs(fb - fa)) / max(np.max(fa), 1e-300))
+
+    def _source(self, total, tol):
         if self.source != "point":
             return total, "collimated source"
         from .point_source import PointSourceBRDF
 
         wrapped = PointSourceBRDF(model=total, distance=self.distance_mm, sample_radius=self.sample_radius_mm)
-        import numpy as np
-
-        x = np.radians(np.linspace(-85.0, 85.0, 69))
-        tr, pr = np.abs(x), np.where(x >= 0, 0.0, math.pi)
-        f_c = total.brdf(self.theta_i, tr, pr)
-        f_p = wrapped.brdf(self.theta_i, tr, pr)
-        dev = float(np.max(np.abs(f_p - f_c)) / max(np.max(f_c), 1e-300))
+        dev = self._deviation(total, wrapped)
         if dev <= tol:
             return total, (
                 f"point source at d/R = {self.distance_mm / self.sample_radius_mm:g} evaluated as collimated: "
@@ -343,12 +376,40 @@ class Scene:
             f"it changes the in-plane BRDF by {dev:.2g} of the peak > tol {tol:g}"
         )
 
+    def _aperture(self, total, tol):
+        """The detector aperture, kept when averaging over it changes the in-plane BRDF by
+        more than ``tol`` of the peak; its quadrature resolution is the smallest whose
+        doubling changes the result by at most ``tol / 10`` (both measured here)."""
+        deg = self.aperture_deg
+        if deg == 0.0:
+            return total, "point detector (no aperture declared)"
+        from .aperture import DetectorAperture
+
+        res, prev = 1, DetectorAperture(model=total, aperture=math.radians(deg), resolution=1)
+        while res < 64:
+            nxt = prev.replace(resolution=2 * res)
+            if self._deviation(nxt, prev) <= 0.1 * tol:
+                break
+            res, prev = 2 * res, nxt
+        dev = self._deviation(total, prev)
+        if dev <= tol:
+            return total, (
+                f"detector aperture {deg:g} deg neglected: averaging over it changes the in-plane BRDF by "
+                f"{dev:.2g} of the peak <= tol {tol:g} (measured)"
+            )
+        return prev, (
+            f"detector aperture {deg:g} deg kept: averaging over it changes the in-plane BRDF by {dev:.2g} of "
+            f"the peak > tol {tol:g} (measured); quadrature resolution {res} (doubling it changes <= tol/10)"
+        )
+
     def describe(self, tol: float = 1e-3) -> str:
         lines = [f"scene {self.name!r} ({self.path})"]
         for m in self.mechanisms():
             lines.append(f"  - {m.name}: {type(m.model).__name__} — {m.why}")
         if self.mechanisms():
-            lines.append(f"  - source: {self.source_decision(tol)}")
+            _, why_source, why_aperture = self._build(tol)
+            lines.append(f"  - source: {why_source}")
+            lines.append(f"  - detector: {why_aperture}")
         lines.extend(f"  note: {n}" for n in self.notes)
         return "\n".join(lines)
 

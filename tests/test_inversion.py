@@ -13,6 +13,7 @@ from models import scene
 from validation.cli import main
 from validation.datafile import Dataset, load_data
 from validation.inversion import UnitSlopes, bootstrap, fit_curve, invert, probed_slopes
+from validation.likelihood import scene_for_data
 
 DATA = references.data_path("scatmech_flake_measurement.csv")
 COATED = os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
@@ -73,9 +74,9 @@ def test_probed_slope_is_the_facet_bisector():
 def test_binned_curve_and_bootstrap_are_calibrated_on_noisy_data():
     """Log-normal 5% noise: the binned estimator is unbiased over realizations and the
     bootstrap's spread matches the spread across realizations."""
-    sc = scene.load(COATED)
-    m = sc.build()
-    inv = invert(m, load_data(DATA))
+    data = load_data(DATA)
+    m = scene_for_data(scene.load(COATED), data).build()  # point detector: the data's sidecar
+    inv = invert(m, data)
     true = m.slopes.p3(inv.zeta_x, inv.zeta_y)
     rng = np.random.default_rng(0)
     norms = []

@@ -32,7 +32,14 @@ def test_coated_flakes_build_only_the_subsurface_facet_model():
     )
     assert [type(m.model) for m in sc.mechanisms()] == [models.SubsurfaceFacetBRDF]
     m = sc.build()
+    # the 0.7 deg detector averages the exponential distribution's cusp at the specular peak
+    # by ~3% of the peak, more than the default tolerance: the aperture is kept (measured)
+    assert isinstance(m, models.DetectorAperture) and math.isclose(m.aperture, math.radians(0.7))
+    assert "kept" in sc.aperture_decision()
+    m = m.model
     assert m.coating == 1.5 and m.substrate == 1.37 + 7.62j and m.slopes.sigma == 0.1
+    # a point detector (the SCATMECH data's sidecar says aperture_deg = 0) builds the bare model
+    assert sc.with_aperture(0.0).build() == m
 
 
 BASE = 'name = "x"\n[illumination]\ntheta_i_deg = 30\n'
@@ -94,7 +101,7 @@ def test_scene_command_writes_csv_and_png(tmp_path):
 
 
 def test_with_values_rebuilds_and_revalidates():
-    sc = scene.load(references.scene_paths()[0])
+    sc = scene.load(references.scene_paths()[0]).with_aperture(0.0)
     s2 = sc.with_values({"substrate.sigma": 0.25, "substrate.index[1]": 7.0, "coating.index": 1.6})
     m = s2.build()
     assert m.slopes.sigma == 0.25 and m.substrate == 1.37 + 7.0j and m.coating == 1.6

@@ -94,8 +94,14 @@ def _load_and_describe(args):
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return None
-    print(loaded[0].describe())
-    print(loaded[2].describe())
+    sc, data, spec, lik = loaded
+    if lik.scene is not sc:
+        print(
+            f"detector: the data's sidecar records aperture_deg = {lik.scene.aperture_deg:g} "
+            f"(the scene says {sc.aperture_deg:g}); the fit uses the data's"
+        )
+    print(lik.scene.describe())
+    print(spec.describe())
     return loaded
 
 

@@ -146,6 +146,7 @@ def _cmd_inversion(args) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from models import DetectorAperture
     from models import scene as scene_mod
 
     from .atomic import atomic_savefig, atomic_write_json
@@ -153,6 +154,7 @@ def _cmd_inversion(args) -> int:
     from .fit import _scan_x
     from .fitspec import FitSpec, parse_exclude
     from .inversion import bootstrap, collapse, fit_curve, invert
+    from .likelihood import scene_for_data
 
     if not _out_ok(args.out, args.force, None):
         return 2
@@ -163,7 +165,13 @@ def _cmd_inversion(args) -> int:
             (), {}, args.near_specular_deg or 0.0, tuple(parse_exclude(t) for t in args.exclude or [])
         )
         data = data.subset(spec.mask(data))
-        model = sc.build()
+        model = scene_for_data(sc, data).build()
+        if isinstance(model, DetectorAperture):
+            print(
+                f"note: the inversion (seed 000 Sec. 4) assumes a point detector; the "
+                f"{math.degrees(model.aperture):g} deg aperture is not deconvolved"
+            )
+            model = model.model
         inv = invert(model, data)
         curve = fit_curve(inv, bins=args.bins)
     except ValueError as exc:

@@ -14,6 +14,11 @@ matching ``*_err`` column, unless the spec turns it off; :attr:`Likelihood.terms
 removed by the spec's mask do not enter.  A model that predicts no light at a
 used row (unreachable geometry) has likelihood zero there.
 
+The detector aperture is the data's: a sidecar that records ``aperture_deg``
+replaces the scene's ``[detector]`` (:func:`scene_for_data`), and the scene then
+averages over it when that changes the BRDF by more than its tolerance
+(:meth:`models.scene.Scene.build`).
+
 The log-likelihood omits the data-only Jacobian ``-sum ln brdf_obs`` (a
 constant for given data, the same for every model compared on them).
 """
@@ -28,16 +33,25 @@ from models.polarization import ellipsometric
 
 from .fitspec import FitSpec
 
-__all__ = ["Likelihood"]
+__all__ = ["Likelihood", "scene_for_data"]
 
 _LOG2PI = math.log(2.0 * math.pi)
+
+
+def scene_for_data(scene, data):
+    """``scene`` with the detector aperture of ``data``'s sidecar, when it records one
+    (the instrument that took the data decides, not the scene's default)."""
+    ap = data.meta.get("aperture_deg") if data.meta else None
+    if ap is None or float(ap) == scene.aperture_deg:
+        return scene
+    return scene.with_aperture(float(ap))
 
 
 class Likelihood:
     """``L(u)``: the log posterior in the spec's sampling coordinates is ``self(u)``."""
 
     def __init__(self, scene, spec: FitSpec, data):
-        self.scene = scene
+        self.scene = scene_for_data(scene, data)
         self.spec = spec
         self.data_all = data
         self.mask = spec.mask(data)

@@ -76,6 +76,8 @@ _NAMED_EDGES = {
     # point source: at the sample's edge, near, far and at infinity (seed 001 Eq. 25-30)
     "distance": (1.0, 10.0, 1e4, math.inf),
     "resolution": (1, 64),
+    # detector aperture: a point, a hair, seed 000's 0.7 deg and the widest cone allowed
+    "aperture": (0.0, 1e-6, math.radians(0.7), 0.5 * math.pi),
     # Monte Carlo: the fewest pairs the model allows and a moderate count
     "pairs": (2, 200),
     "single": (0.0, 1.0),
@@ -93,6 +95,10 @@ _BASES = {
     "RoughDiffuseBRDF": lambda: models.RoughDiffuseBRDF(pairs=200),
     "PointSourceBRDF": lambda: models.PointSourceBRDF(
         model=models.CookTorranceBRDF(normalization="energy"), distance=100.0, sample_radius=1.0
+    ),
+    # a narrow lobe (rms slope 0.02) under seed 000's 0.7 deg aperture: the aperture matters
+    "DetectorAperture": lambda: models.DetectorAperture(
+        model=models.SubsurfaceFacetBRDF(slopes=models.ExponentialSlopes(0.02)), aperture=math.radians(0.7)
     ),
 }
 _INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
