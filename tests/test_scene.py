@@ -253,3 +253,12 @@ def test_maxwell_beard_scene_errors(text, key):
     with pytest.raises(ValueError) as exc:
         scene.loads(text, "mb.toml")
     assert key in str(exc.value) and str(exc.value).startswith("mb.toml")
+
+
+def test_detector_aperture_is_neglected_where_it_changes_nothing():
+    white = _scene("glossy_white_paint.toml")  # totally diffuse: smooth on the scale of 0.7 deg
+    ap = white.with_aperture(0.7)
+    assert ap.build() == white.build() and "neglected" in ap.aperture_decision()
+    assert "detector aperture 0.7 deg" in ap.describe()
+    # a 5 deg cone near grazing, where the interface's transmission falls, is not negligible
+    assert isinstance(white.with_aperture(5.0).build(), models.DetectorAperture)
