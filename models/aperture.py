@@ -38,7 +38,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .base import Model
+from .base import Model, _Wrapper
 from .geometry import disc_quadrature, scattered_direction, sp_basis
 from .params import param
 from .polarization import mueller16_from_jones
@@ -50,7 +50,7 @@ _BLOCK = 1 << 16
 
 
 @dataclass(frozen=True)
-class DetectorAperture(Model):
+class DetectorAperture(_Wrapper):
     """A model seen by a detector whose aperture is a cone of full angle ``aperture``.
 
     Parameters
@@ -68,21 +68,6 @@ class DetectorAperture(Model):
         math.radians(0.7), "full cone angle of the detector (rad)", low=0.0, high=0.5 * math.pi
     )
     resolution: int = param(4, "radial quadrature nodes over the cone", kind="int", low=1, high=256)
-
-    depolarizing = True
-    reciprocal = False
-
-    def _validate(self):
-        if not isinstance(self.model, Model) or self.model.transmission:
-            raise ValueError(f"model must be a reflection model (models.Model); got {self.model!r}")
-
-    @property
-    def mirror_symmetric(self) -> bool:
-        return bool(self.model.mirror_symmetric)
-
-    def rotated(self, angle):
-        inner = self.model.rotated(angle)
-        return self if inner is self.model else self.replace(model=inner)
 
     def lobe(self, theta_i):
         lb = self.model.lobe(theta_i)

@@ -270,3 +270,26 @@ class Sum(Model):
 
     def __repr__(self):
         return " + ".join(f"{w:g}*{m!r}" for w, m in self.terms)
+
+
+class _Wrapper(Model):
+    """A model that changes how another reflection model (its ``model`` field) is
+    illuminated or observed (point source, detector aperture): the inner model must
+    be a reflection model, and mirror symmetry and rotations of the sample follow it.
+    Depolarizing (its result is a weighted sum of the inner model's matrices) and not
+    reciprocal (the source or the detector alone is changed)."""
+
+    depolarizing = True
+    reciprocal = False
+
+    def _validate(self):
+        if not isinstance(self.model, Model) or self.model.transmission:
+            raise ValueError(f"model must be a reflection model (models.Model); got {self.model!r}")
+
+    @property
+    def mirror_symmetric(self) -> bool:
+        return bool(self.model.mirror_symmetric)
+
+    def rotated(self, angle):
+        inner = self.model.rotated(angle)
+        return self if inner is self.model else self.replace(model=inner)

@@ -49,7 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from .base import Model
+from .base import Model, _Wrapper
 from .geometry import disc_quadrature
 from .params import param
 
@@ -60,7 +60,7 @@ _BLOCK = 1 << 16
 
 
 @dataclass(frozen=True)
-class PointSourceBRDF(Model):
+class PointSourceBRDF(_Wrapper):
     """A model illuminated by a point source at height ``distance`` over a disc
     sample of radius ``sample_radius`` (seed 001 Eq. 25-30).
 
@@ -90,12 +90,8 @@ class PointSourceBRDF(Model):
     )
     resolution: int = param(16, "radial quadrature nodes over the disc", kind="int", low=1, high=4096)
 
-    depolarizing = True
-    reciprocal = False
-
     def _validate(self):
-        if not isinstance(self.model, Model) or self.model.transmission:
-            raise ValueError(f"model must be a reflection model (models.Model); got {self.model!r}")
+        super()._validate()
         d = self.distance
         ok = (
             isinstance(d, (int, float))
@@ -105,14 +101,6 @@ class PointSourceBRDF(Model):
         if not ok:
             raise ValueError(f"distance must be a finite real number > 0 or math.inf; got {d!r}")
         object.__setattr__(self, "distance", float(d))
-
-    @property
-    def mirror_symmetric(self) -> bool:
-        return bool(self.model.mirror_symmetric)
-
-    def rotated(self, angle):
-        inner = self.model.rotated(angle)
-        return self if inner is self.model else self.replace(model=inner)
 
     def lobe(self, theta_i):
         lb = self.model.lobe(theta_i)
