@@ -83,11 +83,11 @@ class DetectorAperture(_Wrapper):
         scale = np.where(r > 0, sin_u / np.where(r > 0, r, 1.0), 0.0)
         return x * scale, y * scale, cos_u, w
 
-    def directions(self, theta_r, phi_r):
-        """Node directions ``(n, K, 3)`` of the cones around the nominal directions and
-        their weights ``(n, K)`` (``cos theta_k dOmega``, zero below the horizon,
-        normalized per cone)."""
-        a, b, cos_u, w = self._nodes
+    def directions(self, theta_r, phi_r, nodes=slice(None)):
+        """Directions ``(n, K, 3)`` of the quadrature nodes (``nodes``: a slice of them)
+        in the cones around the nominal directions, and their unnormalized weights
+        ``(n, K)``: ``cos theta_k dOmega``, zero below the horizon."""
+        a, b, cos_u, w = (v[nodes] for v in self._nodes)
         kr = scattered_direction(theta_r, phi_r)
         s_r, p_r = sp_basis(kr)
         k = (
@@ -95,37 +95,32 @@ class DetectorAperture(_Wrapper):
             + a[None, :, None] * p_r[:, None, :]
             + b[None, :, None] * s_r[:, None, :]
         )
-        cz = np.maximum(k[..., 2], 0.0)
-        wt = w[None, :] * cz
-        return k, wt / wt.sum(axis=1, keepdims=True)
+        return k, w[None, :] * np.maximum(k[..., 2], 0.0)
 
     def _mueller16(self, ti, tr, pr):
         if self.aperture == 0.0:
             return self.model._mueller16(ti, tr, pr)
         n = ti.size
         out = np.zeros((16, n))
-        k, wt = self.directions(tr, pr)
-        K = wt.shape[1]
-        kz = np.clip(k[..., 2], -1.0, 1.0)
-        live = wt > 0
-        th = np.where(live, np.arccos(kz), 0.0)  # a dead node gets weight 0 and any valid angle
-        ph = np.arctan2(k[..., 1], k[..., 0])
-        # the nominal analyzer basis carried to each node, and its angle from the node's own basis
+        wsum = np.zeros(n)
         s_r, _ = sp_basis(scattered_direction(tr, pr))
-        s_k, p_k = sp_basis(k)
-        sp_ = s_r[:, None, :] - np.sum(s_r[:, None, :] * k, axis=-1, keepdims=True) * k
-        sp_ /= np.linalg.norm(sp_, axis=-1, keepdims=True)
-        c = np.sum(sp_ * s_k, axis=-1)
-        s = np.sum(sp_ * p_k, axis=-1)
-        zero = np.zeros_like(c)
-        R = mueller16_from_jones((c, zero), (s, zero), (-s, zero), (c, zero)).reshape(4, 4, n, K)
-        step = max(1, _BLOCK // n)
-        tib = np.broadcast_to(ti[:, None], (n, K))
+        K = self._nodes[0].size
+        step = max(1, _BLOCK // n)  # nodes per block: every temporary is O(_BLOCK)
         for k0 in range(0, K, step):
             sl = slice(k0, min(K, k0 + step))
-            kb = sl.stop - sl.start
-            M = self.model._mueller16(
-                np.ascontiguousarray(tib[:, sl]).ravel(), th[:, sl].ravel(), ph[:, sl].ravel()
-            ).reshape(4, 4, n, kb)
-            out += np.einsum("ijnk,jlnk,nk->ilnk", R[:, :, :, sl], M, wt[:, sl]).sum(axis=-1).reshape(16, n)
-        return out
+            k, wt = self.directions(tr, pr, sl)
+            kb = wt.shape[1]
+            th = np.where(wt > 0, np.arccos(np.clip(k[..., 2], -1.0, 1.0)), 0.0)  # dead node: weight 0
+            ph = np.arctan2(k[..., 1], k[..., 0])
+            # the nominal analyzer basis carried to each node, and its angle from the node's own basis
+            s_k, p_k = sp_basis(k)
+            sa = s_r[:, None, :] - np.sum(s_r[:, None, :] * k, axis=-1, keepdims=True) * k
+            sa /= np.linalg.norm(sa, axis=-1, keepdims=True)
+            c = np.sum(sa * s_k, axis=-1)
+            s = np.sum(sa * p_k, axis=-1)
+            zero = np.zeros_like(c)
+            R = mueller16_from_jones((c, zero), (s, zero), (-s, zero), (c, zero)).reshape(4, 4, n, kb)
+            M = self.model._mueller16(np.repeat(ti, kb), th.ravel(), ph.ravel()).reshape(4, 4, n, kb)
+            out += np.einsum("ijnk,jlnk,nk->iln", R, M, wt).reshape(16, n)
+            wsum += wt.sum(axis=1)
+        return out / wsum

@@ -106,8 +106,8 @@ def test_compare_prefers_the_generating_slope_family(setup):
 
 @pytest.fixture(scope="module")
 def pairing():
-    """Seed 003's pairing on 60 rows of each SCATMECH data set, all likelihood terms and the BRDF alone."""
-    return seed003_pairing(rows=60, walkers=16, seed=3, max_steps=300, check_every=100, starts=3)
+    """Seed 003's pairing on 40 rows of each SCATMECH data set, all likelihood terms and the BRDF alone."""
+    return seed003_pairing(rows=40, walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
 
 
 @pytest.mark.parametrize("terms", ["all", "brdf"])

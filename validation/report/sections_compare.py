@@ -28,7 +28,7 @@ STRONG_DBIC = 10.0
 
 def _settings(quick):
     if quick:  # the configuration of tests/test_recovery.py (same seed: fitted once per process)
-        return dict(rows=60, walkers=16, seed=3, max_steps=300, check_every=100, starts=3)
+        return dict(rows=40, walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
     return dict(rows=None, walkers=24, seed=3, max_steps=2000, check_every=100, starts=4)
 
 
