@@ -253,6 +253,10 @@ def _cmd_compare(args) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    for nm, lik in zip(names, liks, strict=True):
+        print(
+            f"{nm}: {len(lik.spec.free)} free ({', '.join(lik.spec.names)}); likelihood terms: {', '.join(lik.terms)}"
+        )
     with make_executor(args.workers, args.scheduler) as ex:
         rows, _ = compare_fits(
             liks,
