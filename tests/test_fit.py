@@ -234,3 +234,32 @@ def test_fit_command_writes_results_refuses_overwrite_and_resumes(tmp_path, caps
         == 2
     )
     assert "noise.brdf" in capsys.readouterr().err
+
+
+def test_the_data_sidecar_sets_the_aperture_and_the_choice_is_fixed_for_the_fit(coated, data):
+    """SCATMECH's data record a point detector (aperture_deg = 0): the 0.7 deg of the scene is not
+    applied.  A sidecar that records 0.7 deg gets the averaged model with the quadrature chosen at
+    the scene's values at every parameter value, though a scene built at a wider lobe alone
+    would choose a coarser one, so ln L is smooth."""
+    import dataclasses
+
+    import models
+
+    spec = fitspec_from(coated, ["sigma:0.01:1:log"], ["brdf=0.05"])
+    d = subsample(data, 20)
+    lik = Likelihood(coated, spec, d)
+    assert lik.scene.aperture_deg == 0.0 and not isinstance(
+        lik.model({"substrate.sigma": 0.1}), models.DetectorAperture
+    )
+    d7 = dataclasses.replace(d, meta={**d.meta, "aperture_deg": 0.7})
+    lik7 = Likelihood(coated, spec, d7)
+    for sigma in (0.1, 1.0):
+        m = lik7.model({"substrate.sigma": sigma})
+        assert isinstance(m, models.DetectorAperture) and m.resolution == lik7._aperture[1]
+    assert lik7._aperture == (pytest.approx(math.radians(0.7)), 8)
+    assert "resolution 4 " in coated.with_values({"substrate.sigma": 1.0}).aperture_decision()
+    # the averaged peak is lower than the point detector's (the exponential cusp is smoothed)
+    assert (
+        lik7.predict(lik7.model({"substrate.sigma": 0.1}))["brdf"].max()
+        < lik.predict(lik.model({"substrate.sigma": 0.1}))["brdf"].max()
+    )

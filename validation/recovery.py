@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .fitspec import FitSpec
-from .likelihood import Likelihood, scene_for_data
+from .likelihood import Likelihood
 from .sampling import initial_ball, optimize, run_chain
 
 __all__ = ["simulate", "Member", "run_member", "recovery_study", "coverage_table", "subsample"]
@@ -54,12 +54,9 @@ def simulate(scene, spec: FitSpec, data, truth: dict, noise: dict, rng):
     ``noise``: levels by term (``brdf`` fractional, ``eta_deg``, ``P``, ``P_C``);
     polarization columns are simulated only for terms with a level.
     """
-    lik = Likelihood.__new__(Likelihood)  # only predict() is needed here
-    lik._same_incident = False
-    lik.data = data
-    # the detector the fit will assume (the data's sidecar aperture, else the scene's)
-    model = scene_for_data(scene, data).with_values(spec.scene_values(truth)).build()
-    pred = Likelihood.predict(lik, model, data)
+    # the fit's own model (its detector aperture, decided as the fit decides it), at every row
+    lik = Likelihood(scene, spec, data)
+    pred = lik.predict(lik.model(truth), data)
     n = len(data)
     b = pred["brdf"] * np.exp(noise["brdf"] * rng.standard_normal(n))
     kw = {
