@@ -311,13 +311,29 @@ class Scene:
             )
         return out
 
-    def build(self, tol: float = 1e-3) -> Model:
+    def build(self, tol: float = 1e-3, decisions: dict | None = None) -> Model:
         """The incoherent sum of :meth:`mechanisms` (a single model when there is one),
         under a point source when the scene declares one and it matters, seen through
         the detector's aperture when it matters: each is kept only if it changes the
         in-plane BRDF by more than ``tol`` (relative to the peak), measured at this
-        scene's incidence."""
-        return self._build(tol)[0]
+        scene's incidence.
+
+        ``decisions`` (from :meth:`decisions`, perhaps of the same scene at other
+        parameter values) replaces the measurements: a fit decides once and keeps
+        the choice at every evaluation, so its likelihood does not jump where a
+        decision would flip."""
+        return self._build(tol, decisions)[0]
+
+    def decisions(self, tol: float = 1e-3) -> dict:
+        """What :meth:`build` measured: ``{"point_source": bool, "aperture_resolution":
+        int or None}`` (None: the aperture is not averaged over)."""
+        from .aperture import DetectorAperture
+        from .point_source import PointSourceBRDF
+
+        m = self.build(tol)
+        res = m.resolution if isinstance(m, DetectorAperture) else None
+        inner = m.model if isinstance(m, DetectorAperture) else m
+        return {"point_source": isinstance(inner, PointSourceBRDF), "aperture_resolution": res}
 
     def source_decision(self, tol: float = 1e-3) -> str:
         """Why the source is evaluated as it is (measured, see :meth:`build`)."""
@@ -327,7 +343,7 @@ class Scene:
         """Why the detector aperture is or is not averaged over (measured, see :meth:`build`)."""
         return self._build(tol)[2]
 
-    def _build(self, tol):
+    def _build(self, tol, decisions=None):
         mech = self.mechanisms()
         if not mech:
             raise SceneError(
@@ -337,8 +353,9 @@ class Scene:
         total = mech[0].model
         for m in mech[1:]:
             total = total + m.model
-        total, why_source = self._source(total, tol)
-        total, why_aperture = self._aperture(total, tol)
+        fixed = decisions or {}
+        total, why_source = self._source(total, tol, fixed.get("point_source"))
+        total, why_aperture = self._aperture(total, tol, fixed.get("aperture_resolution", ...))
         return total, why_source, why_aperture
 
     def _probe(self):
@@ -359,12 +376,21 @@ class Scene:
         fa, fb = a.brdf(self.theta_i, tr, pr), b.brdf(self.theta_i, tr, pr)
         return float(np.max(np.abs(fb - fa)) / max(np.max(fa), 1e-300))
 
-    def _source(self, total, tol):
+    def _source(self, total, tol, keep=None):
         if self.source != "point":
             return total, "collimated source"
         from .point_source import PointSourceBRDF
 
         wrapped = PointSourceBRDF(model=total, distance=self.distance_mm, sample_radius=self.sample_radius_mm)
+        if keep is not None:
+            return (
+                (wrapped, "point source kept (decided beforehand)")
+                if keep
+                else (
+                    total,
+                    "point source evaluated as collimated (decided beforehand)",
+                )
+            )
         dev = self._deviation(total, wrapped)
         if dev <= tol:
             return total, (
@@ -376,14 +402,22 @@ class Scene:
             f"it changes the in-plane BRDF by {dev:.2g} of the peak > tol {tol:g}"
         )
 
-    def _aperture(self, total, tol):
+    def _aperture(self, total, tol, resolution=...):
         """The detector aperture, kept when averaging over it changes the in-plane BRDF by
         more than ``tol`` of the peak; its quadrature resolution is the smallest whose
-        doubling changes the result by at most ``tol / 10`` (both measured here)."""
+        doubling changes the result by at most ``tol / 10`` (both measured here, unless
+        ``resolution`` gives the decision: None to neglect it, an int to keep it)."""
         deg = self.aperture_deg
         if deg == 0.0:
             return total, "point detector (no aperture declared)"
         from .aperture import DetectorAperture
+
+        if resolution is None:
+            return total, f"detector aperture {deg:g} deg neglected (decided beforehand)"
+        if resolution is not ...:
+            return DetectorAperture(model=total, aperture=math.radians(deg), resolution=resolution), (
+                f"detector aperture {deg:g} deg kept at quadrature resolution {resolution} (decided beforehand)"
+            )
 
         res, prev = 1, DetectorAperture(model=total, aperture=math.radians(deg), resolution=1)
         while res < 64:

@@ -255,8 +255,8 @@ def test_the_data_sidecar_sets_the_aperture_and_the_choice_is_fixed_for_the_fit(
     lik7 = Likelihood(coated, spec, d7)
     for sigma in (0.1, 1.0):
         m = lik7.model({"substrate.sigma": sigma})
-        assert isinstance(m, models.DetectorAperture) and m.resolution == lik7._aperture[1]
-    assert lik7._aperture == (pytest.approx(math.radians(0.7)), 8)
+        assert isinstance(m, models.DetectorAperture) and m.resolution == 8
+    assert lik7.decisions == {"point_source": False, "aperture_resolution": 8}
     assert "resolution 4 " in coated.with_values({"substrate.sigma": 1.0}).aperture_decision()
     # the averaged peak is lower than the point detector's (the exponential cusp is smoothed)
     assert (

@@ -262,3 +262,17 @@ def test_detector_aperture_is_neglected_where_it_changes_nothing():
     assert "detector aperture 0.7 deg" in ap.describe()
     # a 5 deg cone near grazing, where the interface's transmission falls, is not negligible
     assert isinstance(white.with_aperture(5.0).build(), models.DetectorAperture)
+
+
+def test_decisions_are_measured_once_and_can_be_imposed():
+    iron = _scene("brushed_varnished_iron_point_source.toml")
+    d = iron.decisions()
+    assert d == {"point_source": True, "aperture_resolution": None}
+    assert isinstance(iron.build(decisions=d), models.PointSourceBRDF)
+    forced = iron.build(decisions={"point_source": False, "aperture_resolution": None})
+    assert isinstance(forced, models.VarnishedCookTorranceBRDF)
+    flakes = _scene("aluminium_flakes_clearcoat.toml")
+    assert flakes.decisions() == {"point_source": False, "aperture_resolution": 8}
+    m = flakes.build(decisions={"point_source": False, "aperture_resolution": 2})
+    assert isinstance(m, models.DetectorAperture) and m.resolution == 2
+    assert flakes.build(decisions={"point_source": False, "aperture_resolution": None}) == m.model

@@ -16,9 +16,10 @@ used row (unreachable geometry) has likelihood zero there.
 
 The detector aperture is the data's: a sidecar that records ``aperture_deg``
 replaces the scene's ``[detector]`` (:func:`scene_for_data`).  Whether averaging
-over it matters (and the quadrature resolution) is measured once, at the scene's
-own values (:meth:`models.scene.Scene.build`), and then kept for every
-evaluation, so the likelihood stays smooth in the parameters.
+over it matters (and the quadrature resolution), and whether a point source
+does, is measured once, at the scene's own values
+(:meth:`models.scene.Scene.decisions`), and kept for every evaluation, so the
+likelihood stays smooth in the parameters.
 
 The log-likelihood omits the data-only Jacobian ``-sum ln brdf_obs`` (a
 constant for given data, the same for every model compared on them).
@@ -82,23 +83,14 @@ class Likelihood:
             terms.append("P_C")
         self.terms = tuple(terms)
         self.n_points = len(d)
-        # Whether the aperture matters is decided once, at the scene's own values, and the
-        # quadrature fixed then: re-deciding per evaluation would make ln L jump where the
-        # decision flips.
-        from models import DetectorAperture
-
-        built = self.scene.build()
-        self._aperture = (built.aperture, built.resolution) if isinstance(built, DetectorAperture) else None
-        self._bare = self.scene.with_aperture(0.0) if self.scene.aperture_deg else self.scene
+        # Whether the point source and the aperture matter (and the aperture's quadrature) is
+        # decided once, at the scene's own values: re-deciding per evaluation would make ln L
+        # jump where a decision flips.
+        self.decisions = self.scene.decisions()
 
     # -- model ---------------------------------------------------------------------
     def model(self, values: dict):
-        m = self._bare.with_values(self.spec.scene_values(values)).build()
-        if self._aperture is None:
-            return m
-        from models import DetectorAperture
-
-        return DetectorAperture(model=m, aperture=self._aperture[0], resolution=self._aperture[1])
+        return self.scene.with_values(self.spec.scene_values(values)).build(decisions=self.decisions)
 
     def predict(self, model, data=None) -> dict:
         """Model ``brdf, eta, P, P_C`` at the rows of ``data`` (default: the fitted rows)."""
