@@ -55,8 +55,12 @@ def _figure(case):
         ):
             lik = fit.lik
             pred = lik.predict(lik.model(_best_values(fit)), data)
-            y = np.degrees(pred["eta"]) if t == "eta" else pred[t]
-            ax.plot(xs, y[sel][order], style, lw=1.2, label=row["scene"])
+            y = (np.degrees(pred["eta"]) if t == "eta" else pred[t])[sel][order]
+            xx = xs
+            if t == "eta":  # eta is an axis: break the line where it wraps from +90 to -90
+                cut = np.flatnonzero(np.abs(np.diff(y)) > 90.0) + 1
+                xx, y = np.insert(xs, cut, np.nan), np.insert(y, cut, np.nan)
+            ax.plot(xx, y, style, lw=1.2, label=row["scene"])
         ax.set_xlabel("signed theta_r (deg), theta_i = 60 deg")
         ax.set_ylabel({"brdf": "BRDF (1/sr)", "eta": "eta (deg)", "P": "P"}[t])
         if t == "brdf":
