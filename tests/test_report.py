@@ -55,6 +55,8 @@ def test_scene_names_are_escaped(tmp_path):
     _, page = build_report(quick=True, only=["scenes"], checks=[], extra_scenes=[str(evil)])
     assert "&lt;script&gt;alert(1)&lt;/script&gt; flakes" in page
     assert "<script>alert(1)" not in page
+    # every scene states how its source and detector are evaluated, and why (measured)
+    assert "detector aperture 0.7 deg kept" in page and "point source at d/R = 10 kept" in page
 
 
 def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):

@@ -528,13 +528,21 @@ def section_scenes(ctx):
             sc = scene_mod.load(path)
             mech = sc.mechanisms()
         except ValueError as exc:
-            rows.append({"scene": os.path.basename(path), "mechanisms": "", "why": f"error: {exc}"})
+            rows.append(
+                {
+                    "scene": os.path.basename(path),
+                    "mechanisms": "",
+                    "why": f"error: {exc}",
+                    "source and detector": "",
+                }
+            )
             continue
         rows.append(
             {
                 "scene": sc.name,
                 "mechanisms": ", ".join(f"{m.name} ({type(m.model).__name__})" for m in mech),
                 "why": "; ".join(m.why for m in mech),
+                "source and detector": f"{sc.source_decision()}; {sc.aperture_decision()}" if mech else "",
             }
         )
         if mech:
@@ -546,9 +554,13 @@ def section_scenes(ctx):
     ax.legend(fontsize=7)
     fig.tight_layout()
     s.blocks.append(
-        figure_block(fig, "In-plane BRDF of each example scene for its declared incident polarization")
+        figure_block(
+            fig,
+            "In-plane BRDF of each example scene for its declared incident polarization (with its point source "
+            "and detector aperture where they matter, as measured in the table)",
+        )
     )
-    s.blocks.append(table_block(s, "scenes", ["scene", "mechanisms", "why"], rows))
+    s.blocks.append(table_block(s, "scenes", ["scene", "mechanisms", "why", "source and detector"], rows))
     return s
 
 
