@@ -39,7 +39,7 @@ from functools import cached_property
 import numpy as np
 
 from .base import Model, _Wrapper
-from .geometry import disc_quadrature, scattered_direction, sp_basis
+from .geometry import disc_quadrature, scattered_direction, sp_basis_angles
 from .params import param
 from .polarization import mueller16_from_jones
 
@@ -89,7 +89,7 @@ class DetectorAperture(_Wrapper):
         ``(n, K)``: ``cos theta_k dOmega``, zero below the horizon."""
         a, b, cos_u, w = (v[nodes] for v in self._nodes)
         kr = scattered_direction(theta_r, phi_r)
-        s_r, p_r = sp_basis(kr)
+        s_r, p_r = sp_basis_angles(theta_r, phi_r)
         k = (
             cos_u[None, :, None] * kr[:, None, :]
             + a[None, :, None] * p_r[:, None, :]
@@ -103,7 +103,7 @@ class DetectorAperture(_Wrapper):
         n = ti.size
         out = np.zeros((16, n))
         wsum = np.zeros(n)
-        s_r, _ = sp_basis(scattered_direction(tr, pr))
+        s_r, _ = sp_basis_angles(tr, pr)
         K = self._nodes[0].size
         step = max(1, _BLOCK // n)  # nodes per block: every temporary is O(_BLOCK)
         for k0 in range(0, K, step):
@@ -113,7 +113,7 @@ class DetectorAperture(_Wrapper):
             th = np.where(wt > 0, np.arccos(np.clip(k[..., 2], -1.0, 1.0)), 0.0)  # dead node: weight 0
             ph = np.arctan2(k[..., 1], k[..., 0])
             # the nominal analyzer basis carried to each node, and its angle from the node's own basis
-            s_k, p_k = sp_basis(k)
+            s_k, p_k = sp_basis_angles(th, ph)  # the basis the model's matrix at (th, ph) is in
             sa = s_r[:, None, :] - np.sum(s_r[:, None, :] * k, axis=-1, keepdims=True) * k
             sa /= np.linalg.norm(sa, axis=-1, keepdims=True)
             c = np.sum(sa * s_k, axis=-1)

@@ -23,6 +23,7 @@ __all__ = [
     "scattered_direction",
     "transmitted_direction",
     "sp_basis",
+    "sp_basis_angles",
     "refracted_cos",
     "broadcast_angles",
     "disc_quadrature",
@@ -64,6 +65,17 @@ def sp_basis(k):
     s = np.where(along_z[..., None], np.array([0.0, 1.0, 0.0]), s)
     p = np.cross(k, s)
     return s, p
+
+
+def sp_basis_angles(theta, phi):
+    """The ``(s, p)`` basis of the upward ray ``(theta, phi)``, ``(..., 3)`` each, with
+    ``s = (-sin phi, cos phi, 0)``: :func:`sp_basis` away from the normal, and along it
+    the limit from the ray's own azimuth, the basis every model uses at ``theta = 0``
+    (SCATMECH's angle convention), so that a scan through the normal is continuous."""
+    t, p = np.broadcast_arrays(np.asarray(theta, float), np.asarray(phi, float))
+    k = scattered_direction(t, p)
+    s = np.stack([-np.sin(p), np.cos(p), np.zeros_like(p)], axis=-1)
+    return s, np.cross(k, s)
 
 
 def refracted_cos(sin_theta, n1, n2):
