@@ -27,6 +27,7 @@ __all__ = [
     "stokes",
     "stokes_from_jones_vector",
     "ellipsometric",
+    "wrap_axis",
     "coherency_matrix",
     "coherency_eigenvalues",
     "is_physical",
@@ -168,6 +169,13 @@ _PAULI = np.array(
 # H = (1/4) sum_ij M_ij kron(sigma_i, conj(sigma_j)) is then vec(J) vec(J)^dagger
 # up to ordering, so a physical (sum of Jones) Mueller matrix has H >= 0 (Cloude).
 _KRON = np.einsum("iab,jcd->ijacbd", _PAULI, np.conj(_PAULI)).reshape(4, 4, 4, 4)
+
+
+def wrap_axis(angle):
+    """An axis angle (radians) wrapped to (-pi/2, pi/2]: the principal angle ``eta`` is
+    defined modulo pi (an axis, not a direction), so differences and noisy values of
+    it are compared after this wrap."""
+    return 0.5 * np.angle(np.exp(2j * np.asarray(angle, dtype=float)))
 
 
 def coherency_matrix(M):

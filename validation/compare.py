@@ -16,7 +16,7 @@ import math
 import numpy as np
 from scipy.special import logsumexp
 
-from .fit import predictive, predictive_checks, run_fit
+from .fit import information_criteria, predictive, predictive_checks, run_fit
 
 __all__ = ["waic", "compare_fits", "format_comparison"]
 
@@ -39,23 +39,22 @@ def compare_fits(liks, names, *, executor=None, **fit_kwargs):
             raise ValueError(
                 f"scene {nm}: its mask uses other rows than {names[0]}'s; compare on the same rows"
             )
+    for nm, lk in zip(names[1:], liks[1:], strict=True):
+        if lk.terms != liks[0].terms:
+            raise ValueError(
+                f"scene {nm}: its likelihood uses the terms {lk.terms}, {names[0]}'s {liks[0].terms}; "
+                "compare with the same terms"
+            )
     rows = []
     fits = []
     for nm, lik in zip(names, liks, strict=True):
         f = run_fit(lik, executor=executor, **fit_kwargs)
         fits.append(f)
-        k, n = len(lik.spec.free), lik.n_points
-        ll_chain = float(np.max(f.chain.log_prob))  # flat prior inside bounds: log posterior = ln L + 0
-        ll = max(f.optimum["log_likelihood"], ll_chain)
         pp = predictive(f, seed=fit_kwargs.get("seed", 0))
         rows.append(
             {
                 "scene": nm,
-                "k": k,
-                "n": n,
-                "max_log_likelihood": ll,
-                "AIC": 2 * k - 2 * ll,
-                "BIC": k * math.log(n) - 2 * ll,
+                **information_criteria(f),
                 **waic(f, seed=fit_kwargs.get("seed", 0)),
                 "predictive": predictive_checks(f, pp),
                 "tau_max": float(np.max(f.chain.tau)),

@@ -16,8 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .likelihood import Likelihood
-from .sampling import ChainResult, initial_ball, optimize, run_chain, summarize
+from models.polarization import wrap_axis
+
+from .likelihood import TERMS, Likelihood, replicate, term_variances
+from .sampling import ChainResult, check_walkers, initial_ball, optimize, run_chain, summarize
 
 __all__ = [
     "FitResult",
@@ -46,10 +48,10 @@ class FitResult:
 def fingerprint(lik, settings) -> str:
     h = hashlib.sha256()
     d = lik.data_all
-    for a in (d.theta_i, d.theta_r, d.phi_r, d.brdf, d.incident):
-        h.update(np.ascontiguousarray(a).tobytes())
-    for a in (d.eta, d.P, d.P_C, d.brdf_err):
-        if a is not None:
+    for name in d._ARRAYS:  # every array the likelihood can read, by name
+        a = getattr(d, name)
+        if a is not None and name != "lines":
+            h.update(name.encode())
             h.update(np.ascontiguousarray(a).tobytes())
     h.update(json.dumps(lik.scene.raw, sort_keys=True, default=str).encode())
     h.update(json.dumps(lik.spec.as_dict(), sort_keys=True).encode())
@@ -74,9 +76,7 @@ def run_fit(
     progress=False,
     resume_from=None,
 ):
-    ndim = len(lik.spec.free)
-    if walkers < 2 * ndim or walkers % 2:
-        raise ValueError(f"walkers must be even and >= 2 x free parameters ({2 * ndim}); got {walkers}")
+    check_walkers(walkers, len(lik.spec.free))
     settings = dict(
         walkers=walkers,
         seed=seed,
@@ -106,11 +106,21 @@ def run_fit(
     )
     optimum = {
         "values": lik.spec.physical(u_opt),
+        "u": [float(x) for x in u_opt],  # sampling coordinates
+        "sd_u": [float(x) for x in info["sd_u"]],  # Gauss-Newton standard deviations there
         "log_posterior": lp_opt,
         "log_likelihood": lik.loglike(u_opt),
         "starts": info["starts"],
     }
     return FitResult(lik, optimum, chain, summarize(chain, lik.spec), settings)
+
+
+def information_criteria(fit: FitResult) -> dict:
+    """Maximum log-likelihood (best of the optimum and the chain: the prior is flat inside the
+    bounds, so the chain's log posterior is ln L), AIC and BIC (lower is better)."""
+    k, n = len(fit.spec.free), fit.lik.n_points
+    ll = max(fit.optimum["log_likelihood"], float(np.max(fit.chain.log_prob)))
+    return {"max_log_likelihood": ll, "k": k, "n": n, "AIC": 2 * k - 2 * ll, "BIC": k * math.log(n) - 2 * ll}
 
 
 def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
@@ -125,31 +135,14 @@ def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 3]))
     samples = fit.chain.samples()
     pick = rng.choice(len(samples), size=min(n_draws, len(samples)), replace=False)
-    out = {t: {"model": [], "replicated": []} for t in ("brdf", "eta", "P", "P_C")}
+    out = {t: {"model": [], "replicated": []} for t in TERMS}
     for u in samples[pick]:
         values = lik.spec.physical(u)
-        noise = lik.spec.noise_values(values)
         pred = lik.predict(lik.model(values), data)
-        f = noise.get("brdf", 0.0)
-        rel = 0.0 if data.brdf_err is None else (data.brdf_err / data.brdf) ** 2
-        sd = {
-            "brdf": np.sqrt(f * f + rel),
-            "eta": np.sqrt(
-                math.radians(noise.get("eta_deg", 0.0)) ** 2
-                + (0 if data.eta_err is None else data.eta_err**2)
-            ),
-            "P": np.sqrt(noise.get("P", 0.0) ** 2 + (0 if data.P_err is None else data.P_err**2)),
-            "P_C": np.sqrt(noise.get("P_C", 0.0) ** 2 + (0 if data.P_C_err is None else data.P_C_err**2)),
-        }
-        n = len(data)
+        rep = replicate(pred, term_variances(lik.spec.noise_values(values), data, TERMS), rng)
         for t in out:
-            m = pred[t]
-            z = rng.standard_normal(n)
-            rep = m * np.exp(sd[t] * z) if t == "brdf" else m + sd[t] * z
-            if t == "eta":
-                rep = 0.5 * np.angle(np.exp(2j * rep))
-            out[t]["model"].append(m)
-            out[t]["replicated"].append(rep)
+            out[t]["model"].append(pred[t])
+            out[t]["replicated"].append(rep[t])
     res = {t: {k: np.array(v) for k, v in d.items()} for t, d in out.items()}
     res["mask"] = lik.spec.mask(data)
     return res
@@ -168,7 +161,7 @@ def predictive_checks(fit: FitResult, pp) -> dict:
         obs = _observed(data, t)[mask]
         rep = pp[t]["replicated"][:, mask]
         if t == "eta":  # compare on the axis: centre the replicates on the observation
-            rep = obs + 0.5 * np.angle(np.exp(2j * (rep - obs)))
+            rep = obs + wrap_axis(rep - obs)
         lo68, hi68, lo95, hi95 = np.percentile(rep, [16, 84, 2.5, 97.5], axis=0)
         out[t] = {
             "inside_68": float(np.mean((obs >= lo68) & (obs <= hi68))),
@@ -212,27 +205,18 @@ def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", p
                     "z": (p["median"] - v) / p["std"] if p["std"] > 0 else None,
                 }
         post["truth_check"] = tr
-    k = len(fit.spec.free)
-    n = fit.lik.n_points
-    ll = fit.optimum["log_likelihood"]
     post.update(
         {
             "data": {
                 "path": data_path,
                 "rows": len(fit.lik.data_all),
-                "used_rows": n,
+                "used_rows": fit.lik.n_points,
                 "terms": list(fit.lik.terms),
             },
             "scene": {"path": scene_path, "name": fit.lik.scene.name},
             "spec": fit.spec.as_dict(),
             "optimum": fit.optimum,
-            "information_criteria": {
-                "max_log_likelihood": ll,
-                "k": k,
-                "n": n,
-                "AIC": 2 * k - 2 * ll,
-                "BIC": k * math.log(n) - 2 * ll,
-            },
+            "information_criteria": information_criteria(fit),
             "posterior_predictive": checks,
             "settings": dict(fit.settings, executor=executor_desc),
         }

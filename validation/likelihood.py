@@ -31,11 +31,45 @@ import math
 
 import numpy as np
 
-from models.polarization import ellipsometric
+from models.polarization import ellipsometric, wrap_axis
 
 from .fitspec import FitSpec
 
-__all__ = ["Likelihood", "scene_for_data"]
+__all__ = ["Likelihood", "scene_for_data", "term_variances", "replicate", "TERMS"]
+
+#: the likelihood's terms, in the order every draw of replicated data takes them
+TERMS = ("brdf", "eta", "P", "P_C")
+
+
+def term_variances(noise: dict, data, terms) -> dict:
+    """Per-row variance of each term: the noise level squared (``noise.brdf`` is fractional:
+    variance of ln BRDF; ``eta_deg`` in degrees) plus the data's own error column when
+    ``data`` has one (``data=None``: the noise levels alone).  A level not given is 0."""
+    err = (lambda name: None) if data is None else (lambda name: getattr(data, name))  # noqa: E731
+    out = {}
+    for t in terms:
+        if t == "brdf":
+            f = noise.get("brdf", 0.0)
+            e = err("brdf_err")
+            out[t] = f * f + (0.0 if e is None else (e / data.brdf) ** 2)
+        else:
+            s = math.radians(noise.get("eta_deg", 0.0)) if t == "eta" else noise.get(t, 0.0)
+            e = err(f"{t}_err")
+            out[t] = s * s + (0.0 if e is None else e**2)
+    return out
+
+
+def replicate(pred: dict, variances: dict, rng) -> dict:
+    """Data drawn from the likelihood's noise model around the model values ``pred``:
+    log-normal BRDF, Gaussian eta (wrapped as an axis), P and P_C; one standard-normal
+    draw per row for each term of ``variances``, in :data:`TERMS` order."""
+    out = {}
+    for t in (t for t in TERMS if t in variances):
+        m = pred[t]
+        z = rng.standard_normal(len(m)) * np.sqrt(variances[t])
+        out[t] = m * np.exp(z) if t == "brdf" else (wrap_axis(m + z) if t == "eta" else m + z)
+    return out
+
 
 _LOG2PI = math.log(2.0 * math.pi)
 
@@ -61,7 +95,6 @@ class Likelihood:
             raise ValueError("mask: every data row is masked out; nothing to fit")
         self.data = data.subset(self.mask)
         d = self.data
-        self._rel_err2 = None if d.brdf_err is None else (d.brdf_err / d.brdf) ** 2
         self._log_obs = np.log(d.brdf)
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
         free_noise = {p.key[6:] for p in spec.free if p.is_noise}
@@ -105,20 +138,7 @@ class Likelihood:
 
     # -- likelihood ----------------------------------------------------------------
     def _variances(self, noise):
-        d = self.data
-        out = {}
-        f = noise.get("brdf", 0.0)
-        out["brdf"] = f * f + (0.0 if self._rel_err2 is None else self._rel_err2)
-        if "eta" in self.terms:
-            s = math.radians(noise.get("eta_deg", 0.0))
-            out["eta"] = s * s + (0.0 if d.eta_err is None else d.eta_err**2)
-        if "P" in self.terms:
-            s = noise.get("P", 0.0)
-            out["P"] = s * s + (0.0 if d.P_err is None else d.P_err**2)
-        if "P_C" in self.terms:
-            s = noise.get("P_C", 0.0)
-            out["P_C"] = s * s + (0.0 if d.P_C_err is None else d.P_C_err**2)
-        return out
+        return term_variances(noise, self.data, self.terms)
 
     def residuals(self, pred) -> dict:
         """Raw residuals (data - model) per term; ln BRDF for the BRDF, radians for eta."""
@@ -127,7 +147,7 @@ class Likelihood:
         with np.errstate(divide="ignore", invalid="ignore"):
             out["brdf"] = self._log_obs - np.log(pred["brdf"])
         if "eta" in self.terms:
-            out["eta"] = 0.5 * np.angle(np.exp(2j * (d.eta - pred["eta"])))  # wrap to (-90, 90] deg
+            out["eta"] = wrap_axis(d.eta - pred["eta"])
         if "P" in self.terms:
             out["P"] = d.P - pred["P"]
         if "P_C" in self.terms:

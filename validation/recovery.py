@@ -33,9 +33,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .fit import run_fit
 from .fitspec import FitSpec
-from .likelihood import Likelihood
-from .sampling import initial_ball, optimize, run_chain
+from .likelihood import Likelihood, replicate, term_variances
+from .sampling import check_walkers
 
 __all__ = ["simulate", "Member", "run_member", "recovery_study", "coverage_table", "subsample"]
 
@@ -52,29 +53,16 @@ def simulate(scene, spec: FitSpec, data, truth: dict, noise: dict, rng):
     """A synthetic copy of ``data`` (same rows, incident states) from the scene at ``truth``.
 
     ``noise``: levels by term (``brdf`` fractional, ``eta_deg``, ``P``, ``P_C``);
-    polarization columns are simulated only for terms with a level.
+    polarization columns are simulated only for terms with a level.  The model is the
+    fit's own (its detector aperture, decided as the fit decides it) and the noise is the
+    likelihood's (:func:`~validation.likelihood.replicate`); error columns are not kept.
     """
-    # the fit's own model (its detector aperture, decided as the fit decides it), at every row
     lik = Likelihood(scene, spec, data)
     pred = lik.predict(lik.model(truth), data)
-    n = len(data)
-    b = pred["brdf"] * np.exp(noise["brdf"] * rng.standard_normal(n))
-    kw = {
-        "brdf": b,
-        "brdf_err": None,
-        "eta": None,
-        "P": None,
-        "P_C": None,
-        "eta_err": None,
-        "P_err": None,
-        "P_C_err": None,
-    }
-    if "eta_deg" in noise:
-        e = pred["eta"] + math.radians(noise["eta_deg"]) * rng.standard_normal(n)
-        kw["eta"] = 0.5 * np.angle(np.exp(2j * e))
-    for t in ("P", "P_C"):
-        if t in noise:
-            kw[t] = pred[t] + noise[t] * rng.standard_normal(n)
+    terms = ["brdf"] + [t for t in ("eta", "P", "P_C") if ("eta_deg" if t == "eta" else t) in noise]
+    rep = replicate(pred, term_variances(noise, None, terms), rng)
+    kw = dict.fromkeys(("eta", "P", "P_C", "brdf_err", "eta_err", "P_err", "P_C_err"))
+    kw.update(rep)
     return data.replace(**kw)
 
 
@@ -99,15 +87,17 @@ def run_member(m: Member) -> dict:
     ss = np.random.SeedSequence(list(m.seed))
     noise_seed, chain_seed = (int(s.generate_state(1)[0]) for s in ss.spawn(2))
     data = simulate(m.scene, m.spec, m.data, m.truth, m.noise, np.random.default_rng(noise_seed))
-    lik = Likelihood(m.scene, m.spec, data)
-    # the optimizer starts from the scene's values (the truth here) plus m.starts - 1 prior draws
-    u0, _, info = optimize(lik, chain_seed, n_starts=m.starts)
-    p0 = initial_ball(u0, m.walkers, chain_seed, m.spec.u_bounds(), sd=info["sd_u"])
-    res = run_chain(
-        lik, p0=p0, seed=chain_seed, max_steps=m.max_steps, check_every=m.check_every, tau_factor=m.tau_factor
+    # the fit a user would run (the optimizer starts from the scene's values, the truth here)
+    fit = run_fit(
+        Likelihood(m.scene, m.spec, data),
+        walkers=m.walkers,
+        seed=chain_seed,
+        max_steps=m.max_steps,
+        check_every=m.check_every,
+        tau_factor=m.tau_factor,
+        starts=m.starts,
     )
-    u = res.samples()
-    sd = np.asarray(info["sd_u"], float)
+    res = fit.chain
     out = {
         "tau_max": float(np.max(res.tau)),
         "steps": res.steps,
@@ -115,19 +105,18 @@ def run_member(m: Member) -> dict:
         "params": {},
     }
     for i, p in enumerate(m.spec.free):
-        x = p.from_u(u[:, i])
-        q = np.percentile(x, [2.5, 16, 50, 84, 97.5])
+        q = fit.summary["parameters"][p.key]
         t = m.truth[p.key]
-        zc = abs(float(u0[i]) - float(p.to_u(t))) / sd[i]
+        zc = abs(fit.optimum["u"][i] - float(p.to_u(t))) / fit.optimum["sd_u"][i]
         out["params"][p.key] = {
             "truth": t,
-            "median": float(q[2]),
-            "in68": bool(q[1] <= t <= q[3]),
-            "in95": bool(q[0] <= t <= q[4]),
+            "median": q["median"],
+            "in68": bool(q["p16"] <= t <= q["p84"]),
+            "in95": bool(q["p2.5"] <= t <= q["p97.5"]),
             "curv_in68": bool(zc <= 1.0),
             "curv_in95": bool(zc <= 2.0),
-            "width68": float(q[3] - q[1]),
-            "width95": float(q[4] - q[0]),
+            "width68": q["p84"] - q["p16"],
+            "width95": q["p97.5"] - q["p2.5"],
         }
     return out
 
@@ -187,6 +176,17 @@ def recovery_study(
     from .executors import SerialExecutor
 
     executor = executor or SerialExecutor()
+    check_walkers(walkers, len(spec.free))
+    missing = [
+        p.key
+        for p in spec.free
+        if p.is_noise and p.key[6:] != "brdf" and p.key[6:] not in (noise_extra or {})
+    ]
+    if missing:
+        raise ValueError(
+            f"{', '.join(missing)}: a free polarization noise level needs the level to simulate with "
+            "(noise_extra, e.g. {'eta_deg': 1.0}); its truth is that level"
+        )
     cells = []
     members = []
     for ci, (lvl, ng) in enumerate((lv, g) for lv in noise_levels for g in n_geometries):

@@ -36,7 +36,22 @@ from scipy import optimize as _opt
 
 from .atomic import atomic_write_bytes
 
-__all__ = ["optimize", "initial_ball", "run_chain", "ChainResult", "summarize", "CheckpointError"]
+__all__ = [
+    "optimize",
+    "initial_ball",
+    "run_chain",
+    "ChainResult",
+    "summarize",
+    "CheckpointError",
+    "check_walkers",
+]
+
+
+def check_walkers(walkers, ndim):
+    """The ensemble needs an even number of walkers, at least two per free parameter
+    (emcee's stretch move splits it in halves)."""
+    if isinstance(walkers, bool) or not isinstance(walkers, int) or walkers < 2 * ndim or walkers % 2:
+        raise ValueError(f"walkers must be even and >= 2 x free parameters ({2 * ndim}); got {walkers!r}")
 
 
 class CheckpointError(ValueError):
@@ -91,15 +106,21 @@ def optimize(lik, seed, n_starts=4, start=None):
         raise ValueError("optimize: no start gave a finite likelihood; check the bounds and the data")
     u, val = best
     if noise_idx:
+
+        def neg(v):
+            lp = lik(v)
+            return -lp if math.isfinite(lp) else 1e300
+
         r = _opt.minimize(
-            lambda v: -lik(v) if math.isfinite(lik(v)) else 1e300,
+            neg,
             u,
             method="Powell",
             bounds=list(map(tuple, b)),
             options={"xtol": 1e-6, "ftol": 1e-10, "maxfev": 4000},
         )
-        if lik(r.x) > val:
-            u, val = np.asarray(r.x, float), float(lik(r.x))
+        lp = lik(r.x)
+        if lp > val:
+            u, val = np.asarray(r.x, float), float(lp)
     return u, float(val), {"starts": len(starts), "start_values": tried, "sd_u": _posterior_sd(lik, u)}
 
 
@@ -290,6 +311,7 @@ def run_chain(
     else:
         p0 = np.asarray(p0, float)
         nwalkers, ndim = p0.shape
+        check_walkers(nwalkers, ndim)
         state = emcee.State(p0, random_state=np.random.RandomState(int(seed) % 2**32).get_state())
         chain = np.empty((0, nwalkers, ndim))
         lps = np.empty((0, nwalkers))
