@@ -171,8 +171,14 @@ class Model(Declared):
 
     def rotated(self, angle):
         """The model of the sample rotated by ``angle`` about z.  Models with no
-        preferred azimuth (isotropic slopes, smooth interfaces) return themselves."""
+        preferred azimuth (isotropic slopes, smooth interfaces) return themselves:
+        callers test ``model.rotated(a) is model`` to take their isotropic paths."""
         return self
+
+    def _rotated_slopes(self, angle):
+        """:meth:`rotated` for a model whose only azimuthal structure is its ``slopes``."""
+        slopes = self.slopes.rotated(angle)
+        return self if slopes is self.slopes else self.replace(slopes=slopes)
 
     # -- integration hints -------------------------------------------------------------
     def lobe(self, theta_i):
@@ -266,7 +272,12 @@ class Sum(Model):
         return min(lobes, key=lambda lb: lb[2])
 
     def rotated(self, angle):
-        return Sum(terms=tuple((w, m.rotated(angle)) for w, m in self.terms))
+        terms = tuple((w, m.rotated(angle)) for w, m in self.terms)
+        return (
+            self
+            if all(r is m for (_, r), (_, m) in zip(terms, self.terms, strict=True))
+            else Sum(terms=terms)
+        )
 
     def __repr__(self):
         return " + ".join(f"{w:g}*{m!r}" for w, m in self.terms)

@@ -156,7 +156,7 @@ class _FacetModel(Model):
             )
 
     def rotated(self, angle):
-        return self.replace(slopes=self.slopes.rotated(angle))
+        return self._rotated_slopes(angle)
 
     @property
     def mirror_symmetric(self) -> bool:

@@ -232,7 +232,7 @@ class FacetBTDF(Model):
         return J.reshape(ti.shape + (2, 2))
 
     def rotated(self, angle):
-        return self.replace(slopes=self.slopes.rotated(angle))
+        return self._rotated_slopes(angle)
 
     @property
     def mirror_symmetric(self) -> bool:

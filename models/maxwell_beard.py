@@ -109,7 +109,7 @@ class MaxwellBeardBRDF(Model):
         return out
 
     def rotated(self, angle):
-        return self.replace(slopes=self.slopes.rotated(angle))
+        return self._rotated_slopes(angle)
 
     @property
     def mirror_symmetric(self):  # type: ignore[override]

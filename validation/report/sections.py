@@ -21,7 +21,7 @@ import references  # noqa: E402
 
 from ..checks import check_modules, run_checks  # noqa: E402
 from ..integrate import integrated_reflectance  # noqa: E402
-from ..reciprocity import reciprocity_error  # noqa: E402
+from ..reciprocity import reciprocity_error, reversed_mueller  # noqa: E402
 from .core import Section, checks_block, figure_block, table_block, text_block  # noqa: E402
 
 __all__ = ["SECTION_FUNCS"]
@@ -274,7 +274,7 @@ def section_conservation(ctx):
     for ax, m in zip(axes[0], ms, strict=True):
         TI, TR = np.meshgrid(t, t, indexing="ij")
         fwd = m.brdf(TI, TR, 0.7)
-        rev = m.brdf(TR, TI, -0.7) if m.rotated(1.0) is m else fwd
+        rev = reversed_mueller(m, TI, TR, 0.7)[..., 0, 0]  # the reversed path, rotated sample if anisotropic
         scale = np.maximum(np.abs(fwd), np.abs(rev))
         err = np.where(scale > 0, np.abs(fwd - rev) / np.where(scale > 0, scale, 1), 0.0)
         im = ax.imshow(
