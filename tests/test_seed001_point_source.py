@@ -97,8 +97,8 @@ def test_not_reciprocal_and_by_how_much():
     ps = models.PointSourceBRDF(model=BASE, distance=1.0, resolution=8)
     assert ps.reciprocal is False
     nr = c.point_source_nonreciprocity((1.0, 10.0, 100.0), n=120)
-    assert nr[1.0][0] > 0.5 and nr[10.0][0] > 0.1 and nr[100.0][0] > 1e-3
-    assert nr[1.0][0] > nr[10.0][0] > nr[100.0][0]
+    assert nr[1.0] > 0.5 and nr[10.0] > 0.1 and nr[100.0] > 1e-3
+    assert nr[1.0] > nr[10.0] > nr[100.0]
     # and the collimated model is reciprocal at the same geometries
     rng = np.random.default_rng(0)
     ti, tr = rng.uniform(0, 1.4, (2, 50))

@@ -445,9 +445,20 @@ def all_sections():
 
 
 def run_checks(checks=None):
+    """Every check's results; a check that raises is a failed check (named after its
+    function, with the error), so one broken check cannot empty the summary."""
     out = []
     for fn in checks or all_checks():
-        r = fn()
+        try:
+            r = fn()
+        except Exception as exc:  # noqa: BLE001 - any error is this check's failure
+            r = Check(
+                getattr(fn, "__name__", repr(fn)),
+                math.nan,
+                math.nan,
+                "fail",
+                f"raised {type(exc).__name__}: {exc}",
+            )
         out.extend(r if isinstance(r, list) else [r])
     return out
 

@@ -19,7 +19,7 @@ from models.cook_torrance import fresnel_real_printed
 
 from .checks import Check, _le, slope_normalization_errors
 from .integrate import integrated_reflectance
-from .reciprocity import reciprocity_error
+from .reciprocity import reciprocity_error, reversed_mueller
 
 __all__ = [
     "CHECKS",
@@ -496,8 +496,8 @@ def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_
 
 
 def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
-    """``{d: (max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak, scalar
-    error over all lit geometries)}`` for the varnished iron plate, R = 1."""
+    """``{d: max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak}`` for the
+    varnished iron plate, R = 1 (the reversed path from :mod:`validation.reciprocity`)."""
     base = models.VarnishedCookTorranceBRDF(normalization="energy")
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.4, (2, n))
@@ -505,10 +505,10 @@ def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     out = {}
     for d in distances:
         ps = models.PointSourceBRDF(model=base, distance=d, resolution=16)
-        f, g = ps.brdf(ti, tr, pr), ps.brdf(tr, ti, -pr)
+        f, g = ps.brdf(ti, tr, pr), reversed_mueller(ps, ti, tr, pr)[..., 0, 0]
         big = np.maximum(f, g)
         live = big > 1e-3 * big.max()
-        out[d] = (float(np.max(np.abs(f - g)[live] / big[live])), reciprocity_error(ps, ti, tr, pr).scalar)
+        out[d] = float(np.max(np.abs(f - g)[live] / big[live]))
     return out
 
 
@@ -537,11 +537,13 @@ def check_point_source():
         ),
         Check(
             "seed001: point-source non-reciprocity (d = 10 R)",
-            nr[10.0][0],
-            0.0,
-            "finding",
+            nr[10.0],
+            1e-3,
+            # a finding while the extended source breaks reciprocity; reciprocal here would mean
+            # the wrapper no longer spreads the source (a failure)
+            "finding" if nr[10.0] > 1e-3 else "fail",
             "max |f(i->r) - f(r->i)| / max over geometries with >= 1e-3 of the peak: "
-            + ", ".join(f"d = {d:g} R: {v[0]:.3g}" for d, v in nr.items())
+            + ", ".join(f"d = {d:g} R: {v:.3g}" for d, v in nr.items())
             + " (an extended source is not an extended detector; Eq. 28 is not reciprocal)",
         ),
     ]
