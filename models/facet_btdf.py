@@ -130,9 +130,15 @@ def projected_area(slopes, cos_theta, quantiles=2048):
     ``a`` for ``b <= a`` and ``(a (pi - phi0) + b sin phi0) / pi``,
     ``phi0 = arccos(a / b)``, otherwise (``a = cos theta``, ``b = sin theta
     |zeta|``); the radial average uses midpoint quantiles of the slope
-    magnitude.  Vectorized over ``cos_theta``.
+    magnitude.  Vectorized over ``cos_theta``, computed once per distinct value (it
+    depends on the incidence alone, which a scan repeats).
     """
-    c = np.asarray(cos_theta, dtype=float)
+    if not slopes.isotropic:
+        raise ValueError(
+            f"slopes must be isotropic for the exact projected-area normalization; got {slopes!r}"
+        )
+    c_all = np.asarray(cos_theta, dtype=float)
+    c, inverse = np.unique(c_all, return_inverse=True)
     u = (np.arange(quantiles) + 0.5) / quantiles
     z = slopes._sample_radius_unit(u)
     a = c[..., None]
@@ -141,7 +147,7 @@ def projected_area(slopes, cos_theta, quantiles=2048):
     ratio = np.where(big, a / np.where(big, b, 1.0), 1.0)
     phi0 = np.arccos(np.clip(ratio, -1.0, 1.0))
     val = np.where(big, (a * (math.pi - phi0) + b * np.sqrt(1.0 - ratio * ratio)) / math.pi, a)
-    return val.mean(axis=-1)
+    return val.mean(axis=-1)[inverse].reshape(c_all.shape)
 
 
 @dataclass(frozen=True)
@@ -186,6 +192,11 @@ class FacetBTDF(Model):
         if self.substrate == 1.0:
             raise ValueError(
                 "substrate must be a real index > 1 (at n = 1 the interface vanishes and the BTDF is a delta)"
+            )
+        if self.normalization == "exact" and not self.slopes.isotropic:
+            raise ValueError(
+                "normalization 'exact' needs isotropic slopes (its projected area is the isotropic "
+                f"average); got {self.slopes!r}; use normalization='paper'"
             )
 
     def _parts(self, ti, tt, pt):
