@@ -314,7 +314,7 @@ def check_extremes():
 
 # ----------------------------------------------------------------------------- integrals
 def check_table1():
-    rows, seconds = compute_table1(tol=1e-4)
+    rows, seconds = compute_table1()
     rough = [r for r in rows if r.sigma > 0]
     flat = [r for r in rows if r.sigma == 0]
     worst_scm = max(abs(r.computed - r.independent) for r in rough)

@@ -19,6 +19,7 @@ import numpy as np  # noqa: E402
 import models  # noqa: E402
 import references  # noqa: E402
 
+from .. import table1  # noqa: E402
 from ..checks import check_modules, run_checks  # noqa: E402
 from ..integrate import integrated_reflectance  # noqa: E402
 from ..reciprocity import reciprocity_error, reversed_mueller  # noqa: E402
@@ -97,9 +98,9 @@ def section_table1(ctx):
         s.tracked[f"table1|{key}"] = {"value": r["computed"], "tol": max(2e-4, 2 * r["error"])}
     s.blocks.append(
         text_block(
-            f"27 integrals (theta_i = 60 deg, unpolarized, exponential slopes) computed in {seconds:.2f} s at "
-            "tolerance 1e-4. The flat column is the closed form; its independent value is the model's integral "
-            "at sigma = 1e-3. Rough entries are compared with SCATMECH's model integrated over facet slopes "
+            f"{len(rows)} integrals (theta_i = {math.degrees(table1.THETA_I):g} deg, unpolarized, exponential "
+            f"slopes) computed in {seconds:.2f} s at tolerance {table1.TOL:g}. The flat column is the closed form; "
+            f"its independent value is the model's integral at sigma = {table1.LIMIT_SIGMA:g}. Rough entries are compared with SCATMECH's model integrated over facet slopes "
             "(references/data/table1_scatmech.csv)."
         )
     )

@@ -527,7 +527,8 @@ def section_uncertainty(ctx):
     s.blocks.append(
         figure_block(
             corner_figure(fit),
-            "Posterior (burn-in 2 max tau, thinned by min tau / 2) with the 2.5/16/50/84/97.5 percentiles; "
+            f"Posterior (burn-in {samp['burn_in']} steps, thinned by {samp['thin']}: 2 max tau and min tau / 2 "
+            "when converged, else the second half) with the 2.5/16/50/84/97.5 percentiles; "
             "blue lines: the true values of the sidecar.",
             dpi=60,
         )
