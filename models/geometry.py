@@ -24,6 +24,7 @@ __all__ = [
     "transmitted_direction",
     "sp_basis",
     "sp_basis_angles",
+    "signed_inplane",
     "refracted_cos",
     "broadcast_angles",
     "disc_quadrature",
@@ -76,6 +77,13 @@ def sp_basis_angles(theta, phi):
     k = scattered_direction(t, p)
     s = np.stack([-np.sin(p), np.cos(p), np.zeros_like(p)], axis=-1)
     return s, np.cross(k, s)
+
+
+def signed_inplane(x):
+    """A signed in-plane scattering angle ``x`` (radians) as ``(theta_r, phi_r)``: positive
+    forward (``phi_r = 0``, the specular side), negative on the incidence side (``phi_r = pi``)."""
+    x = np.asarray(x, dtype=float)
+    return np.abs(x), np.where(x >= 0, 0.0, np.pi)
 
 
 def refracted_cos(sin_theta, n1, n2):

@@ -363,10 +363,12 @@ class Scene:
         deg plus 41 within 5 deg of the specular direction (where narrow peaks live)."""
         import numpy as np
 
+        from .geometry import signed_inplane
+
         spec = math.degrees(self.theta_i)
         x = np.concatenate([np.linspace(-85.0, 85.0, 69), np.linspace(spec - 5.0, spec + 5.0, 41)])
         x = x[np.abs(x) <= 89.9]
-        return np.radians(np.abs(x)), np.where(x >= 0, 0.0, math.pi)
+        return signed_inplane(np.radians(x))
 
     def _deviation(self, a, b):
         """max |f_b - f_a| over the probe, relative to the peak of f_a."""

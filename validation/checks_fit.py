@@ -18,6 +18,7 @@ import numpy as np
 
 import models
 import references
+from models.geometry import signed_inplane
 
 from .checks import Check
 
@@ -25,9 +26,15 @@ __all__ = ["CHECKS"]
 
 
 def _synthetic(model):
-    rows = [(60.0, abs(x), 180.0 if x < 0 else 0.0) for x in np.linspace(-89.0, 89.0, 357)]
-    rows += [(45.0, 45.0, p) for p in np.linspace(0.0, 180.0, 91)]
-    g = np.radians(np.array(rows))
+    tr, pr = signed_inplane(np.radians(np.linspace(-89.0, 89.0, 357)))
+    phi = np.radians(np.linspace(0.0, 180.0, 91))
+    g = np.column_stack(
+        [
+            np.concatenate([np.full(tr.size, math.radians(60.0)), np.full(phi.size, math.radians(45.0))]),
+            np.concatenate([tr, np.full(phi.size, math.radians(45.0))]),
+            np.concatenate([pr, phi]),
+        ]
+    )
     inc = np.tile([1.0, 0.0, 1.0, 0.0], (len(g), 1))
     from .datafile import Dataset
 

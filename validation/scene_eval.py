@@ -15,6 +15,7 @@ import os
 
 import numpy as np
 
+from models.geometry import signed_inplane
 from models.polarization import ellipsometric
 
 from .atomic import atomic_savefig, atomic_write_text
@@ -30,7 +31,7 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None):
     phi = np.radians(np.linspace(0.0, 180.0, n_azimuth))
     rows = {}
     for label, tr, pr, coord in (
-        ("in-plane", np.abs(x), np.where(x >= 0, 0.0, math.pi), np.degrees(x)),
+        ("in-plane", *signed_inplane(x), np.degrees(x)),
         ("out-of-plane", np.full_like(phi, ti), phi, np.degrees(phi)),
     ):
         S = model.mueller(ti, tr, pr) @ s_in

@@ -28,6 +28,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 import models
+from models.geometry import signed_inplane
 
 from .energy import exposed_reflectance
 from .integrate import integrated_reflectance
@@ -105,7 +106,7 @@ def knob_grid(quick=False):
     fine = np.linspace(-math.radians(89), math.radians(89), 20001)
 
     def curve(x):
-        return model.brdf(theta_i, np.abs(x), np.where(x >= 0, 0.0, math.pi))
+        return model.brdf(theta_i, *signed_inplane(x))
 
     ref = curve(fine)
     points = []

@@ -18,6 +18,7 @@ import numpy as np  # noqa: E402
 
 import models  # noqa: E402
 import references  # noqa: E402
+from models.geometry import signed_inplane  # noqa: E402
 
 from .. import table1  # noqa: E402
 from ..checks import check_modules, run_checks  # noqa: E402
@@ -146,8 +147,7 @@ def section_table1(ctx):
 
 
 def _inplane(model, theta_i, x_deg, incident="unpolarized"):
-    x = np.radians(x_deg)
-    return model.polarization(theta_i, np.abs(x), np.where(x >= 0, 0.0, math.pi), incident=incident)
+    return model.polarization(theta_i, *signed_inplane(np.radians(x_deg)), incident=incident)
 
 
 def section_seed000(ctx):

@@ -21,6 +21,7 @@ from scipy import optimize as _opt  # noqa: E402
 import models  # noqa: E402
 import references  # noqa: E402
 from models.combination import mueller_with_error  # noqa: E402
+from models.geometry import signed_inplane  # noqa: E402
 from models.polarization import ellipsometric, stokes  # noqa: E402
 from references import presets_seed003  # noqa: E402
 
@@ -39,9 +40,8 @@ DEG = math.pi / 180.0
 
 
 def _signed(x_deg):
-    """Signed in-plane angle (deg) -> (|theta|, phi): positive forward (phi = 0), negative phi = pi."""
-    x = np.radians(np.asarray(x_deg, dtype=float))
-    return np.abs(x), np.where(x >= 0, 0.0, math.pi)
+    """Signed in-plane angle (deg) -> (theta_r, phi_r) (:func:`models.geometry.signed_inplane`)."""
+    return signed_inplane(np.radians(x_deg))
 
 
 # ----------------------------------------------------------------------------- seed 003 Fig. 1
