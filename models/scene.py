@@ -15,7 +15,7 @@ Schema (angles in degrees in files, as everywhere outside the Python API)::
     polarization = "linear:45"     # unpolarized | s | p | +45 | -45 | left | right | linear:<deg> | [I, Q, U, V]
     wavelength_nm = 632.8
     source = "collimated"          # collimated | point
-    distance_mm = 500.0            # point source: distance to the sample centre
+    distance_mm = 500.0            # point source: its height above the sample plane (seed 001's d)
     sample_radius_mm = 10.0        # point source: illuminated radius
 
     [coating]                      # optional clear layer over the substrate/flakes
@@ -110,7 +110,6 @@ class Scene:
     volume: dict | None
     detector: dict | None
     fit: dict | None = None
-    notes: tuple = field(default_factory=tuple)
     raw: dict = field(default_factory=dict, repr=False, compare=False)
 
     def get_value(self, key: str):
@@ -446,7 +445,6 @@ class Scene:
             _, why_source, why_aperture = self._build(tol)
             lines.append(f"  - source: {why_source}")
             lines.append(f"  - detector: {why_aperture}")
-        lines.extend(f"  note: {n}" for n in self.notes)
         return "\n".join(lines)
 
 
@@ -719,7 +717,6 @@ def from_dict(data: dict, path: str = "<scene>") -> Scene:
                 path, "[detector] aperture_deg", detector.get("aperture_deg", 0.0), 0.0, 90.0
             )
         }
-    notes = []
     return Scene(
         name=name,
         path=path,
@@ -734,7 +731,6 @@ def from_dict(data: dict, path: str = "<scene>") -> Scene:
         volume=volume,
         detector=detector,
         fit=data.get("fit"),
-        notes=tuple(notes),
         raw=copy.deepcopy(data),
     )
 

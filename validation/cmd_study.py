@@ -180,7 +180,6 @@ def _cmd_inversion(args) -> int:
     boot = bootstrap(inv, bins=args.bins, n=args.bootstrap, seed=args.seed)
     _, groups = _scan_x(data)
     col = collapse(inv, curve, groups)
-    true_norm = getattr(getattr(model, "slopes", None), "coverage", None)
     res = {
         "data": args.data,
         "scene": args.scene,
@@ -203,7 +202,7 @@ def _cmd_inversion(args) -> int:
         ax.semilogy(inv.zeta[s], inv.p3[s], ".", ms=4, label=g)
     zz = np.linspace(0, curve.zeta_max, 400)
     ax.semilogy(zz, curve(zz), "k-", lw=1, label="common curve (spline of ln P3)")
-    if true_norm is not None and hasattr(model.slopes, "p3"):
+    if hasattr(getattr(model, "slopes", None), "p3"):
         ax.semilogy(zz, model.slopes.p3(zz, 0 * zz), "r--", lw=0.8, label="scene's P3 (for reference)")
     ax.set_xlabel("facet slope |zeta|")
     ax.set_ylabel("P3 estimate")

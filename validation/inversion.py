@@ -85,7 +85,6 @@ class Inversion:
     zeta_x: np.ndarray
     zeta_y: np.ndarray
     p3: np.ndarray
-    p3_err: np.ndarray | None
 
     @property
     def zeta(self):
@@ -97,10 +96,10 @@ def invert(model, data) -> Inversion:
     K = unit_response(model, data)
     if np.any(K <= 0):
         bad = int(np.flatnonzero(K <= 0)[0])
-        raise ValueError(f"data row {bad}: the model connects no facet for this geometry (K = 0); mask it")
+        where = f"{data.path}:{data.lines[bad]}" if data.lines is not None else f"{data.path}: data row {bad}"
+        raise ValueError(f"{where}: the model connects no facet for this geometry (K = 0); mask it")
     zx, zy = probed_slopes(model, data.theta_i, data.theta_r, data.phi_r)
-    err = None if data.brdf_err is None else data.brdf_err / K
-    return Inversion(zx, zy, data.brdf / K, err)
+    return Inversion(zx, zy, data.brdf / K)
 
 
 @dataclass
@@ -185,7 +184,7 @@ def bootstrap(inv: Inversion, bins=None, n=200, seed=0):
     m = len(inv.p3)
     for _ in range(n):
         pick = rng.integers(0, m, m)
-        sub = Inversion(inv.zeta_x[pick], inv.zeta_y[pick], inv.p3[pick], None)
+        sub = Inversion(inv.zeta_x[pick], inv.zeta_y[pick], inv.p3[pick])
         try:
             norms.append(fit_curve(sub, bins).normalization)
         except ValueError:

@@ -92,7 +92,7 @@ class Likelihood:
         self.data_all = data
         self.mask = spec.mask(data)
         if not self.mask.any():
-            raise ValueError("mask: every data row is masked out; nothing to fit")
+            raise ValueError(f"{data.path}: mask: every data row is masked out; nothing to fit")
         self.data = data.subset(self.mask)
         d = self.data
         self._log_obs = np.log(d.brdf)
