@@ -14,9 +14,14 @@ check on its data sets.
 
 from __future__ import annotations
 
+import os
+import sys
+
+# the checkout's packages, not an installed copy, when run as ``python benchmarks/...``
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
 import argparse
 import math
-import os
 import time
 
 import numpy as np

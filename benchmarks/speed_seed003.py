@@ -14,8 +14,13 @@ against a 100000-pair reference, for 50 .. 20000 pairs.
 
 from __future__ import annotations
 
-import math
 import os
+import sys
+
+# the checkout's packages, not an installed copy, when run as ``python benchmarks/...``
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+import math
 import time
 
 import numpy as np

@@ -7,32 +7,28 @@ Table I's 27 integrals at <= 1e-4 absolute error in <= 1 s.
 
 import math
 
+from conftest import per_geometry
+
 import models
 from validation.table1 import compute_table1
-
-
-def _per_geometry(benchmark, n):
-    benchmark.extra_info["geometries"] = n
-    benchmark.extra_info["us_per_geometry_min"] = benchmark.stats.stats.min / n * 1e6
-    benchmark.extra_info["us_per_geometry_median"] = benchmark.stats.stats.median / n * 1e6
 
 
 def test_subsurface_facet_mueller_1e6(benchmark, geometries_1e6):
     m = models.SubsurfaceFacetBRDF(slopes=models.ExponentialSlopes(0.2), coating=1.5, substrate=1.37 + 7.62j)
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=5, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_facet_mueller_1e6(benchmark, geometries_1e6):
     m = models.FacetBRDF(slopes=models.GaussianSlopes(0.2), substrate=1.37 + 7.62j)
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=5, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_subsurface_facet_brdf_1e6(benchmark, geometries_1e6):
     m = models.SubsurfaceFacetBRDF(slopes=models.ExponentialSlopes(0.2), coating=1.5, substrate=math.inf)
     benchmark.pedantic(m.brdf, args=geometries_1e6, rounds=5, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_table1_27_integrals(benchmark):

@@ -10,38 +10,33 @@ point-source trade-off against the resolution knob is printed by
 import math
 
 import numpy as np
+from conftest import per_geometry
 
 import models
-
-
-def _per_geometry(benchmark, n):
-    benchmark.extra_info["geometries"] = n
-    benchmark.extra_info["us_per_geometry_min"] = benchmark.stats.stats.min / n * 1e6
-    benchmark.extra_info["us_per_geometry_median"] = benchmark.stats.stats.median / n * 1e6
 
 
 def test_cook_torrance_brdf_1e6(benchmark, geometries_1e6):
     m = models.CookTorranceBRDF(m=0.03, substrate=2.29 + 3.37j)
     benchmark.pedantic(m.brdf, args=geometries_1e6, rounds=5, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_varnished_brdf_1e6(benchmark, geometries_1e6):
     m = models.VarnishedCookTorranceBRDF(m_parallel=0.03, m_perpendicular=0.1, stroke_angle=0.3)
     benchmark.pedantic(m.brdf, args=geometries_1e6, rounds=5, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_varnished_isotropic_brdf_1e6(benchmark, geometries_1e6):
     m = models.VarnishedCookTorranceBRDF()
     benchmark.pedantic(m.brdf, args=geometries_1e6, rounds=5, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_cook_torrance_mueller_1e6(benchmark, geometries_1e6):
     m = models.CookTorranceBRDF(m=0.03, substrate=2.29 + 3.37j)
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def _grid():

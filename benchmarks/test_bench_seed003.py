@@ -10,33 +10,27 @@ prints the same numbers with ratios and the Monte Carlo error/cost vs pairs.
 import math
 
 import numpy as np
+from conftest import per_geometry
 
 import models
-
-
-def _per_geometry(benchmark, n):
-    benchmark.extra_info["geometries"] = n
-    if benchmark.stats is None:  # --benchmark-disable: the function ran once, no timing
-        return
-    benchmark.extra_info["us_per_geometry_min"] = benchmark.stats.stats.min / n * 1e6
 
 
 def test_diffuse_subsurface_mueller_1e6(benchmark, geometries_1e6):
     m = models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.93)
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_single_scatter_depolarizing_mueller_1e6(benchmark, geometries_1e6):
     m = models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3, polarized=False))
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_single_scatter_polarized_mueller_1e6(benchmark, geometries_1e6):
     m = models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3, polarized=True))
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
-    _per_geometry(benchmark, geometries_1e6[0].size)
+    per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def in_plane_curve():

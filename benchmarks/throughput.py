@@ -13,11 +13,15 @@ which shows the working memory is bounded by the chunk size.
 
 from __future__ import annotations
 
+import os
+import sys
+
+# the checkout's packages, not an installed copy, when run as ``python benchmarks/...``
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
 import argparse
 import json
-import os
 import subprocess
-import sys
 
 CHILD = r"""
 import json, math, resource, sys, time
@@ -71,7 +75,7 @@ def main():
     names = args.models or [c.__name__ for c in models.Model.registry if c is not models.Sum]
     # Monte Carlo (200 pairs per geometry here) and the point-source wrapper (512 inner
     # evaluations per geometry) cost 2-3 orders more per geometry: sizes up to 10^5.
-    heavy = {"RoughDiffuseBRDF", "PointSourceBRDF"}
+    heavy = {"RoughDiffuseBRDF", "PointSourceBRDF", "DetectorAperture"}  # 10-100 us per geometry
     print(f"{'model':<22} {'what':<12} {'N':>9} {'us/geom':>9} {'peak RSS MB':>12}")
     for name in names:
         for what in ("brdf", "iter_mueller"):
