@@ -28,7 +28,7 @@ import numpy as np
 
 from .base import Model
 from .params import param
-from .smooth_interface import interface_amplitudes, internal_hemispherical_reflectance
+from .smooth_interface import depolarized_between, interface_amplitudes, internal_hemispherical_reflectance
 
 __all__ = ["DiffuseSubsurfaceBRDF"]
 
@@ -60,23 +60,15 @@ class DiffuseSubsurfaceBRDF(Model):
         return (self.rho / math.pi) / (1.0 - self.rho * self.rbar)
 
     def _amps(self, ti, tr):
+        """Interface amplitudes ``(a_s, a_p)``, rows incidence then scattering."""
         _, _, a_s, a_p = interface_amplitudes(np.cos(np.stack([ti, tr])), self.n)
-        a2, b2 = a_s * a_s, a_p * a_p
-        S = 0.5 * (a2 + b2)  # (|t_s|^2 + |t_p|^2)/2 * cos'/cos, row i then row r
-        Dd = 0.5 * (a2 - b2)
-        return S, Dd
+        return a_s, a_p
 
     def _mueller16(self, ti, tr, pr):
-        (Si, Sr), (Di, Dr) = self._amps(ti, tr)
-        Sr = Sr * self._scale
-        Dr = Dr * self._scale
-        out = np.zeros((16, ti.size))
-        out[0] = Sr * Si
-        out[1] = Sr * Di
-        out[4] = Dr * Si
-        out[5] = Dr * Di
-        return out
+        (asi, asr), (api, apr) = self._amps(ti, tr)
+        return depolarized_between(asi, api, asr, apr, self._scale)
 
     def _brdf_flat(self, ti, tr, pr):
-        (Si, Sr), _ = self._amps(ti, tr)
-        return self._scale * Sr * Si
+        a_s, a_p = self._amps(ti, tr)
+        S = 0.5 * (a_s * a_s + a_p * a_p)  # (|t_s|^2 + |t_p|^2)/2 * cos'/cos, row i then row r
+        return self._scale * S[1] * S[0]

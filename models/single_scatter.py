@@ -37,7 +37,7 @@ from .base import Model
 from .params import param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
-from .smooth_interface import interface_amplitudes
+from .smooth_interface import depolarized_between, interface_amplitudes
 
 __all__ = ["SingleScatterBRDF"]
 
@@ -90,17 +90,7 @@ class SingleScatterBRDF(Model):
         if self.phase.polarized:
             return mueller16_from_jones(*self._jones_parts(ti, tr, pr))
         _, _, _, _, _, _, _, asi, asr, api, apr, K = self._parts(ti, tr, pr)
-        # D between the two transmissions: M(t_r)[:, 0] (x) M(t_i)[0, :] (Eq. 28 structure).
-        out = np.zeros((16, ti.size))
-        a, b = asr * asr, apr * apr
-        c, d = asi * asi, api * api
-        Sr, Dr = 0.5 * (a + b) * K, 0.5 * (a - b) * K
-        Si, Di = 0.5 * (c + d), 0.5 * (c - d)
-        out[0] = Sr * Si
-        out[1] = Sr * Di
-        out[4] = Dr * Si
-        out[5] = Dr * Di
-        return out
+        return depolarized_between(asi, api, asr, apr, K)  # a depolarizing phase between the crossings
 
     def _brdf_flat(self, ti, tr, pr):
         _, _, _, _, _, _, _, asi, asr, api, apr, K = self._parts(ti, tr, pr)

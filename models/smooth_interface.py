@@ -24,7 +24,7 @@ from scipy import integrate
 
 from .fresnel import fresnel_reflectance
 
-__all__ = ["interface_amplitudes", "internal_hemispherical_reflectance"]
+__all__ = ["interface_amplitudes", "internal_hemispherical_reflectance", "depolarized_between"]
 
 _TINY = 1e-300
 
@@ -43,6 +43,23 @@ def interface_amplitudes(cos_ext, n):
     a_s = root / np.maximum(c + n * c_int, _TINY)
     a_p = root / np.maximum(n * c + c_int, _TINY)
     return s_int, c_int, a_s, a_p
+
+
+def depolarized_between(a_s_in, a_p_in, a_s_out, a_p_out, scale):
+    """Mueller elements ``(16, n)`` of light transmitted in, fully depolarized, and transmitted
+    out: ``scale x M(t_out)[:, 0] (x) M(t_in)[0, :]`` (seed 003 Eq. 28's structure) from the
+    interface amplitudes (:func:`interface_amplitudes`) of the two crossings.  Only the
+    intensity and the linear s/p diattenuation survive (elements 00, 01, 10, 11)."""
+    a, b = a_s_out * a_s_out, a_p_out * a_p_out
+    c, d = a_s_in * a_s_in, a_p_in * a_p_in
+    s_out, d_out = 0.5 * (a + b) * scale, 0.5 * (a - b) * scale
+    s_in, d_in = 0.5 * (c + d), 0.5 * (c - d)
+    out = np.zeros((16,) + np.shape(s_in * s_out))
+    out[0] = s_out * s_in
+    out[1] = s_out * d_in
+    out[4] = d_out * s_in
+    out[5] = d_out * d_in
+    return out
 
 
 def internal_hemispherical_reflectance(n: float) -> float:
