@@ -37,7 +37,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Model
+from .fresnel import fresnel_reflectance
 from .params import param
+from .stroke_slopes import stroke_d
 
 __all__ = [
     "CookTorranceBRDF",
@@ -48,11 +50,6 @@ __all__ = [
 ]
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
-
-
-def _exp_neg(x):
-    """``exp(-x)`` for ``x >= 0``; exactly 0 beyond 700 (no underflow, no subnormals)."""
-    return np.exp(-np.minimum(x, 700.0)) * (x < 700.0)
 
 
 def fresnel_real(cos_i, n, k=0.0):
@@ -129,12 +126,11 @@ def _fs_fp(c, s2, root, a):
 
 
 def fresnel_average(cos_i, index):
-    """Natural-light reflectance ``F = (F_s + F_p) / 2`` (Eq. 17) of relative index ``index``."""
-    if index == math.inf:
-        return np.ones_like(np.asarray(cos_i, dtype=float))
-    z = complex(index)
-    fs, fp = fresnel_real(cos_i, z.real, z.imag)
-    return 0.5 * (fs + fp)
+    """Natural-light reflectance ``F = (F_s + F_p) / 2`` (Eq. 17) of relative index ``index``:
+    the shared complex Fresnel reflectances (:func:`models.fresnel.fresnel_reflectance`),
+    which the corrected real form :func:`fresnel_real` equals (checked in validate)."""
+    rs, rp = fresnel_reflectance(cos_i, 1.0, index)
+    return 0.5 * (rs + rp)
 
 
 def _grazing_safe(ti, tr):
@@ -174,15 +170,6 @@ def ct_kernel(ci, cr, cp, sp, d_fn, index, shadowing):
     return val
 
 
-def isotropic_d(m):
-    inv_m2 = 1.0 / (m * m)
-
-    def d_fn(hx, hy, hz2):
-        return _exp_neg((hx * hx + hy * hy) * inv_m2 / hz2) * inv_m2
-
-    return d_fn
-
-
 class _CookTorranceBase(Model):
     """Shared parts of the scalar Cook-Torrance models (depolarizing, M00 only)."""
 
@@ -199,7 +186,8 @@ class _CookTorranceBase(Model):
     def mueller(self, theta_i, theta_r, phi_r=0.0):
         """Mueller BRDF ``(..., 4, 4)``: the ideal depolarizer ``diag(f, 0, 0, 0)``
         with ``M00 = f`` the scalar BRDF.  The model is scalar (natural light,
-        Eq. 17): it predicts no polarization, so only ``M00`` carries information."""
+        Eq. 17): it predicts no polarization, so only ``M00`` carries information.
+        (Overridden for this docstring, which ``help(model.mueller)`` shows.)"""
         return super().mueller(theta_i, theta_r, phi_r)
 
 
@@ -234,7 +222,9 @@ class CookTorranceBRDF(_CookTorranceBase):
 
     def _brdf_flat(self, ti, tr, pr):
         ci, cr, live = _grazing_safe(ti, tr)
-        val = ct_kernel(ci, cr, np.cos(pr), np.sin(pr), isotropic_d(self.m), self.substrate, self.shadowing)
+        val = ct_kernel(
+            ci, cr, np.cos(pr), np.sin(pr), stroke_d(self.m, self.m, 0.0), self.substrate, self.shadowing
+        )
         scale = _INV_4PI if self.normalization == "energy" else 1.0
         val *= scale / (ci * cr)
         if live is not None:

@@ -35,13 +35,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .params import param
-from .slopes import SlopeDistribution
+from .slopes import SlopeDistribution, _exp_neg
 
 __all__ = ["StrokeSlopes", "stroke_d"]
-
-
-def _exp_neg(x):
-    return np.exp(-np.minimum(x, 700.0)) * (x < 700.0)
 
 
 def stroke_d(m_par, m_perp, stroke_angle):
