@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Model
+from .geometry import sp_basis
 from .params import param
 from .polarization import mueller16_from_jones
 from .slopes import GaussianSlopes, SlopeDistribution
@@ -61,14 +62,10 @@ def _cross(a, b):
 
 
 def ray_basis(k):
-    """``(s, p)`` of rays ``k`` given as ``(3, ...)`` arrays: ``s = unit(z x k)``, ``p = k x s``
-    (:func:`models.geometry.sp_basis`, with ``s = +y`` along the z axis)."""
-    sx, sy = -k[1], k[0]
-    norm = np.sqrt(sx * sx + sy * sy)
-    along = norm <= 1e-15
-    inv = 1.0 / np.where(along, 1.0, norm)
-    s = np.stack([np.where(along, 0.0, sx * inv), np.where(along, 1.0, sy * inv), np.zeros_like(norm)])
-    return s, _cross(k, s)
+    """``(s, p)`` of rays ``k`` given as ``(3, ...)`` arrays: :func:`models.geometry.sp_basis`
+    (``s = unit(z x k)``, ``p = k x s``, ``s = +y`` along the z axis) in this layout."""
+    s, p = sp_basis(np.moveaxis(k, 0, -1))
+    return np.moveaxis(s, -1, 0), np.moveaxis(p, -1, 0)
 
 
 def angle_basis(k, sx, sy):
