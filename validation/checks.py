@@ -200,14 +200,15 @@ def check_scatmech_facet():
 
 
 # ----------------------------------------------------------------------------- models
-def _random_geometries(n, seed=0, max_deg=89.0):
+def random_geometries(n, seed=0, max_deg=89.0):
+    """``n`` seeded random geometries, polar angles up to ``max_deg``, every azimuth."""
     rng = np.random.default_rng(seed)
     tmax = math.radians(max_deg)
     return rng.uniform(0, tmax, n), rng.uniform(0, tmax, n), rng.uniform(-math.pi, math.pi, n)
 
 
 def check_coating_one():
-    ti, tr, pr = _random_geometries(2000)
+    ti, tr, pr = random_geometries(2000)
     worst = 0.0
     for sub in (1.37 + 7.62j, 1.5, math.inf):
         s = models.GaussianSlopes(0.3)
@@ -234,7 +235,7 @@ def _facet_suite():
 
 
 def check_reciprocity():
-    ti, tr, pr = _random_geometries(400, seed=3)
+    ti, tr, pr = random_geometries(400, seed=3)
     worst = {"scalar": 0.0, "mueller": 0.0, "jones": 0.0}
     for m in _facet_suite():
         r = reciprocity_error(m, ti, tr, pr)
@@ -249,7 +250,7 @@ def check_reciprocity():
 
 
 def check_realizability():
-    ti, tr, pr = _random_geometries(2000, seed=5)
+    ti, tr, pr = random_geometries(2000, seed=5)
     worst = 0.0
     for m in _facet_suite():
         M = m.mueller(ti, tr, pr)
@@ -271,6 +272,27 @@ def extreme_geometries():
     return ti, tr, pr
 
 
+def count_extremes(models_, ti, tr, pr, jones=False):
+    """``(bad, warned, M)`` over models at the given geometries: non-finite Mueller (and
+    Jones) elements and negative M00 counted in ``bad``, floating-point warnings other than
+    gradual underflow in ``warned`` (a far tail underflowing to zero is the correct IEEE
+    result); ``M`` the last model's matrices."""
+    bad = warned = 0
+    Ms = []
+    for m in models_:
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
+                M = m.mueller(ti, tr, pr)
+                J = m.jones(ti, tr, pr) if jones else None
+        warned += len(w)
+        bad += int(np.sum(~np.isfinite(M))) + int(np.sum(M[..., 0, 0] < 0))
+        if J is not None:
+            bad += int(np.sum(~np.isfinite(J)))
+        Ms.append(M)
+    return bad, warned, Ms
+
+
 def extreme_models():
     out = []
     for sigma in (1e-4, 0.1, 5.0):
@@ -285,22 +307,9 @@ def extreme_models():
 
 def check_extremes():
     ti, tr, pr = extreme_geometries()
-    bad = 0
-    warned = 0
-    nonzero_grazing = 0
-    for m in extreme_models():
-        # Gradual underflow to zero is the correct IEEE result for far tails, so it
-        # is not counted; division by zero, overflow and invalid operations are.
-        with warnings.catch_warnings(record=True) as w:
-            warnings.simplefilter("always")
-            with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-                M = m.mueller(ti, tr, pr)
-                J = m.jones(ti, tr, pr)
-        warned += len(w)
-        bad += int(np.sum(~np.isfinite(M))) + int(np.sum(~np.isfinite(J)))
-        bad += int(np.sum(M[..., 0, 0] < 0))
-        grazing = (ti == math.pi / 2) | (tr == math.pi / 2)
-        nonzero_grazing += int(np.sum(M[grazing] != 0))
+    bad, warned, Ms = count_extremes(extreme_models(), ti, tr, pr, jones=True)
+    grazing = (ti == math.pi / 2) | (tr == math.pi / 2)
+    nonzero_grazing = sum(int(np.sum(M[grazing] != 0)) for M in Ms)
     total = bad + warned + nonzero_grazing
     return _le(
         "extremes: non-finite, negative M00, warnings",

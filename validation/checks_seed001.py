@@ -9,7 +9,6 @@ non-reciprocity and the iron-plate preset).  The helpers are shared with
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 
@@ -17,7 +16,8 @@ import models
 import references
 from models.cook_torrance import fresnel_real_printed
 
-from .checks import Check, _le, slope_normalization_errors
+from .checks import Check, _le, count_extremes, extreme_geometries, slope_normalization_errors
+from .checks import random_geometries as _geoms
 from .integrate import integrated_reflectance
 from .reciprocity import reciprocity_error, reversed_mueller
 
@@ -35,12 +35,6 @@ __all__ = [
 
 IRON = 2.29 + 3.37j
 SUBSTRATES = (IRON, 1.37 + 7.62j, 1.5, 3.88 + 0.02j, math.inf)
-
-
-def _geoms(n, seed=0, max_deg=89.0):
-    rng = np.random.default_rng(seed)
-    t = math.radians(max_deg)
-    return rng.uniform(0, t, n), rng.uniform(0, t, n), rng.uniform(-math.pi, math.pi, n)
 
 
 def _rel_where_both(a, b):
@@ -448,25 +442,11 @@ def extreme_seed001_models():
     return out
 
 
-def extreme_geometries_seed001():
-    d = math.radians
-    t = np.array([0.0, 1e-9, d(30), d(60), d(89.99), math.pi / 2])
-    ti, tr = (a.ravel() for a in np.meshgrid(t, t, indexing="ij"))
-    phis = np.array([0.0, math.pi, -math.pi, math.pi / 2, 1e-12])
-    return np.repeat(ti, len(phis)), np.repeat(tr, len(phis)), np.tile(phis, len(t) ** 2)
-
-
 def extremes_count():
-    ti, tr, pr = extreme_geometries_seed001()
-    bad = warned = 0
-    for m in extreme_seed001_models():
-        with warnings.catch_warnings(record=True) as w:
-            warnings.simplefilter("always")
-            with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-                M = m.mueller(ti, tr, pr)
-        warned += len(w)
-        bad += int(np.sum(~np.isfinite(M))) + int(np.sum(M[..., 0, 0] < 0))
-    return bad, warned, len(extreme_seed001_models()) * len(ti)
+    ti, tr, pr = extreme_geometries()
+    ms = extreme_seed001_models()
+    bad, warned, _ = count_extremes(ms, ti, tr, pr)
+    return bad, warned, len(ms) * len(ti)
 
 
 def check_extremes():

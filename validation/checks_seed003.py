@@ -9,7 +9,6 @@ convergence and error scaling, reciprocity, energy and extremes.
 from __future__ import annotations
 
 import math
-import warnings
 from functools import cache, lru_cache
 
 import numpy as np
@@ -20,7 +19,7 @@ import references
 from models.polarization import reciprocal_mueller
 from models.smooth_interface import internal_hemispherical_reflectance
 
-from .checks import Check, _le
+from .checks import Check, _le, count_extremes, random_geometries
 from .energy_seed003 import grid_reflectance
 from .fig1_seed003 import SIGMAS, fig1
 from .integrate import integrated_reflectance
@@ -358,17 +357,10 @@ def check_mc_scaling():
 
 
 # ----------------------------------------------------------------------------- reciprocity
-def _random_geometries(n, seed=3):
-    rng = np.random.default_rng(seed)
-    return (
-        rng.uniform(0, math.radians(88), n),
-        rng.uniform(0, math.radians(88), n),
-        rng.uniform(-math.pi, math.pi, n),
-    )
 
 
 def deterministic_reciprocity():
-    ti, tr, pr = _random_geometries(400)
+    ti, tr, pr = random_geometries(400, seed=3, max_deg=88.0)
     worst = {}
     for m in (
         models.MaxwellBeardBRDF(
@@ -547,14 +539,7 @@ def check_extremes_seed003():
             )
         )
     ms.append(models.RoughDiffuseBRDF(slopes=models.GaussianSlopes(0.3), n=1.0, rho=0.0, pairs=50))
-    bad = warned = 0
-    for m in ms:
-        with warnings.catch_warnings(record=True) as w:
-            warnings.simplefilter("always")
-            with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-                M = m.mueller(ti, tr, pr)
-        warned += len(w)
-        bad += int(np.sum(~np.isfinite(M))) + int(np.sum(M[..., 0, 0] < 0))
+    bad, warned, _ = count_extremes(ms, ti, tr, pr)
     return _le(
         "seed 003 extremes: non-finite, negative M00, warnings",
         bad + warned,
