@@ -20,11 +20,11 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 import references  # noqa: E402
 from models import scene  # noqa: E402
-from validation.datafile import load_data  # noqa: E402
-from validation.executors import make_executor  # noqa: E402
-from validation.fitspec import fitspec_from  # noqa: E402
-from validation.likelihood import Likelihood  # noqa: E402
-from validation.sampling import initial_ball, optimize, run_chain, summarize  # noqa: E402
+from validation.fitting.datafile import load_data  # noqa: E402
+from validation.fitting.executors import make_executor  # noqa: E402
+from validation.fitting.fitspec import fitspec_from  # noqa: E402
+from validation.fitting.likelihood import Likelihood  # noqa: E402
+from validation.fitting.sampling import initial_ball, optimize, run_chain, summarize  # noqa: E402
 
 
 def main():

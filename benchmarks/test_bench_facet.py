@@ -10,7 +10,7 @@ import math
 from conftest import per_geometry
 
 import models
-from validation.table1 import compute_table1
+from validation.checks.table1 import compute_table1
 
 
 def test_subsurface_facet_mueller_1e6(benchmark, geometries_1e6):

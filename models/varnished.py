@@ -17,7 +17,7 @@ Normalizations as for :class:`models.CookTorranceBRDF`: ``published`` is Eq. 24
 as printed, ``energy`` divides by ``4 pi``.
 
 What Eq. 24 leaves out (measured against :class:`models.SubsurfaceFacetBRDF`,
-see ``validation.checks_seed001``):
+see ``validation.checks.seed001``):
 
 * the solid-angle Jacobian of refraction.  Radiance crossing into a medium of
   index ``n_v`` is multiplied by ``n_v^2`` (``L / n^2`` is invariant), and the

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import references
-from validation.datafile import DataFileError, load_data, write_data
+from validation.fitting.datafile import DataFileError, load_data, write_data
 
 SCATMECH = references.data_path("scatmech_flake_measurement.csv")
 HEAD = "theta_i_deg,theta_r_deg,phi_r_deg,brdf,incident\n"

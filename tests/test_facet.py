@@ -8,9 +8,9 @@ import pytest
 
 import models
 import references
-from validation.checks import extreme_geometries, extreme_models, scatmech_facet_errors
-from validation.flat import flat_coated_reflectance
-from validation.integrate import integrated_reflectance
+from validation.checks.seed000 import extreme_geometries, extreme_models, scatmech_facet_errors
+from validation.numerics.flat import flat_coated_reflectance
+from validation.numerics.integrate import integrated_reflectance
 
 
 def test_scatmech_reference_set_is_broad():

@@ -10,13 +10,13 @@ import pytest
 import references
 from models import scene
 from validation.cli import main
-from validation.datafile import load_data
-from validation.executors import DaskExecutor, ProcessExecutor, SerialExecutor
-from validation.fit import run_fit
-from validation.fitspec import FitSpecError, fitspec_from, parse_free
-from validation.likelihood import Likelihood
-from validation.recovery import subsample
-from validation.sampling import CheckpointError, initial_ball, optimize, run_chain
+from validation.fitting.datafile import load_data
+from validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor
+from validation.fitting.fit import run_fit
+from validation.fitting.fitspec import FitSpecError, fitspec_from, parse_free
+from validation.fitting.likelihood import Likelihood
+from validation.fitting.recovery import subsample
+from validation.fitting.sampling import CheckpointError, initial_ball, optimize, run_chain
 
 SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
 COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
@@ -75,7 +75,7 @@ def test_scene_fit_table_and_log_prior_bounds():
 def test_masks_near_specular_and_boxes(coated, data):
     spec = fitspec_from(coated, ["sigma:0.01:1:log"], ["brdf=0.05"], near_specular_deg=5.0)
     keep = spec.mask(data)
-    from validation.fitspec import specular_distance
+    from validation.fitting.fitspec import specular_distance
 
     d = np.degrees(specular_distance(data.theta_i, data.theta_r, data.phi_r))
     assert np.array_equal(keep, d > 5.0) and 0 < (~keep).sum() < 40

@@ -8,8 +8,8 @@ import pytest
 
 import models
 from models.base import Model
-from validation.energy import exposed_reflectance
-from validation.integrate import gauss_kronrod_15, integrated_reflectance
+from validation.numerics.energy import exposed_reflectance
+from validation.numerics.integrate import gauss_kronrod_15, integrated_reflectance
 
 
 @dataclass(frozen=True)
@@ -102,7 +102,7 @@ def test_anisotropic_uses_full_azimuth():
     assert not m.mirror_symmetric
     r = integrated_reflectance(m, 0.3, tol=1e-5)
     # perfect conductor, modest angle: every illuminated facet reflects upward -> close to H
-    from validation.energy import hit_fraction
+    from validation.numerics.energy import hit_fraction
 
     assert r.value <= hit_fraction(s, 0.3) + r.error
     assert r.value > 0.99

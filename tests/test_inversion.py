@@ -11,9 +11,9 @@ import models
 import references
 from models import scene
 from validation.cli import main
-from validation.datafile import Dataset, load_data
-from validation.inversion import UnitSlopes, bootstrap, fit_curve, invert, probed_slopes
-from validation.likelihood import scene_for_data
+from validation.fitting.datafile import Dataset, load_data
+from validation.fitting.inversion import UnitSlopes, bootstrap, fit_curve, invert, probed_slopes
+from validation.fitting.likelihood import scene_for_data
 
 DATA = references.data_path("scatmech_flake_measurement.csv")
 COATED = os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 import models
 from models.polarization import coherency_eigenvalues
-from validation.reciprocity import reciprocity_error
+from validation.numerics.reciprocity import reciprocity_error
 
 angle = st.floats(0.0, math.radians(89.99))
 azimuth = st.floats(-2 * math.pi, 2 * math.pi)

@@ -7,8 +7,8 @@ import numpy as np
 
 import models
 from models.base import Model
-from validation.checks import _facet_suite
-from validation.reciprocity import reciprocity_error
+from validation.checks.seed000 import _facet_suite
+from validation.numerics.reciprocity import reciprocity_error
 
 
 def test_facet_models_are_reciprocal(rng):

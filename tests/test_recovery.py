@@ -9,12 +9,12 @@ import pytest
 import references
 from models import scene
 from validation.cli import main
-from validation.compare import compare_fits, seed003_pairing
-from validation.datafile import load_data
-from validation.executors import ProcessExecutor
-from validation.fitspec import fitspec_from
-from validation.likelihood import Likelihood
-from validation.recovery import recovery_study, subsample
+from validation.fitting.compare import compare_fits, seed003_pairing
+from validation.fitting.datafile import load_data
+from validation.fitting.executors import ProcessExecutor
+from validation.fitting.fitspec import fitspec_from
+from validation.fitting.likelihood import Likelihood
+from validation.fitting.recovery import recovery_study, subsample
 
 SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
 COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")

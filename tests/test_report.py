@@ -8,7 +8,7 @@ import re
 import pytest
 
 import models.facet
-from validation.checks import check_table1
+from validation.checks.seed000 import check_table1
 from validation.report import build_report, nightly
 
 

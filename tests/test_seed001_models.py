@@ -8,10 +8,10 @@ import pytest
 
 import models
 from models.cook_torrance import fresnel_real_printed
-from validation import checks_seed001 as c
-from validation.energy import exposed_reflectance
-from validation.integrate import integrated_reflectance
-from validation.reciprocity import reciprocity_error
+from validation.checks import seed001 as c
+from validation.numerics.energy import exposed_reflectance
+from validation.numerics.integrate import integrated_reflectance
+from validation.numerics.reciprocity import reciprocity_error
 
 IRON = 2.29 + 3.37j
 
@@ -123,7 +123,7 @@ def test_energy_blinn_albedo_at_most_one(m):
 
 @pytest.mark.parametrize("m", [0.03, 0.3])
 def test_energy_no_shadowing_integral_matches_slope_space(m):
-    """The integrator with the model's lobe hint against validation.energy's slope-space form."""
+    """The integrator with the model's lobe hint against validation.numerics.energy's slope-space form."""
     for ti in (0.2, 1.0):
         r = integrated_reflectance(
             models.CookTorranceBRDF(m=m, normalization="energy", shadowing="none"), ti, tol=1e-5

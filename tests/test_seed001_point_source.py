@@ -7,8 +7,8 @@ import pytest
 
 import models
 import references
-from validation import checks_seed001 as c
-from validation.reciprocity import reciprocity_error
+from validation.checks import seed001 as c
+from validation.numerics.reciprocity import reciprocity_error
 
 BASE = models.VarnishedCookTorranceBRDF(normalization="energy")
 

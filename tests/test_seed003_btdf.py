@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import models
-from validation import checks_seed003 as c3
-from validation.fig1_seed003 import effective_index, peak_angle
-from validation.integrate import integrated_reflectance
+from validation.checks import seed003 as c3
+from validation.checks.fig1 import effective_index, peak_angle
+from validation.numerics.integrate import integrated_reflectance
 
 
 def test_scatmech_btdf():

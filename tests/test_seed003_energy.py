@@ -6,8 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import models
-from validation import checks_seed003 as c3
-from validation.integrate import integrated_reflectance
+from validation.checks import seed003 as c3
+from validation.numerics.integrate import integrated_reflectance
 
 
 @settings(max_examples=10, deadline=None)

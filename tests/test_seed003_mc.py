@@ -7,7 +7,7 @@ import pytest
 
 import models
 from references import presets_seed003
-from validation import checks_seed003 as c3
+from validation.checks import seed003 as c3
 
 KW = dict(slopes=models.ExponentialSlopes(0.5), n=1.5, phase=models.HenyeyGreenstein(0.3), rho=0.3)
 G = c3._GEOM

@@ -7,8 +7,8 @@ import pytest
 from scipy import integrate
 
 import models
-from validation import checks_seed003 as c3
-from validation.integrate import integrated_reflectance
+from validation.checks import seed003 as c3
+from validation.numerics.integrate import integrated_reflectance
 
 
 @pytest.mark.parametrize("g", [-0.95, -0.5, 0.0, 0.3, 0.8, 0.95])

@@ -9,7 +9,7 @@ import pytest
 import models
 from models.base import Model
 from models.params import param
-from validation.stability import classify, edge_geometries, edge_instances, load_accepted, sweep
+from validation.studies.stability import classify, edge_geometries, edge_instances, load_accepted, sweep
 
 
 @pytest.fixture(scope="module")

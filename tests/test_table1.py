@@ -3,7 +3,7 @@
 import pytest
 
 import references
-from validation.table1 import compute_table1, format_table1
+from validation.checks.table1 import compute_table1, format_table1
 
 
 @pytest.fixture(scope="module")

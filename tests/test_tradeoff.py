@@ -7,7 +7,7 @@ import pytest
 
 from validation.atomic import atomic_write_json
 from validation.cli import main
-from validation.tradeoff import Point, choose, pareto, study
+from validation.studies.tradeoff import Point, choose, pareto, study
 
 
 @pytest.fixture(scope="module")

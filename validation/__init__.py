@@ -3,7 +3,7 @@
 ``validation`` may import ``models``; ``models`` never imports ``validation``.
 """
 
-from .integrate import IntegralResult, integrated_reflectance
-from .reciprocity import ReciprocityResult, reciprocity_error
+from .numerics.integrate import IntegralResult, integrated_reflectance
+from .numerics.reciprocity import ReciprocityResult, reciprocity_error
 
 __all__ = ["IntegralResult", "integrated_reflectance", "ReciprocityResult", "reciprocity_error"]

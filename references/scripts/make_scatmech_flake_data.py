@@ -132,7 +132,7 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=20261122)
     args = ap.parse_args(argv)
     sys.path.insert(0, ROOT)
-    from validation.datafile import write_data
+    from validation.fitting.datafile import write_data
 
     model = BRDF_Model(
         "Subsurface_Facet_BRDF_Model",

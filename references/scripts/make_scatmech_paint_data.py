@@ -127,7 +127,7 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=20261123)
     args = ap.parse_args(argv)
     sys.path.insert(0, ROOT)
-    from validation.datafile import write_data
+    from validation.fitting.datafile import write_data
 
     version = metadata.version("pySCATMECH")
     when = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d")

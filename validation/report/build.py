@@ -9,7 +9,8 @@ import sys
 import time
 import traceback
 
-from ..atomic import atomic_write_json, atomic_write_text
+from validation.atomic import atomic_write_json, atomic_write_text
+
 from .core import Context, Section, render_html
 from .sections import SECTION_FUNCS, _git_commit
 

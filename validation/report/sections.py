@@ -19,11 +19,11 @@ import numpy as np  # noqa: E402
 import models  # noqa: E402
 import references  # noqa: E402
 from models.geometry import signed_inplane  # noqa: E402
+from validation.checks import table1  # noqa: E402
+from validation.checks.seed000 import check_modules, run_checks  # noqa: E402
+from validation.numerics.integrate import integrated_reflectance  # noqa: E402
+from validation.numerics.reciprocity import reciprocity_error, reversed_mueller  # noqa: E402
 
-from .. import table1  # noqa: E402
-from ..checks import check_modules, run_checks  # noqa: E402
-from ..integrate import integrated_reflectance  # noqa: E402
-from ..reciprocity import reciprocity_error, reversed_mueller  # noqa: E402
 from .core import Section, checks_block, figure_block, table_block, text_block  # noqa: E402
 
 __all__ = ["SECTION_FUNCS"]
@@ -35,7 +35,7 @@ def _checks(ctx):
     if "checks" not in ctx.cache:
         funcs = ctx.cache.get("check_funcs")
         if funcs is None:
-            from ..checks import all_checks
+            from validation.checks.seed000 import all_checks
 
             funcs = all_checks()
             if ctx.quick:
@@ -237,7 +237,7 @@ def _default_models():
     """One instance per model class: its defaults, or the stability sweep's
     representative base (the point-source wrapper around Cook-Torrance, the Monte
     Carlo model at 200 pairs)."""
-    from ..stability import _BASES
+    from validation.studies.stability import _BASES
 
     out = []
     for cls in models.Model.registry:
@@ -332,7 +332,7 @@ def section_conservation(ctx):
 
 
 def section_scatmech(ctx):
-    from ..checks import scatmech_facet_errors
+    from validation.checks.seed000 import scatmech_facet_errors
 
     s = Section("scatmech", "Agreement with SCATMECH")
     errs = {f"{k} (committed)": v for k, v in scatmech_facet_errors().items()}
@@ -401,7 +401,7 @@ def _live_scatmech(ctx):
 
 
 def section_speed(ctx):
-    from ..tradeoff import pareto, study
+    from validation.studies.tradeoff import pareto, study
 
     s = Section("speed", "Speed and accuracy")
     results = study(quick=ctx.quick)
@@ -464,7 +464,7 @@ def section_speed(ctx):
 
 
 def section_stability(ctx):
-    from ..stability import classify, sweep
+    from validation.studies.stability import classify, sweep
 
     s = Section("stability", "Stability sweep at the extremes")
     found = sweep(energy=not ctx.quick)

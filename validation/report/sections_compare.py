@@ -1,6 +1,6 @@
 """Report section: seed 003's combination against Maxwell-Beard on the same data (issue 6 item 8).
 
-Both hypotheses are fitted (emcee, :func:`validation.compare.seed003_pairing`)
+Both hypotheses are fitted (emcee, :func:`validation.fitting.compare.seed003_pairing`)
 to two held-out SCATMECH data sets, one made by each hypothesis's generator,
 once with every likelihood term (BRDF, eta, P, P_C) and once with the BRDF
 alone; the page shows the information criteria, the fitted speckle level
@@ -76,7 +76,7 @@ def _figure(case):
 
 
 def section_model_comparison(ctx):
-    from ..compare import SEED003_PAIRING, seed003_pairing
+    from validation.fitting.compare import SEED003_PAIRING, seed003_pairing
 
     s = Section("model_comparison", "Model comparison: seed 003's combination against Maxwell-Beard")
     st = _settings(ctx.quick)

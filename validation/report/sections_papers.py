@@ -1,8 +1,8 @@
 """Report sections reproducing the papers' figures and the uncertainty study (issue 7).
 
 Every number is computed by the run, from the models and the analyses that
-already exist (:mod:`validation.fig1_seed003`, :mod:`validation.checks_seed001`,
-:mod:`references.presets_seed003`, :mod:`validation.fit`, :mod:`validation.recovery`).
+already exist (:mod:`validation.checks.fig1`, :mod:`validation.checks.seed001`,
+:mod:`references.presets_seed003`, :mod:`validation.fitting.fit`, :mod:`validation.fitting.recovery`).
 """
 
 from __future__ import annotations
@@ -24,8 +24,8 @@ from models.combination import mueller_with_error  # noqa: E402
 from models.geometry import signed_inplane  # noqa: E402
 from models.polarization import ellipsometric, stokes  # noqa: E402
 from references import presets_seed003  # noqa: E402
+from validation.numerics.integrate import integrated_reflectance  # noqa: E402
 
-from ..integrate import integrated_reflectance  # noqa: E402
 from .core import Section, figure_block, table_block, text_block  # noqa: E402
 
 __all__ = [
@@ -46,8 +46,8 @@ def _signed(x_deg):
 
 # ----------------------------------------------------------------------------- seed 003 Fig. 1
 def section_seed003_fig1(ctx):
-    from ..checks_seed003 import fig1_rows
-    from ..fig1_seed003 import N_INDEX, SIGMAS, THETA_I, mean_transmitted_angle
+    from validation.checks.fig1 import N_INDEX, SIGMAS, THETA_I, mean_transmitted_angle
+    from validation.checks.seed003 import fig1_rows
 
     s = Section("seed003_fig1", "Seed 003 Fig. 1 reproduced: Snell shift of facet transmission")
     rows = [dict(r) for r in fig1_rows()]  # the analysis of validation/fig1_seed003.py (cached)
@@ -281,7 +281,7 @@ def section_seed003_presets(ctx):
 
 # ----------------------------------------------------------------------------- seed 001
 def section_seed001(ctx):
-    from ..checks_seed001 import (
+    from validation.checks.seed001 import (
         _pair,
         point_source_collimated_error,
         published_albedos,
@@ -379,7 +379,7 @@ def section_seed001(ctx):
             "varnish_ratio",
             list(vrows[0]),
             vrows,
-            caption="ratio maps summarized (validation/checks_seed001.varnish_ratio_map)",
+            caption="ratio maps summarized (validation.checks.seed001.varnish_ratio_map)",
         )
     )
     # --- point source vs collimated, iron plate
@@ -435,7 +435,7 @@ def section_seed001(ctx):
             list(crow[0]),
             crow,
             caption="point source -> collimated as the source recedes (energy-normalized iron plate, theta_i = 17 deg, "
-            "in-plane 0..60 deg, exact method, resolution 8; validation/checks_seed001.point_source_collimated_error)",
+            "in-plane 0..60 deg, exact method, resolution 8; validation.checks.seed001.point_source_collimated_error)",
             fmt={"max |f_point - f_collimated| / max f": ".3e"},
         )
     )
@@ -490,12 +490,11 @@ def _recovery_settings(quick):
 
 def section_uncertainty(ctx):
     from models import scene as scene_mod
-
-    from ..datafile import load_data
-    from ..fit import corner_figure, predictive, predictive_figure, run_fit, write_fit
-    from ..fitspec import fitspec_from
-    from ..likelihood import Likelihood
-    from ..recovery import recovery_study
+    from validation.fitting.datafile import load_data
+    from validation.fitting.fit import corner_figure, predictive, predictive_figure, run_fit, write_fit
+    from validation.fitting.fitspec import fitspec_from
+    from validation.fitting.likelihood import Likelihood
+    from validation.fitting.recovery import recovery_study
 
     s = Section("uncertainty", "Uncertainty: an example posterior and the recovery coverage")
     scene_path = os.path.join(os.path.dirname(references.__file__), "scenes", FIT_SCENE)
@@ -609,7 +608,7 @@ def section_uncertainty(ctx):
     rs = _recovery_settings(ctx.quick)
     rsc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
     rspec = fitspec_from(rsc, rs["free"], rs["noise"])
-    from ..executors import make_executor
+    from validation.fitting.executors import make_executor
 
     with make_executor(rs.get("workers", 1), None) as ex:  # identical results on any executor (tested)
         cells = recovery_study(

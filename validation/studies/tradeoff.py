@@ -6,7 +6,7 @@ an independent higher-accuracy reference (never an extrapolation):
 
 * ``integration tolerance``: the integrated reflectance at ``tol`` in
   1e-2 .. 1e-8, against the slope-space prediction of
-  :mod:`validation.energy` (an exposed facet surface) — a different algorithm,
+  :mod:`validation.numerics.energy` (an exposed facet surface) — a different algorithm,
   not the same integrator at a tighter tolerance;
 * ``in-plane grid``: an in-plane BRDF curve sampled on ``k`` points and linearly
   interpolated, against the model evaluated on a 20001-point grid (max relative
@@ -29,9 +29,8 @@ import numpy as np
 
 import models
 from models.geometry import signed_inplane
-
-from .energy import exposed_reflectance
-from .integrate import integrated_reflectance
+from validation.numerics.energy import exposed_reflectance
+from validation.numerics.integrate import integrated_reflectance
 
 __all__ = ["Point", "KnobResult", "register_knob", "KNOBS", "study", "pareto", "choose"]
 
@@ -91,7 +90,7 @@ def knob_integration(quick=False):
     return KnobResult(
         "integration tolerance",
         "integrated reflectance, FacetBRDF(exponential sigma 0.1, aluminium), 60 deg",
-        "slope-space integral (validation.energy.exposed_reflectance)",
+        "slope-space integral (validation.numerics.energy.exposed_reflectance)",
         points,
     )
 

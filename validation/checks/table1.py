@@ -3,7 +3,7 @@
 Each of the 27 entries is the integrated reflectance of
 :class:`models.SubsurfaceFacetBRDF` (exponential slopes, ``theta_i = 60 deg``)
 for unpolarized light.  The ``sigma = 0.0`` column is the flat-interface limit:
-its value is the closed form :func:`validation.flat.flat_coated_reflectance`,
+its value is the closed form :func:`validation.numerics.flat.flat_coated_reflectance`,
 shown beside the integral at ``sigma = 1e-3`` (the limit approached by the
 model itself).  Every entry is compared with
 
@@ -26,9 +26,8 @@ from dataclasses import asdict, dataclass
 
 import models
 import references
-
-from .flat import flat_coated_reflectance
-from .integrate import integrated_reflectance
+from validation.numerics.flat import flat_coated_reflectance
+from validation.numerics.integrate import integrated_reflectance
 
 __all__ = ["Table1Row", "compute_table1", "format_table1", "THETA_I"]
 

@@ -375,7 +375,7 @@ def write_data(path, columns: dict, meta: dict | None = None, comments=()):
     for ``incident``, to a list of strings.  Numbers are written with 17
     significant digits so a round trip is exact.
     """
-    from .atomic import atomic_write_json, atomic_write_text
+    from validation.atomic import atomic_write_json, atomic_write_text
 
     names = list(columns)
     for n in names:

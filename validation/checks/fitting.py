@@ -20,7 +20,7 @@ import models
 import references
 from models.geometry import signed_inplane
 
-from .checks import Check
+from .seed000 import Check
 
 __all__ = ["CHECKS"]
 
@@ -36,7 +36,7 @@ def _synthetic(model):
         ]
     )
     inc = np.tile([1.0, 0.0, 1.0, 0.0], (len(g), 1))
-    from .datafile import Dataset
+    from validation.fitting.datafile import Dataset
 
     b = np.einsum("nij,nj->ni", model.mueller(g[:, 0], g[:, 1], g[:, 2]), inc)[:, 0]
     k = b > 0
@@ -44,7 +44,7 @@ def _synthetic(model):
 
 
 def check_inversion_round_trip():
-    from .inversion import fit_curve, invert
+    from validation.fitting.inversion import fit_curve, invert
 
     out = []
     for slopes in (models.ExponentialSlopes(0.1), models.GaussianSlopes(0.15, coverage=0.8)):
@@ -79,12 +79,11 @@ class _Crash:
 
 def check_resume_identity():
     from models import scene
-
-    from .datafile import load_data
-    from .fitspec import fitspec_from
-    from .likelihood import Likelihood
-    from .recovery import subsample
-    from .sampling import initial_ball, run_chain
+    from validation.fitting.datafile import load_data
+    from validation.fitting.fitspec import fitspec_from
+    from validation.fitting.likelihood import Likelihood
+    from validation.fitting.recovery import subsample
+    from validation.fitting.sampling import initial_ball, run_chain
 
     sc = scene.load(
         os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")

@@ -18,12 +18,12 @@ import models
 import references
 from models.polarization import reciprocal_mueller
 from models.smooth_interface import internal_hemispherical_reflectance
+from validation.numerics.grid import grid_reflectance
+from validation.numerics.integrate import integrated_reflectance
+from validation.numerics.reciprocity import reciprocity_error
 
-from .checks import Check, _le, count_extremes, random_geometries
-from .energy_seed003 import grid_reflectance
-from .fig1_seed003 import SIGMAS, fig1
-from .integrate import integrated_reflectance
-from .reciprocity import reciprocity_error
+from .fig1 import SIGMAS, fig1
+from .seed000 import Check, _le, count_extremes, random_geometries
 
 __all__ = ["CHECKS", "SECTIONS", "scatmech_seed003_errors"]
 

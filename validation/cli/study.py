@@ -1,9 +1,9 @@
 """``scatterbench study recovery | inversion | compare``: uncertainty studies.
 
 * ``recovery``: injection-recovery coverage, bias and width versus noise level
-  and number of geometries (:mod:`validation.recovery`).
-* ``inversion``: slope distribution from measured BRDF (:mod:`validation.inversion`).
-* ``compare``: several scenes fitted to the same data (:mod:`validation.compare`).
+  and number of geometries (:mod:`validation.fitting.recovery`).
+* ``inversion``: slope distribution from measured BRDF (:mod:`validation.fitting.inversion`).
+* ``compare``: several scenes fitted to the same data (:mod:`validation.fitting.compare`).
 
 Each writes JSON and PNG into ``--out`` (refused when it exists and is not
 empty, unless ``--force``).
@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from .cmd_fit import _executor_args, _load_and_describe, _mcmc_args, _mcmc_kwargs, _out_ok, _spec_args
+from .fit import _executor_args, _load_and_describe, _mcmc_args, _mcmc_kwargs, _out_ok, _spec_args
 
 __all__ = ["register"]
 
@@ -33,9 +33,9 @@ def _ints(text):
 
 # ----------------------------------------------------------------------------- recovery
 def _cmd_recovery(args) -> int:
-    from .atomic import atomic_write_json
-    from .executors import make_executor
-    from .recovery import recovery_study
+    from validation.atomic import atomic_write_json
+    from validation.fitting.executors import make_executor
+    from validation.fitting.recovery import recovery_study
 
     if not _out_ok(args.out, args.force, None):
         return 2
@@ -106,7 +106,7 @@ def _recovery_plot(cells, out):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .atomic import atomic_savefig
+    from validation.atomic import atomic_savefig
 
     keys = list(cells[0]["summary"])
     fig, axes = plt.subplots(3, len(keys), figsize=(4.5 * len(keys), 8), squeeze=False)
@@ -148,13 +148,12 @@ def _cmd_inversion(args) -> int:
 
     from models import DetectorAperture
     from models import scene as scene_mod
-
-    from .atomic import atomic_savefig, atomic_write_json
-    from .datafile import load_data
-    from .fit import _scan_x
-    from .fitspec import FitSpec, parse_exclude
-    from .inversion import bootstrap, collapse, fit_curve, invert
-    from .likelihood import scene_for_data
+    from validation.atomic import atomic_savefig, atomic_write_json
+    from validation.fitting.datafile import load_data
+    from validation.fitting.fit import _scan_x
+    from validation.fitting.fitspec import FitSpec, parse_exclude
+    from validation.fitting.inversion import bootstrap, collapse, fit_curve, invert
+    from validation.fitting.likelihood import scene_for_data
 
     if not _out_ok(args.out, args.force, None):
         return 2
@@ -231,13 +230,12 @@ def _cmd_inversion(args) -> int:
 # ----------------------------------------------------------------------------- compare
 def _cmd_compare(args) -> int:
     from models import scene as scene_mod
-
-    from .atomic import atomic_write_json
-    from .compare import compare_fits, format_comparison
-    from .datafile import load_data
-    from .executors import make_executor
-    from .fitspec import fitspec_from
-    from .likelihood import Likelihood
+    from validation.atomic import atomic_write_json
+    from validation.fitting.compare import compare_fits, format_comparison
+    from validation.fitting.datafile import load_data
+    from validation.fitting.executors import make_executor
+    from validation.fitting.fitspec import fitspec_from
+    from validation.fitting.likelihood import Likelihood
 
     if not _out_ok(args.out, args.force, None):
         return 2

@@ -10,7 +10,7 @@ __all__ = ["main"]
 
 
 def _cmd_validate(args) -> int:
-    from .checks import all_sections, format_checks, run_checks
+    from validation.checks.seed000 import all_sections, format_checks, run_checks
 
     t0 = time.perf_counter()
     results = run_checks()
@@ -26,7 +26,7 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_table1(args) -> int:
-    from .table1 import compute_table1, format_table1
+    from validation.checks.table1 import compute_table1, format_table1
 
     rows, seconds = compute_table1(tol=args.tol)
     print(format_table1(rows))
@@ -35,7 +35,7 @@ def _cmd_table1(args) -> int:
 
 
 def _cmd_stability(args) -> int:
-    from .stability import classify, format_sweep, sweep
+    from validation.studies.stability import classify, format_sweep, sweep
 
     t0 = time.perf_counter()
     findings = sweep(energy=not args.no_energy)
@@ -53,8 +53,8 @@ def _cmd_tradeoff(args) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .atomic import atomic_savefig, atomic_write_json
-    from .tradeoff import choose, pareto, study
+    from validation.atomic import atomic_savefig, atomic_write_json
+    from validation.studies.tradeoff import choose, pareto, study
 
     results = study(quick=args.quick)
     os.makedirs(args.out, exist_ok=True)
@@ -97,8 +97,7 @@ def _cmd_tradeoff(args) -> int:
 
 def _cmd_scene(args) -> int:
     from models import scene as scene_mod
-
-    from .scene_eval import write_scene_outputs
+    from validation.studies.scenes import write_scene_outputs
 
     try:
         sc = scene_mod.load(args.file)
@@ -161,20 +160,7 @@ def main(argv=None) -> int:
 
 
 def _command_modules():
-    """``validation.cmd_*`` modules: each defines ``register(subparsers)`` adding its
-    subcommands (with ``set_defaults(func=...)``), so features add commands without
-    editing this file."""
-    import importlib
-    import pkgutil
+    """The command modules besides this one: each defines ``register(subparsers)``."""
+    from . import fit, report, study
 
-    import validation
-
-    mods = []
-    for info in sorted(pkgutil.iter_modules(validation.__path__), key=lambda i: i.name):
-        if info.name.startswith("cmd_"):
-            mods.append(importlib.import_module(f"validation.{info.name}"))
-    return mods
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    return [fit, report, study]

@@ -186,7 +186,7 @@ def _scan_x(data):
 
 def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", plots=True, n_draws=200):
     """Write posterior.json and the plots into ``out`` (atomic writes)."""
-    from .atomic import atomic_write_json
+    from validation.atomic import atomic_write_json
 
     os.makedirs(out, exist_ok=True)
     pp = predictive(fit, n_draws=n_draws, seed=fit.settings["seed"])
@@ -298,7 +298,7 @@ def _plots(fit, pp, out):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .atomic import atomic_savefig
+    from validation.atomic import atomic_savefig
 
     spec = fit.spec
     fig = corner_figure(fit)

@@ -1,4 +1,4 @@
-"""``scatterbench fit`` (the study commands are in :mod:`validation.cmd_study`).
+"""``scatterbench fit`` (the study commands are in :mod:`validation.cli.study`).
 
 Output folders are refused when they exist and are not empty, unless
 ``--force`` (replace the results; files are replaced atomically, so a failed
@@ -70,10 +70,9 @@ def _mcmc_args(p, walkers=32, max_steps=20000):
 
 def _load(args):
     from models import scene as scene_mod
-
-    from .datafile import load_data
-    from .fitspec import fitspec_from
-    from .likelihood import Likelihood
+    from validation.fitting.datafile import load_data
+    from validation.fitting.fitspec import fitspec_from
+    from validation.fitting.likelihood import Likelihood
 
     sc = scene_mod.load(args.scene)
     data = load_data(args.data)
@@ -118,8 +117,8 @@ def _mcmc_kwargs(args):
 
 
 def _cmd_fit(args) -> int:
-    from .executors import make_executor
-    from .fit import run_fit, write_fit
+    from validation.fitting.executors import make_executor
+    from validation.fitting.fit import run_fit, write_fit
 
     if not _out_ok(args.out, args.force, args.resume):
         return 2

@@ -6,7 +6,7 @@ import os
 
 
 def _report(args) -> int:
-    from .report import write_report
+    from validation.report import write_report
 
     res = write_report(args.out, quick=args.quick)
     s = res["summary"]
@@ -18,7 +18,7 @@ def _report(args) -> int:
 
 
 def _nightly(args) -> int:
-    from .report import nightly
+    from validation.report import nightly
 
     code, regressions, run_dir = nightly(args.history, quick=args.quick)
     print(f"nightly run written to {run_dir}; latest -> {os.path.relpath(run_dir, args.history)}")

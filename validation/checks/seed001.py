@@ -15,11 +15,11 @@ import numpy as np
 import models
 import references
 from models.cook_torrance import fresnel_real_printed
+from validation.numerics.integrate import integrated_reflectance
+from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 
-from .checks import Check, _le, count_extremes, extreme_geometries, slope_normalization_errors
-from .checks import random_geometries as _geoms
-from .integrate import integrated_reflectance
-from .reciprocity import reciprocity_error, reversed_mueller
+from .seed000 import Check, _le, count_extremes, extreme_geometries, slope_normalization_errors
+from .seed000 import random_geometries as _geoms
 
 __all__ = [
     "CHECKS",
@@ -477,7 +477,7 @@ def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_
 
 def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     """``{d: max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak}`` for the
-    varnished iron plate, R = 1 (the reversed path from :mod:`validation.reciprocity`)."""
+    varnished iron plate, R = 1 (the reversed path from :mod:`validation.numerics.reciprocity`)."""
     base = models.VarnishedCookTorranceBRDF(normalization="energy")
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.4, (2, n))

@@ -34,7 +34,7 @@ import emcee
 import numpy as np
 from scipy import optimize as _opt
 
-from .atomic import atomic_write_bytes
+from validation.atomic import atomic_write_bytes
 
 __all__ = [
     "optimize",
@@ -60,7 +60,7 @@ class CheckpointError(ValueError):
 
 # ---------------------------------------------------------------------------- optimum
 def optimize(lik, seed, n_starts=4, start=None):
-    """Maximum of the log posterior ``lik(u)`` (a :class:`~validation.likelihood.Likelihood`).
+    """Maximum of the log posterior ``lik(u)`` (a :class:`~validation.fitting.likelihood.Likelihood`).
 
     Returns ``(u_best, log_post_best, info)``.  Starts: ``start`` (default the
     scene's values, clipped into the bounds; free noise terms at the middle of

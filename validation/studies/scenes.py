@@ -17,8 +17,7 @@ import numpy as np
 
 from models.geometry import signed_inplane
 from models.polarization import ellipsometric
-
-from .atomic import atomic_savefig, atomic_write_text
+from validation.atomic import atomic_savefig, atomic_write_text
 
 __all__ = ["scan", "write_scene_outputs"]
 
@@ -49,7 +48,7 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None):
 
 
 def choose_settings(scene, tol):
-    """Settings for ``tol`` from the measured speed/accuracy curves (validation.tradeoff).
+    """Settings for ``tol`` from the measured speed/accuracy curves (validation.studies.tradeoff).
 
     Returns ``(model, n_inplane, notes)``: the cheapest in-plane grid, Monte Carlo
     pair count and point-source resolution whose *measured* error meets ``tol``

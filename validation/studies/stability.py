@@ -38,10 +38,9 @@ import numpy as np
 import models
 from models.params import Declared
 from models.polarization import coherency_eigenvalues
-
-from .energy import hit_fraction
-from .integrate import integrated_reflectance
-from .reciprocity import reciprocity_error
+from validation.numerics.energy import hit_fraction
+from validation.numerics.integrate import integrated_reflectance
+from validation.numerics.reciprocity import reciprocity_error
 
 __all__ = [
     "Finding",
