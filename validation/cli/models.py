@@ -1,0 +1,17 @@
+"""``scatterbench models``: every model with its declared parameters."""
+
+from __future__ import annotations
+
+__all__ = ["register"]
+
+
+def _cmd_models(args) -> int:
+    import models
+
+    print(models.list_models())
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser("models", help="list the models and their declared parameters")
+    p.set_defaults(func=_cmd_models)

@@ -1,0 +1,24 @@
+"""``scatterbench stability``: every model at the extremes of its parameters and geometries."""
+
+from __future__ import annotations
+
+import time
+
+__all__ = ["register"]
+
+
+def _cmd_stability(args) -> int:
+    from validation.studies.stability import classify, format_sweep, sweep
+
+    t0 = time.perf_counter()
+    findings = sweep(energy=not args.no_energy)
+    print(format_sweep(findings))
+    print(f"stability sweep finished in {time.perf_counter() - t0:.1f} s")
+    _, bad = classify(findings)
+    return 1 if bad else 0
+
+
+def register(sub):
+    p = sub.add_parser("stability", help="sweep every model at its extremes; exit 1 on unaccepted findings")
+    p.add_argument("--no-energy", action="store_true", help="skip the integrated-reflectance checks")
+    p.set_defaults(func=_cmd_stability)

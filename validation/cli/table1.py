@@ -1,0 +1,20 @@
+"""``scatterbench table1``: seed 000 Table I beside the printed values."""
+
+from __future__ import annotations
+
+__all__ = ["register"]
+
+
+def _cmd_table1(args) -> int:
+    from validation.checks.table1 import compute_table1, format_table1
+
+    rows, seconds = compute_table1(tol=args.tol)
+    print(format_table1(rows))
+    print(f"27 entries in {seconds:.2f} s (tol {args.tol:g})")
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser("table1", help="seed 000 Table I beside the printed values")
+    p.add_argument("--tol", type=float, default=1e-4, help="absolute integration tolerance")
+    p.set_defaults(func=_cmd_table1)
