@@ -150,9 +150,22 @@ def integrated_reflectance(
     if not (0.0 <= theta_i <= math.pi / 2):
         raise ValueError(f"theta_i must lie in [0, pi/2] radians; got {theta_i!r}")
     s_in = np.asarray(stokes(incident), dtype=float)
-    polarized = bool(np.any(s_in[1:] != 0))
     if symmetric is None:
         symmetric = bool(getattr(model, "mirror_symmetric", False)) and s_in[2] == 0 and s_in[3] == 0
+    f = _integrand(model, theta_i, s_in)
+    rects = _initial_rectangles(model.lobe(theta_i) if hasattr(model, "lobe") else None, symmetric)
+    factor = 2.0 if symmetric else 1.0
+    # the half-range integral is doubled, and so is its error
+    value, error, evals, converged = _adaptive(f, rects, tol / factor, max_evaluations)
+    return IntegralResult(
+        value=factor * value, error=factor * error, evaluations=int(evals), converged=converged
+    )
+
+
+def _integrand(model, theta_i, s_in):
+    """The integrand over ``t = sin^2(theta_r)`` and ``phi``: the scattered intensity
+    times ``cos(tr) sin(tr) dtr dphi = dt dphi / 2``."""
+    polarized = bool(np.any(s_in[1:] != 0))
 
     def f(t, phi):
         th = np.arcsin(np.sqrt(np.clip(t, 0.0, 1.0)))
@@ -161,9 +174,14 @@ def integrated_reflectance(
             v = (M[..., 0, :] @ s_in) / s_in[0]
         else:
             v = model.brdf(theta_i, th, phi)
-        return 0.5 * v  # cos(tr) sin(tr) dtr dphi = dt dphi / 2
+        return 0.5 * v
 
-    lobe = model.lobe(theta_i) if hasattr(model, "lobe") else None
+    return f
+
+
+def _initial_rectangles(lobe, symmetric):
+    """``(R, 4)`` rectangles ``(t0, t1, phi0, phi1)``: a coarse grid, refined towards a
+    narrow lobe (``(theta_c, phi_c, width)``) so the adaptive rule cannot miss it."""
     phi_lo, phi_hi = (0.0, math.pi) if symmetric else (-math.pi, math.pi)
     if lobe is not None:
         tc, pc, w = lobe
@@ -178,62 +196,61 @@ def integrated_reflectance(
         pb = np.linspace(phi_lo, phi_hi, 9)
     t0, p0 = np.meshgrid(tb[:-1], pb[:-1], indexing="ij")
     t1, p1 = np.meshgrid(tb[1:], pb[1:], indexing="ij")
-    rects = np.stack([t0.ravel(), t1.ravel(), p0.ravel(), p1.ravel()], axis=1)
+    return np.stack([t0.ravel(), t1.ravel(), p0.ravel(), p1.ravel()], axis=1)
 
-    def evaluate(r):
-        a, b, c, d = r.T
-        ht = 0.5 * (b - a)
-        hp = 0.5 * (d - c)
-        tt = (0.5 * (a + b))[:, None] + ht[:, None] * _X[None, :]
-        pp = (0.5 * (c + d))[:, None] + hp[:, None] * _X[None, :]
-        vals = f(tt[:, :, None], pp[:, None, :])  # (R, 15, 15)
-        area = ht * hp
-        kk = np.einsum("rij,i,j->r", vals, _WKF, _WKF) * area
-        gg = np.einsum("rij,i,j->r", vals, _WGF, _WGF) * area
-        et = np.abs(np.einsum("rij,i,j->r", vals, _WKF - _WGF, _WKF)) * area
-        ep = np.abs(np.einsum("rij,i,j->r", vals, _WKF, _WKF - _WGF)) * area
-        return kk, np.abs(kk - gg), et, ep, vals.size
 
-    factor = 2.0 if symmetric else 1.0
-    goal = tol / factor  # the half-range integral is doubled, and so is its error
-    kk, err, et, ep, evals = evaluate(rects)
-    converged = False
+def _evaluate(f, r):
+    """Tensor Gauss-Kronrod on each rectangle: Kronrod value, |Kronrod - Gauss| error,
+    the error along t and along phi (which direction to bisect), evaluations."""
+    a, b, c, d = r.T
+    ht = 0.5 * (b - a)
+    hp = 0.5 * (d - c)
+    tt = (0.5 * (a + b))[:, None] + ht[:, None] * _X[None, :]
+    pp = (0.5 * (c + d))[:, None] + hp[:, None] * _X[None, :]
+    vals = f(tt[:, :, None], pp[:, None, :])  # (R, 15, 15)
+    area = ht * hp
+    kk = np.einsum("rij,i,j->r", vals, _WKF, _WKF) * area
+    gg = np.einsum("rij,i,j->r", vals, _WGF, _WGF) * area
+    et = np.abs(np.einsum("rij,i,j->r", vals, _WKF - _WGF, _WKF)) * area
+    ep = np.abs(np.einsum("rij,i,j->r", vals, _WKF, _WKF - _WGF)) * area
+    return kk, np.abs(kk - gg), et, ep, vals.size
+
+
+def _bisected(r, et, ep):
+    """Both halves of each rectangle, cut across the direction that carries more error."""
+    along_t = et >= ep
+    mt = 0.5 * (r[:, 0] + r[:, 1])
+    mp = 0.5 * (r[:, 2] + r[:, 3])
+    c1 = r.copy()
+    c2 = r.copy()
+    c1[along_t, 1] = mt[along_t]
+    c2[along_t, 0] = mt[along_t]
+    c1[~along_t, 3] = mp[~along_t]
+    c2[~along_t, 2] = mp[~along_t]
+    return np.concatenate([c1, c2])
+
+
+def _adaptive(f, rects, goal, max_evaluations):
+    """Bisect the rectangles carrying half of the error until the summed error estimate
+    meets ``goal`` or the evaluation budget is spent: ``(value, error, evals, converged)``."""
+    kk, err, et, ep, evals = _evaluate(f, rects)
     while True:
         total_err = float(err.sum())
         if total_err <= goal:
-            converged = True
-            break
+            return float(kk.sum()), total_err, evals, True
         if evals >= max_evaluations:
-            break
-        # Bisect the rectangles that together carry half of the error.
+            return float(kk.sum()), total_err, evals, False
         order = np.argsort(err)[::-1]
         cum = np.cumsum(err[order])
         nsplit = int(np.searchsorted(cum, 0.5 * (total_err - 0.5 * goal))) + 1
         split = order[:nsplit]
         keep = np.ones(len(rects), bool)
         keep[split] = False
-        r = rects[split]
-        along_t = et[split] >= ep[split]
-        mt = 0.5 * (r[:, 0] + r[:, 1])
-        mp = 0.5 * (r[:, 2] + r[:, 3])
-        c1 = r.copy()
-        c2 = r.copy()
-        c1[along_t, 1] = mt[along_t]
-        c2[along_t, 0] = mt[along_t]
-        c1[~along_t, 3] = mp[~along_t]
-        c2[~along_t, 2] = mp[~along_t]
-        children = np.concatenate([c1, c2])
-        k2, e2, et2, ep2, n2 = evaluate(children)
+        children = _bisected(rects[split], et[split], ep[split])
+        k2, e2, et2, ep2, n2 = _evaluate(f, children)
         evals += n2
         rects = np.concatenate([rects[keep], children])
         kk = np.concatenate([kk[keep], k2])
         err = np.concatenate([err[keep], e2])
         et = np.concatenate([et[keep], et2])
         ep = np.concatenate([ep[keep], ep2])
-    value = float(kk.sum())
-    return IntegralResult(
-        value=factor * float(value),
-        error=factor * float(total_err),
-        evaluations=int(evals),
-        converged=converged,
-    )
