@@ -507,14 +507,9 @@ def section_stability(ctx):
 
 
 def _git_commit():
-    try:
-        here = os.path.dirname(os.path.abspath(__file__))
-        r = subprocess.run(
-            ["git", "-C", here, "rev-parse", "--short", "HEAD"], capture_output=True, text=True, timeout=5
-        )
-        return r.stdout.strip() or "unknown"
-    except (OSError, subprocess.SubprocessError):
-        return "unknown"
+    from .provenance import git_commit
+
+    return git_commit()
 
 
 def section_scenes(ctx):
