@@ -49,6 +49,8 @@ __all__ = [
     "sweep",
     "load_accepted",
     "classify",
+    "FindingGroup",
+    "group_findings",
     "format_sweep",
 ]
 
@@ -363,21 +365,41 @@ def classify(findings, accepted=None):
     return ok, bad
 
 
-def format_sweep(findings, accepted=None) -> str:
+@dataclass(frozen=True)
+class FindingGroup:
+    """The findings of one model and kind that share one verdict: how many, the worst
+    (largest magnitude) with its parameters and geometry, and the accepted reason (None:
+    unaccepted)."""
+
+    model: str
+    kind: str
+    count: int
+    worst: Finding
+    reason: str | None
+
+
+def group_findings(findings, accepted=None) -> list[FindingGroup]:
+    """Findings grouped by (model, kind, reason), unaccepted groups first."""
     ok, bad = classify(findings, accepted)
-    lines = []
     groups = {}
     for f, reason in ok + bad:
-        key = (f.model, f.kind, reason)
-        groups.setdefault(key, []).append(f)
-    lines.append(f"{'model':<22} {'kind':<13} {'count':>5} {'worst':>11}  status")
-    lines.append("-" * 70)
-    for (model, kind, reason), fs in sorted(groups.items(), key=lambda kv: (kv[0][2] is not None, kv[0][:2])):
-        worst = max(fs, key=lambda f: abs(f.value))
-        status = "ACCEPTED" if reason else "UNACCEPTED"
-        lines.append(f"{model:<22} {kind:<13} {len(fs):>5} {worst.value:>11.4g}  {status}")
-        lines.append(f"    e.g. {worst.params} at {worst.where}")
-        if reason:
-            lines.append(f"    reason: {reason}")
-    lines.append(f"{len(findings)} findings: {len(ok)} accepted, {len(bad)} unaccepted")
+        groups.setdefault((f.model, f.kind, reason), []).append(f)
+    out = [
+        FindingGroup(model, kind, len(fs), max(fs, key=lambda f: abs(f.value)), reason)
+        for (model, kind, reason), fs in groups.items()
+    ]
+    return sorted(out, key=lambda g: (g.reason is not None, g.model, g.kind))
+
+
+def format_sweep(findings, accepted=None) -> str:
+    groups = group_findings(findings, accepted)
+    lines = [f"{'model':<22} {'kind':<13} {'count':>5} {'worst':>11}  status", "-" * 70]
+    for g in groups:
+        status = "ACCEPTED" if g.reason else "UNACCEPTED"
+        lines.append(f"{g.model:<22} {g.kind:<13} {g.count:>5} {g.worst.value:>11.4g}  {status}")
+        lines.append(f"    e.g. {g.worst.params} at {g.worst.where}")
+        if g.reason:
+            lines.append(f"    reason: {g.reason}")
+    n_bad = sum(g.count for g in groups if g.reason is None)
+    lines.append(f"{len(findings)} findings: {len(findings) - n_bad} accepted, {n_bad} unaccepted")
     return "\n".join(lines)
