@@ -34,9 +34,20 @@ __all__ = ["CheckpointBackend", "CheckpointError", "FORMAT"]
 
 FORMAT = "scatterbench-chain/2"
 
-#: the arrays of a checkpoint file besides ``format`` and ``fingerprint``
-_ENTRIES = ("chain", "log_prob", "accepted", "rs_name", "rs_keys", "rs_pos", "rs_has_gauss", "rs_cached")
-_ENTRIES += ("tau_history", "seconds")
+#: what a checkpoint file holds besides ``format`` (the random state is numpy's MT19937 tuple, ``rs_*``)
+_ENTRIES = (
+    "fingerprint",
+    "chain",
+    "log_prob",
+    "accepted",
+    "rs_name",
+    "rs_keys",
+    "rs_pos",
+    "rs_has_gauss",
+    "rs_cached",
+    "tau_history",
+    "seconds",
+)
 
 
 class CheckpointError(ValueError):
@@ -155,7 +166,8 @@ class CheckpointBackend(emcee.backends.Backend):
                 f"inconsistent shapes: chain {chain.shape}, log_prob {log_prob.shape}, accepted {accepted.shape}"
             )
         self.reset(nwalkers, ndim)
-        self.chain, self.log_prob, self.accepted = chain.astype(float), log_prob.astype(float), accepted
+        self.chain, self.log_prob = chain.astype(self.dtype), log_prob.astype(self.dtype)
+        self.accepted = accepted.astype(self.dtype)
         self.iteration = steps
         rs = (
             str(e["rs_name"]),
@@ -185,7 +197,7 @@ def _read(path) -> dict:
         raise CheckpointError(
             f"{path}: a checkpoint of {made}; this version resumes {FORMAT!r} only: start a new run"
         )
-    missing = [k for k in ("fingerprint",) + _ENTRIES if k not in entries]
+    missing = [k for k in _ENTRIES if k not in entries]
     if missing:
         raise CheckpointError(f"{path}: a corrupt checkpoint (missing {', '.join(missing)}); start a new run")
     entries["fingerprint"] = str(entries["fingerprint"])

@@ -1,9 +1,10 @@
 """A fit from data file + scene + spec to a posterior: optimum, chain, summary, checks, plots.
 
-``run_fit`` does the work (no files except the checkpoint); ``write_fit`` writes
-``posterior.json``, ``chain.npz`` (the resumable checkpoint: chain, log
-posterior, acceptance counts, last ensemble and the sampler's random state) and
-the plots ``corner.png``, ``predictive.png``, ``residuals.png``.
+``run_fit`` does the work (no files except the resumable checkpoint, a
+:class:`~validation.fitting.checkpoint.CheckpointBackend`: chain, log posterior,
+acceptance counts, the sampler's random state, tau history; ``scatterbench fit``
+keeps it as ``chain.npz``); ``write_fit`` writes ``posterior.json`` and the
+plots ``corner.png``, ``predictive.png``, ``residuals.png``.
 """
 
 from __future__ import annotations
@@ -106,11 +107,9 @@ def run_fit(
     else:
         backend = CheckpointBackend(checkpoint, fp)
     u_opt, lp_opt, info = optimize(lik, settings.seed, n_starts=settings.starts)
-    p0 = (
-        None
-        if resume
-        else initial_ball(u_opt, settings.walkers, settings.seed, lik.spec.u_bounds(), sd=info["sd_u"])
-    )
+    p0 = None
+    if not resume:
+        p0 = initial_ball(u_opt, settings.walkers, settings.seed, lik.spec.u_bounds(), sd=info["sd_u"])
     chain = run_chain(lik, settings, p0=p0, backend=backend, executor=executor, progress=progress)
     optimum = {
         "values": lik.spec.physical(u_opt),
