@@ -93,13 +93,17 @@ def _load(args):
 
 
 def _load_and_describe(args):
-    """``_load`` for a command: prints the scene and fit spec, or the error (then ``None``)."""
+    """The chain settings from the flags and ``_load``'s inputs, ``(settings, scene, data,
+    spec, likelihood)``, with the scene and fit spec printed; or ``None`` after printing
+    the error."""
+    settings = _chain_settings(args)
+    if settings is None:
+        return None
     try:
-        loaded = _load(args)
+        sc, data, spec, lik = _load(args)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return None
-    sc, data, spec, lik = loaded
     if lik.scene is not sc:
         print(
             f"detector: the data's sidecar records aperture_deg = {lik.scene.aperture_deg:g} "
@@ -107,7 +111,7 @@ def _load_and_describe(args):
         )
     print(lik.scene.describe())
     print(spec.describe())
-    return loaded
+    return settings, sc, data, spec, lik
 
 
 def _chain_settings(args):
@@ -203,11 +207,10 @@ def _print_posterior(post):
 def _cmd_fit(args) -> int:
     if not _out_ok(args.out, args.force, args.resume):
         return 2
-    settings = _chain_settings(args)
-    loaded = None if settings is None else _load_and_describe(args)
+    loaded = _load_and_describe(args)
     if loaded is None:
         return 2
-    _, data, _, lik = loaded
+    settings, _, data, _, lik = loaded
     print(
         f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
     )

@@ -60,11 +60,10 @@ def _cmd_recovery(args) -> int:
 
     if not _out_ok(args.out, args.force, None):
         return 2
-    settings = _chain_settings(args)
-    loaded = None if settings is None else _load_and_describe(args)
+    loaded = _load_and_describe(args)
     if loaded is None:
         return 2
-    sc, data, spec, _ = loaded
+    settings, sc, data, spec, _ = loaded
     extra = {k: v for k, v in spec.noise.items() if k != "brdf"}
     try:
         check_inputs(spec, settings, extra)
