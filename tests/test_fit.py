@@ -370,6 +370,8 @@ def test_fit_and_studies_refuse_bad_settings_and_unusable_checkpoints_without_a_
              "--injections", "1", "--out", str(tmp_path / "rec")]  # fmt: skip
     assert main(study + two) == 2
     assert "walkers must be even and >= 2 x free parameters (4); got 2" in capsys.readouterr().err
+    assert main(study[:-4] + ["--injections", "0"] + study[-2:]) == 2
+    assert capsys.readouterr().err == "error: injections must be an integer >= 1; got 0\n"
     assert main(study + ["--check-every", "0"]) == 2
     assert capsys.readouterr().err == "error: check_every must be an integer >= 1; got 0\n"
 

@@ -66,7 +66,7 @@ def _cmd_recovery(args) -> int:
     settings, sc, data, spec, _ = loaded
     extra = {k: v for k, v in spec.noise.items() if k != "brdf"}
     try:
-        check_inputs(spec, settings, extra)
+        check_inputs(spec, settings, extra, args.injections)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -149,10 +149,10 @@ def coverage_table(results, keys):
     return out
 
 
-def check_inputs(spec, chain, noise_extra=None):
+def check_inputs(spec, chain, noise_extra=None, injections=1):
     """Raise ``ValueError`` unless a study of ``spec`` can run: enough walkers for its free
-    parameters, and a level to simulate with (its truth) for every free polarization
-    noise level.
+    parameters, a level to simulate with (its truth) for every free polarization noise
+    level, at least one injection per cell.
 
     Parameters
     ----------
@@ -160,7 +160,11 @@ def check_inputs(spec, chain, noise_extra=None):
     chain : ChainSettings
     noise_extra : dict, optional
         Fixed levels of polarization terms.
+    injections : int
+        Members per cell, >= 1.
     """
+    if isinstance(injections, bool) or not isinstance(injections, int) or injections < 1:
+        raise ValueError(f"injections must be an integer >= 1; got {injections!r}")
     chain.require_walkers(len(spec.free))
     missing = [
         p.key
@@ -265,7 +269,7 @@ def recovery_study(
     """
     from .executors import SerialExecutor
 
-    check_inputs(spec, chain, noise_extra)
+    check_inputs(spec, chain, noise_extra, injections)
     cells, members = [], []
     for ci, (lvl, ng) in enumerate((lv, g) for lv in noise_levels for g in n_geometries):
         d, cell_spec, truth, noise = _cell(scene, spec, data, lvl, ng, noise_extra)
