@@ -461,7 +461,9 @@ def _fit_settings(quick, seed):
     return ChainSettings(seed=seed)  # scatterbench fit's defaults: 32 walkers, 20000 steps, 4 starts
 
 
-def _recovery_settings(quick):
+def _recovery_settings(quick, seed):
+    from validation.fitting.settings import ChainSettings
+
     if quick:  # the configuration of tests/test_recovery.py
         return dict(
             free=["sigma:0.01:1:log"],
@@ -469,7 +471,7 @@ def _recovery_settings(quick):
             noise_levels=(0.1,),
             n_geometries=(8,),
             injections=50,
-            chain=dict(walkers=4, max_steps=150, check_every=150, starts=1),
+            chain=ChainSettings(walkers=4, seed=seed, max_steps=150, check_every=150, starts=1),
         )
     # Two correlated parameters, 16 walkers run to N > 50 tau, on both cores: the same study over 4
     # cells (8 and 32 geometries) took 1315 s on a loaded machine; the 8-geometry cells are the cheaper half.
@@ -479,7 +481,7 @@ def _recovery_settings(quick):
         noise_levels=(0.05, 0.1),
         n_geometries=(8,),
         injections=50,
-        chain=dict(walkers=16, max_steps=4000, check_every=100, starts=1),
+        chain=ChainSettings(walkers=16, seed=seed, max_steps=4000, check_every=100, starts=1),
         workers=2,
     )
 
@@ -601,13 +603,12 @@ def section_uncertainty(ctx):
         )
     )
     # --- recovery study
-    rs = _recovery_settings(ctx.quick)
+    rs = _recovery_settings(ctx.quick, ctx.seed)
     rsc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
     rspec = fitspec_from(rsc, rs["free"], rs["noise"])
     from validation.fitting.executors import make_executor
-    from validation.fitting.settings import ChainSettings
 
-    rchain = ChainSettings(seed=ctx.seed, **rs["chain"])
+    rchain = rs["chain"]
     with make_executor(rs.get("workers", 1), None) as ex:  # identical results on any executor (tested)
         cells = recovery_study(
             rsc,
