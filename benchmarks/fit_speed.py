@@ -25,6 +25,7 @@ from validation.fitting.executors import make_executor  # noqa: E402
 from validation.fitting.fitspec import fitspec_from  # noqa: E402
 from validation.fitting.likelihood import Likelihood  # noqa: E402
 from validation.fitting.sampling import initial_ball, optimize, run_chain, summarize  # noqa: E402
+from validation.fitting.settings import ChainSettings  # noqa: E402
 
 
 def main():
@@ -42,17 +43,16 @@ def main():
         ["eta_deg=1", "P=0.02", "P_C=0.02"],
     )
     lik = Likelihood(sc, spec, data)
+    settings = ChainSettings(walkers=32, seed=args.seed, max_steps=20000, check_every=100, tau_factor=50)
     t0 = time.perf_counter()
-    u0, _, info = optimize(lik, args.seed)
+    u0, _, info = optimize(lik, settings.seed, n_starts=settings.starts)
     t_opt = time.perf_counter() - t0
-    p0 = initial_ball(u0, 32, args.seed, spec.u_bounds(), sd=info["sd_u"])
+    p0 = initial_ball(u0, settings.walkers, settings.seed, spec.u_bounds(), sd=info["sd_u"])
     with make_executor(args.workers) as ex:
-        res = run_chain(
-            lik, p0=p0, seed=args.seed, max_steps=20000, check_every=100, tau_factor=50, executor=ex
-        )
+        res = run_chain(lik, settings, p0=p0, executor=ex)
         desc = ex.describe()
     s = summarize(res, spec)["sampling"]
-    print(f"executor: {desc}; {len(data)} data points, 3 free parameters, 32 walkers")
+    print(f"executor: {desc}; {len(data)} data points, 3 free parameters, {settings.walkers} walkers")
     print(f"least-squares optimum: {t_opt:.2f} s")
     print(f"{res.stop_reason}")
     print(

@@ -16,7 +16,14 @@ from validation.fitting.fit import run_fit
 from validation.fitting.fitspec import FitSpecError, fitspec_from, parse_free
 from validation.fitting.likelihood import Likelihood
 from validation.fitting.recovery import subsample
-from validation.fitting.sampling import CheckpointError, initial_ball, optimize, run_chain
+from validation.fitting.sampling import (
+    ChainSettings,
+    CheckpointBackend,
+    CheckpointError,
+    initial_ball,
+    optimize,
+    run_chain,
+)
 
 SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
 COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
@@ -138,46 +145,148 @@ def test_resume_after_interruption_gives_the_same_chain_bit_for_bit(coated, data
     lik = _small(coated, data)
     u0, _, _ = optimize(lik, 7, n_starts=1)
     p0 = initial_ball(u0, 8, 7, lik.spec.u_bounds())
-    kw = dict(seed=7, max_steps=60, check_every=20, tau_factor=50)
-    full = run_chain(lik, p0=p0, checkpoint=str(tmp_path / "a.npz"), fingerprint="f", **kw)
+    st = ChainSettings(walkers=8, seed=7, max_steps=60, check_every=20, tau_factor=50)
+    full = run_chain(lik, st, p0=p0, backend=CheckpointBackend(str(tmp_path / "a.npz"), "f"))
     ck = str(tmp_path / "b.npz")
-    with pytest.raises(KeyboardInterrupt):
-        run_chain(Crash(lik, 8 + 8 * 35), p0=p0, checkpoint=ck, fingerprint="f", **kw)  # dies in step ~35
+    with pytest.raises(KeyboardInterrupt):  # dies in step ~35
+        run_chain(Crash(lik, 8 + 8 * 35), st, p0=p0, backend=CheckpointBackend(ck, "f"))
     with np.load(ck) as z:
         assert z["chain"].shape[0] == 20  # the last complete segment survived
-    resumed = run_chain(lik, checkpoint=ck, resume=True, fingerprint="f", **kw)
+    resumed = run_chain(lik, st, backend=CheckpointBackend.load(ck, "f"))
     assert np.array_equal(resumed.chain, full.chain)
     assert np.array_equal(resumed.log_prob, full.log_prob)
     assert np.array_equal(resumed.accepted, full.accepted)
+    assert [s for s, _ in resumed.tau_history] == [s for s, _ in full.tau_history] == [20, 40, 60]
+    for (_, a), (_, b) in zip(resumed.tau_history, full.tau_history, strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
+    assert resumed.evaluations == full.evaluations == 8 * 61
     # stopping early on a budget and continuing with a larger one is the same too
-    part = run_chain(
-        lik, p0=p0, checkpoint=str(tmp_path / "c.npz"), fingerprint="f", **dict(kw, max_steps=40)
-    )
+    c = str(tmp_path / "c.npz")
+    part = run_chain(lik, st.replace(max_steps=40), p0=p0, backend=CheckpointBackend(c, "f"))
     assert part.steps == 40 and not part.converged and "step budget" in part.stop_reason
-    more = run_chain(lik, checkpoint=str(tmp_path / "c.npz"), resume=True, fingerprint="f", **kw)
+    more = run_chain(lik, st, backend=CheckpointBackend.load(c, "f"))
     assert np.array_equal(more.chain, full.chain)
     with pytest.raises(CheckpointError, match="other data"):
-        run_chain(lik, checkpoint=ck, resume=True, fingerprint="other", **kw)
+        CheckpointBackend.load(ck, "other")
+    with pytest.raises(CheckpointError, match="has 8 walkers, the settings 10"):
+        run_chain(lik, st.replace(walkers=10), backend=CheckpointBackend.load(ck, "f"))
+
+
+def test_the_checkpoint_is_an_emcee_backend_kept_in_memory(coated, data):
+    """Without a path the backend is emcee's in-memory one; the sampler stores into it."""
+    import emcee
+
+    lik = _small(coated, data, 20)
+    p0 = initial_ball(np.array([math.log(0.1), 1.5]), 6, 1, lik.spec.u_bounds())
+    backend = CheckpointBackend()
+    res = run_chain(
+        lik, ChainSettings(walkers=6, seed=1, max_steps=25, check_every=10), p0=p0, backend=backend
+    )
+    assert isinstance(backend, emcee.backends.Backend)
+    assert backend.iteration == 25 and np.array_equal(backend.get_chain(), res.chain)
+    assert [s for s, _ in backend.tau_history] == [
+        10,
+        20,
+        25,
+    ]  # checks on multiples of check_every, then the end
+
+
+def _old_format_checkpoint(path):
+    """A checkpoint as scatterbench wrote it before the emcee backend (no format entry)."""
+    rs = np.random.RandomState(0).get_state()
+    np.savez(
+        path,
+        chain=np.zeros((3, 4, 1)),
+        log_prob=np.zeros((3, 4)),
+        accepted=np.zeros(4),
+        coords=np.zeros((4, 1)),
+        last_log_prob=np.zeros(4),
+        rs_name=np.array(rs[0]),
+        rs_keys=rs[1],
+        rs_pos=np.array(rs[2]),
+        rs_has_gauss=np.array(rs[3]),
+        rs_cached=np.array(rs[4]),
+        fingerprint=np.array("f"),
+        tau_history="[]",
+        seconds=np.array(1.0),
+        evaluations=np.array(16),
+    )
+
+
+@pytest.mark.parametrize(
+    "kind", ["old format", "not a zip", "truncated", "missing entry", "bad shapes", "missing"]
+)
+def test_unusable_checkpoints_are_refused_naming_the_file(coated, data, tmp_path, kind):
+    lik = _small(coated, data, 20)
+    st = ChainSettings(walkers=4, seed=1, max_steps=20, check_every=10)
+    good = str(tmp_path / "good.npz")
+    run_chain(lik, st, p0=initial_ball(np.array([math.log(0.1), 1.5]), 4, 1, lik.spec.u_bounds()),
+              backend=CheckpointBackend(good, "f"))  # fmt: skip
+    path = str(tmp_path / "chain.npz")
+    if kind == "old format":
+        _old_format_checkpoint(path)
+    elif kind == "not a zip":
+        open(path, "w").write("not a checkpoint\n")
+    elif kind == "truncated":
+        open(path, "wb").write(open(good, "rb").read()[:500])
+    elif kind in ("missing entry", "bad shapes"):
+        with np.load(good) as z:
+            e = {k: z[k] for k in z.files}
+        if kind == "missing entry":
+            del e["rs_keys"]
+        else:
+            e["accepted"] = np.zeros(3)
+        np.savez(path, **e)
+    words = {"old format": "older scatterbench", "missing": "no checkpoint"}.get(kind, "")
+    with pytest.raises(CheckpointError, match=f"^{path}: .*{words}"):
+        CheckpointBackend.load(path, "f")
+
+
+def test_chain_settings_name_the_field_and_its_range():
+    for field, bad, words in [
+        ("walkers", 7, "even"),
+        ("walkers", 0, ">= 2"),
+        ("walkers", 8.0, "integer"),
+        ("seed", -1, ">= 0"),
+        ("max_steps", 0, ">= 1"),
+        ("check_every", 0, ">= 1"),
+        ("tau_factor", math.inf, "finite number > 0"),
+        ("tau_factor", 0.0, "> 0"),
+        ("tau_rtol", -0.1, "> 0"),
+        ("starts", 0, ">= 1"),
+        ("starts", True, "integer"),
+    ]:
+        with pytest.raises(ValueError, match=f"^{field} must be .*{words}"):
+            ChainSettings(**{field: bad})
+    st = ChainSettings(walkers=np.int64(6), tau_factor=np.float32(40))
+    assert type(st.walkers) is int and type(st.tau_factor) is float
+    assert st.require_walkers(3) is st
+    with pytest.raises(ValueError, match=r"walkers must be even and >= 2 x free parameters \(8\); got 6"):
+        st.require_walkers(4)
+    with pytest.raises(ValueError, match="max_steps"):
+        st.replace(max_steps=-5)
+    with pytest.raises(AttributeError):
+        st.walkers = 8  # frozen
 
 
 def test_same_seed_same_chain_whatever_the_executor(coated, data):
     from dask.distributed import Client, LocalCluster
 
     lik = _small(coated, data, 20)
-    kw = dict(walkers=8, seed=3, max_steps=30, check_every=15, starts=1)
-    ref = run_fit(lik, executor=SerialExecutor(), **kw)
+    st = ChainSettings(walkers=8, seed=3, max_steps=30, check_every=15, starts=1)
+    ref = run_fit(lik, st, executor=SerialExecutor())
     with ProcessExecutor(2) as ex:
-        procs = run_fit(lik, executor=ex, **kw)
+        procs = run_fit(lik, st, executor=ex)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         with Client(cluster) as client, DaskExecutor(client) as ex:
             assert ex.workers == 2
-            dask = run_fit(lik, executor=ex, **kw)
+            dask = run_fit(lik, st, executor=ex)
         with DaskExecutor(cluster.scheduler_address) as ex:  # the --scheduler ADDRESS path
             assert ex.map(abs, [-3, 1, -2]) == [3, 1, 2]
     assert np.array_equal(ref.chain.chain, procs.chain.chain)
     assert np.array_equal(ref.chain.chain, dask.chain.chain)
     assert np.array_equal(ref.chain.log_prob, dask.chain.log_prob)
-    other = run_fit(lik, executor=SerialExecutor(), **dict(kw, seed=4))
+    other = run_fit(lik, st.replace(seed=4), executor=SerialExecutor())
     assert not np.array_equal(ref.chain.chain, other.chain.chain)
 
 
@@ -193,7 +302,8 @@ def test_recovers_the_scatmech_sample_within_95_percent(coated, data):
         ["brdf=0.05", "eta_deg=1", "P=0.02", "P_C=0.02"],
     )
     res = run_fit(
-        Likelihood(coated, spec, data), walkers=16, seed=11, max_steps=500, check_every=100, starts=2
+        Likelihood(coated, spec, data),
+        ChainSettings(walkers=16, seed=11, max_steps=500, check_every=100, starts=2),
     )
     truth = data.meta["truth"]
     for key, v in truth.items():
@@ -234,6 +344,36 @@ def test_fit_command_writes_results_refuses_overwrite_and_resumes(tmp_path, caps
         == 2
     )
     assert "noise.brdf" in capsys.readouterr().err
+
+
+def test_fit_and_studies_refuse_bad_settings_and_unusable_checkpoints_without_a_traceback(tmp_path, capsys):
+    out = tmp_path / "fit"
+    out.mkdir()
+    ck = out / "chain.npz"
+    _old_format_checkpoint(str(ck))
+    args = [
+        "fit", DATA, "--scene", COATED, "--free", "sigma:0.01:1:log", "--noise", "brdf=0.05", "--walkers", "4",
+        "--max-steps", "20", "--starts", "1", "--no-progress", "--no-plots", "--out", str(out), "--resume",
+    ]  # fmt: skip
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {ck}: a checkpoint of an older scatterbench") and "Traceback" not in err
+    ck.write_bytes(b"garbage")
+    assert main(args) == 2
+    assert capsys.readouterr().err.startswith(f"error: {ck}: not a readable checkpoint")
+    assert main(args[:-1] + ["--force", "--max-steps", "0"]) == 2
+    assert capsys.readouterr().err == "error: max_steps must be an integer >= 1; got 0\n"
+    two = ["--free", "coating:1.2:2", "--walkers", "2"]
+    assert main(args[:-1] + ["--force"] + two) == 2
+    assert "walkers must be even and >= 2 x free parameters (4); got 2" in capsys.readouterr().err
+    study = ["study", "recovery", DATA, "--scene", COATED, "--free", "sigma:0.01:1:log", "--noise", "brdf=0.1",
+             "--injections", "1", "--out", str(tmp_path / "rec")]  # fmt: skip
+    assert main(study + two) == 2
+    assert "walkers must be even and >= 2 x free parameters (4); got 2" in capsys.readouterr().err
+    assert main(study[:-4] + ["--injections", "0"] + study[-2:]) == 2
+    assert capsys.readouterr().err == "error: injections must be an integer >= 1; got 0\n"
+    assert main(study + ["--check-every", "0"]) == 2
+    assert capsys.readouterr().err == "error: check_every must be an integer >= 1; got 0\n"
 
 
 def test_the_data_sidecar_sets_the_aperture_and_the_choice_is_fixed_for_the_fit(coated, data):

@@ -15,6 +15,7 @@ from validation.fitting.executors import ProcessExecutor
 from validation.fitting.fitspec import fitspec_from
 from validation.fitting.likelihood import Likelihood
 from validation.fitting.recovery import recovery_study, subsample
+from validation.fitting.settings import ChainSettings
 
 SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
 COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
@@ -35,8 +36,8 @@ def test_coverage_over_50_injections_is_within_binomial_error(setup):
     sc, data = setup
     spec = fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0.1"])
     (cell,) = recovery_study(
-        sc, spec, data, noise_levels=(0.1,), n_geometries=(8,), injections=50, seed=5,
-        walkers=4, max_steps=150, check_every=150, starts=1,
+        sc, spec, data, ChainSettings(walkers=4, seed=5, max_steps=150, check_every=150, starts=1),
+        noise_levels=(0.1,), n_geometries=(8,), injections=50,
     )  # fmt: skip
     s = cell["summary"]["substrate.sigma"]
     assert s["injections"] == 50 and cell["steps_over_tau_min"] > 8
@@ -49,18 +50,11 @@ def test_coverage_over_50_injections_is_within_binomial_error(setup):
 def test_study_members_are_identical_on_any_executor(setup):
     sc, data = setup
     spec = fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0.1"])
-    kw = dict(
-        noise_levels=(0.05, 0.2),
-        n_geometries=(6,),
-        injections=2,
-        seed=1,
-        walkers=4,
-        max_steps=40,
-        check_every=40,
-    )
-    a = recovery_study(sc, spec, data, **kw)
+    st = ChainSettings(walkers=4, seed=1, max_steps=40, check_every=40)
+    kw = dict(noise_levels=(0.05, 0.2), n_geometries=(6,), injections=2)
+    a = recovery_study(sc, spec, data, st, **kw)
     with ProcessExecutor(2) as ex:
-        b = recovery_study(sc, spec, data, executor=ex, **kw)
+        b = recovery_study(sc, spec, data, st, executor=ex, **kw)
     assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
     # widths grow with the noise level
     w = [c["summary"]["substrate.sigma"]["width68_mean"] for c in a]
@@ -93,7 +87,9 @@ def test_compare_prefers_the_generating_slope_family(setup):
     gauss = sc.with_values({"substrate.distribution": "gaussian"})
     liks = [Likelihood(s, fitspec_from(s, ["sigma:0.01:1:log"], ["brdf:0.01:1:log"]), d) for s in (sc, gauss)]
     rows, _ = compare_fits(
-        liks, ["exponential", "gaussian"], walkers=8, seed=2, max_steps=200, check_every=100, starts=2
+        liks,
+        ["exponential", "gaussian"],
+        ChainSettings(walkers=8, seed=2, max_steps=200, check_every=100, starts=2),
     )
     e, g = rows
     assert e["max_log_likelihood"] > g["max_log_likelihood"] + 10
@@ -107,7 +103,9 @@ def test_compare_prefers_the_generating_slope_family(setup):
 @pytest.fixture(scope="module")
 def pairing():
     """Seed 003's pairing on 40 rows of each SCATMECH data set, all likelihood terms and the BRDF alone."""
-    return seed003_pairing(rows=40, walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
+    return seed003_pairing(
+        ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3), rows=40
+    )
 
 
 @pytest.mark.parametrize("terms", ["all", "brdf"])

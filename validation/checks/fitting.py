@@ -83,7 +83,7 @@ def check_resume_identity():
     from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
     from validation.fitting.recovery import subsample
-    from validation.fitting.sampling import initial_ball, run_chain
+    from validation.fitting.sampling import ChainSettings, CheckpointBackend, initial_ball, run_chain
 
     sc = scene.load(
         os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
@@ -91,17 +91,17 @@ def check_resume_identity():
     data = subsample(load_data(references.data_path("scatmech_flake_measurement.csv")), 20)
     lik = Likelihood(sc, fitspec_from(sc, ["sigma:0.01:1:log", "coating:1.2:2"], ["brdf=0.05"]), data)
     p0 = initial_ball(np.array([math.log(0.1), 1.5]), 6, 3, lik.spec.u_bounds())
-    kw = dict(seed=3, max_steps=30, check_every=10, fingerprint="x")
+    st = ChainSettings(walkers=6, seed=3, max_steps=30, check_every=10)
     with tempfile.TemporaryDirectory() as tmp:
-        full = run_chain(lik, p0=p0, checkpoint=os.path.join(tmp, "a.npz"), **kw)
+        full = run_chain(lik, st, p0=p0, backend=CheckpointBackend(os.path.join(tmp, "a.npz"), "x"))
         ck = os.path.join(tmp, "b.npz")
         # emcee prints the interrupted call's traceback; keep validate's table clean
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             try:
-                run_chain(_Crash(lik, 6 + 6 * 15), p0=p0, checkpoint=ck, **kw)
+                run_chain(_Crash(lik, 6 + 6 * 15), st, p0=p0, backend=CheckpointBackend(ck, "x"))
             except KeyboardInterrupt:
                 pass
-        resumed = run_chain(lik, checkpoint=ck, resume=True, **kw)
+        resumed = run_chain(lik, st, backend=CheckpointBackend.load(ck, "x"))
     diff = (
         float(np.max(np.abs(resumed.chain - full.chain)))
         if resumed.chain.shape == full.chain.shape

@@ -59,13 +59,19 @@ def _spec_args(p):
     )
 
 
-def _mcmc_args(p, walkers=32, max_steps=20000):
-    p.add_argument("--walkers", type=int, default=walkers)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--max-steps", type=int, default=max_steps, help="step budget")
-    p.add_argument("--check-every", type=int, default=100, help="steps between tau checks and checkpoints")
-    p.add_argument("--tau-factor", type=float, default=50.0, help="stop when steps >= this x tau")
-    p.add_argument("--starts", type=int, default=4, help="least-squares starts for the optimum")
+def _mcmc_args(p, walkers=None, max_steps=None):
+    """The sampler flags; defaults: :class:`ChainSettings`' unless ``walkers``/``max_steps`` given."""
+    from validation.fitting.settings import ChainSettings
+
+    d = ChainSettings()
+    p.add_argument("--walkers", type=int, default=walkers or d.walkers)
+    p.add_argument("--seed", type=int, default=d.seed)
+    p.add_argument("--max-steps", type=int, default=max_steps or d.max_steps, help="step budget")
+    p.add_argument(
+        "--check-every", type=int, default=d.check_every, help="steps between tau checks and checkpoints"
+    )
+    p.add_argument("--tau-factor", type=float, default=d.tau_factor, help="stop when steps >= this x tau")
+    p.add_argument("--starts", type=int, default=d.starts, help="least-squares starts for the optimum")
 
 
 def _load(args):
@@ -87,13 +93,17 @@ def _load(args):
 
 
 def _load_and_describe(args):
-    """``_load`` for a command: prints the scene and fit spec, or the error (then ``None``)."""
+    """The chain settings from the flags and ``_load``'s inputs, ``(settings, scene, data,
+    spec, likelihood)``, with the scene and fit spec printed; or ``None`` after printing
+    the error."""
+    settings = _chain_settings(args)
+    if settings is None:
+        return None
     try:
-        loaded = _load(args)
+        sc, data, spec, lik = _load(args)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return None
-    sc, data, spec, lik = loaded
     if lik.scene is not sc:
         print(
             f"detector: the data's sidecar records aperture_deg = {lik.scene.aperture_deg:g} "
@@ -101,56 +111,54 @@ def _load_and_describe(args):
         )
     print(lik.scene.describe())
     print(spec.describe())
-    return loaded
+    return settings, sc, data, spec, lik
 
 
-def _mcmc_kwargs(args):
-    """The sampler settings shared by fit and the studies."""
-    return dict(
-        walkers=args.walkers,
-        seed=args.seed,
-        max_steps=args.max_steps,
-        check_every=args.check_every,
-        tau_factor=args.tau_factor,
-        starts=args.starts,
-    )
+def _chain_settings(args):
+    """The sampler settings of fit and the studies, built from their flags here and only
+    here; ``None`` after printing the error when a flag is out of range."""
+    from validation.fitting.settings import ChainSettings
+
+    try:
+        return ChainSettings(
+            walkers=args.walkers,
+            seed=args.seed,
+            max_steps=args.max_steps,
+            check_every=args.check_every,
+            tau_factor=args.tau_factor,
+            starts=args.starts,
+        )
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return None
 
 
-def _cmd_fit(args) -> int:
+def _run_fit(args, lik, settings):
+    """Run (or resume) the chain in ``args.out`` and write the results; returns the
+    posterior summary, or ``None`` after printing the error.  The running checkpoint is
+    chain.partial.npz; it becomes chain.npz when the run ends, so a failed --force
+    run never replaces a previous complete chain."""
     from validation.fitting.executors import make_executor
     from validation.fitting.fit import run_fit, write_fit
 
-    if not _out_ok(args.out, args.force, args.resume):
-        return 2
-    loaded = _load_and_describe(args)
-    if loaded is None:
-        return 2
-    sc, data, spec, lik = loaded
-    print(
-        f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
-    )
     os.makedirs(args.out, exist_ok=True)
-    # The running checkpoint is chain.partial.npz; it becomes chain.npz when the run
-    # ends, so a failed --force run never replaces a previous complete chain.
     ck = os.path.join(args.out, "chain.partial.npz")
     final = os.path.join(args.out, "chain.npz")
-    resume_from = ck if os.path.exists(ck) else final
-    t0 = time.perf_counter()
     with make_executor(args.workers, args.scheduler) as ex:
         print(f"executor: {ex.describe()}")
         try:
             res = run_fit(
                 lik,
-                **_mcmc_kwargs(args),
+                settings,
                 executor=ex,
                 checkpoint=ck,
                 resume=args.resume,
-                resume_from=resume_from,
+                resume_from=ck if os.path.exists(ck) else final,
                 progress=not args.no_progress,
             )
-        except ValueError as exc:
+        except ValueError as exc:  # settings this spec cannot use, a checkpoint that cannot be resumed
             print(f"error: {exc}", file=sys.stderr)
-            return 2
+            return None
         if os.path.exists(ck):
             os.replace(ck, final)
         post = write_fit(
@@ -161,7 +169,10 @@ def _cmd_fit(args) -> int:
             executor_desc=ex.describe(),
             plots=not args.no_plots,
         )
-    s = post["sampling"]
+    return post
+
+
+def _print_sampling(s, total_seconds):
     print(f"\n{s['stop_reason']}")
     print(
         f"walkers {s['walkers']}, steps {s['steps']}, tau (steps) "
@@ -170,8 +181,11 @@ def _cmd_fit(args) -> int:
     )
     print(
         f"sampling time {s['seconds']:.1f} s, {s['log_prob_evaluations']} likelihood evaluations, "
-        f"{s['evaluations_per_second']:.0f} evaluations/s (total {time.perf_counter() - t0:.1f} s)"
+        f"{s['evaluations_per_second']:.0f} evaluations/s (total {total_seconds:.1f} s)"
     )
+
+
+def _print_posterior(post):
     print(
         f"\n{'parameter':<22} {'2.5%':>10} {'16%':>10} {'50%':>10} {'84%':>10} {'97.5%':>10}"
         + ("  truth" if "truth_check" in post else "")
@@ -188,6 +202,24 @@ def _cmd_fit(args) -> int:
         print(
             f"predictive check {t}: {c['inside_68']:.2f} of rows inside 68%, {c['inside_95']:.2f} inside 95%"
         )
+
+
+def _cmd_fit(args) -> int:
+    if not _out_ok(args.out, args.force, args.resume):
+        return 2
+    loaded = _load_and_describe(args)
+    if loaded is None:
+        return 2
+    settings, _, data, _, lik = loaded
+    print(
+        f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
+    )
+    t0 = time.perf_counter()
+    post = _run_fit(args, lik, settings)
+    if post is None:
+        return 2
+    _print_sampling(post["sampling"], time.perf_counter() - t0)
+    _print_posterior(post)
     print(
         f"wrote {args.out}/posterior.json, chain.npz"
         + ("" if args.no_plots else ", corner.png, predictive.png, residuals.png")

@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from .fit import _executor_args, _load_and_describe, _mcmc_args, _mcmc_kwargs, _out_ok, _spec_args
+from .fit import _chain_settings, _executor_args, _load_and_describe, _mcmc_args, _out_ok, _spec_args
 
 __all__ = ["register"]
 
@@ -32,49 +32,7 @@ def _ints(text):
 
 
 # ----------------------------------------------------------------------------- recovery
-def _cmd_recovery(args) -> int:
-    from validation.atomic import atomic_write_json
-    from validation.fitting.executors import make_executor
-    from validation.fitting.recovery import recovery_study
-
-    if not _out_ok(args.out, args.force, None):
-        return 2
-    loaded = _load_and_describe(args)
-    if loaded is None:
-        return 2
-    sc, data, spec, _ = loaded
-    extra = {k: v for k, v in spec.noise.items() if k != "brdf"}
-    t0 = time.perf_counter()
-    with make_executor(args.workers, args.scheduler) as ex:
-        print(f"executor: {ex.describe()}")
-        cells = recovery_study(
-            sc,
-            spec,
-            data,
-            noise_levels=_floats(args.noise_levels),
-            n_geometries=_ints(args.n_geometries) if args.n_geometries else (None,),
-            injections=args.injections,
-            executor=ex,
-            **_mcmc_kwargs(args),
-            noise_extra=extra,
-            progress=not args.no_progress,
-        )
-    seconds = time.perf_counter() - t0
-    os.makedirs(args.out, exist_ok=True)
-    atomic_write_json(
-        os.path.join(args.out, "recovery.json"),
-        {
-            "scene": args.scene,
-            "geometries_from": args.data,
-            "spec": spec.as_dict(),
-            "seed": args.seed,
-            "injections_per_cell": args.injections,
-            "walkers": args.walkers,
-            "max_steps": args.max_steps,
-            "seconds": seconds,
-            "cells": cells,
-        },
-    )
+def _print_recovery(cells, injections):
     print(
         f"\n{'noise':>6} {'geoms':>5} {'parameter':<20} {'cov68':>6} {'z68':>6} {'cov95':>6} {'z95':>6} "
         f"{'bias':>10} {'width68':>10} {'curv68':>6} {'curv95':>6}  steps/tau(min)"
@@ -90,9 +48,60 @@ def _cmd_recovery(args) -> int:
             )
     print("curv68/curv95: coverage of the optimum's curvature (Gauss-Newton) intervals on the same data sets")
     print(
-        f"binomial standard errors over {args.injections} injections: 68%: "
-        f"{math.sqrt(0.6827 * 0.3173 / args.injections):.3f}, 95%: {math.sqrt(0.9545 * 0.0455 / args.injections):.3f}"
+        f"binomial standard errors over {injections} injections: 68%: "
+        f"{math.sqrt(0.6827 * 0.3173 / injections):.3f}, 95%: {math.sqrt(0.9545 * 0.0455 / injections):.3f}"
     )
+
+
+def _cmd_recovery(args) -> int:
+    from validation.atomic import atomic_write_json
+    from validation.fitting.executors import make_executor
+    from validation.fitting.recovery import check_inputs, recovery_study
+
+    if not _out_ok(args.out, args.force, None):
+        return 2
+    loaded = _load_and_describe(args)
+    if loaded is None:
+        return 2
+    settings, sc, data, spec, _ = loaded
+    extra = {k: v for k, v in spec.noise.items() if k != "brdf"}
+    try:
+        check_inputs(spec, settings, extra, args.injections)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    t0 = time.perf_counter()
+    with make_executor(args.workers, args.scheduler) as ex:
+        print(f"executor: {ex.describe()}")
+        cells = recovery_study(
+            sc,
+            spec,
+            data,
+            settings,
+            noise_levels=_floats(args.noise_levels),
+            n_geometries=_ints(args.n_geometries) if args.n_geometries else (None,),
+            injections=args.injections,
+            executor=ex,
+            noise_extra=extra,
+            progress=not args.no_progress,
+        )
+    seconds = time.perf_counter() - t0
+    os.makedirs(args.out, exist_ok=True)
+    atomic_write_json(
+        os.path.join(args.out, "recovery.json"),
+        {
+            "scene": args.scene,
+            "geometries_from": args.data,
+            "spec": spec.as_dict(),
+            "seed": settings.seed,
+            "injections_per_cell": args.injections,
+            "walkers": settings.walkers,
+            "max_steps": settings.max_steps,
+            "seconds": seconds,
+            "cells": cells,
+        },
+    )
+    _print_recovery(cells, args.injections)
     _recovery_plot(cells, args.out)
     print(
         f"{len(cells)} cells x {args.injections} injections in {seconds:.1f} s; wrote {args.out}/recovery.json, recovery.png"
@@ -140,113 +149,107 @@ def _recovery_plot(cells, out):
 
 
 # ----------------------------------------------------------------------------- inversion
+def _inversion_model(args):
+    """The data (masked) and the scene's model for them, at a point detector."""
+    from models import DetectorAperture
+    from models import scene as scene_mod
+    from validation.fitting.datafile import load_data
+    from validation.fitting.fitspec import FitSpec, parse_exclude
+    from validation.fitting.likelihood import scene_for_data
+
+    sc = scene_mod.load(args.scene)
+    data = load_data(args.data)
+    spec = FitSpec((), {}, args.near_specular_deg or 0.0, tuple(parse_exclude(t) for t in args.exclude or []))
+    data = data.subset(spec.mask(data))
+    model = scene_for_data(sc, data).build()
+    if isinstance(model, DetectorAperture):
+        print(
+            f"note: the inversion (seed 000 Sec. 4) assumes a point detector; the "
+            f"{math.degrees(model.aperture):g} deg aperture is not deconvolved"
+        )
+        model = model.model
+    return data, model
+
+
+def _print_inversion(study):
+    curve, boot = study.curve, study.bootstrap
+    lo, hi = boot["normalization_p2.5_p97.5"]
+    p16, _, p84 = boot["normalization_p16_p50_p84"]
+    print(f"{len(study.inversion.p3)} rows; probed slopes 0-{curve.zeta_max:.3f}")
+    print(
+        f"normalization over the probed range (Eq. 33): {curve.normalization:.6f} "
+        f"(interpolation error estimate {curve.interpolation_error:.2g}); "
+        f"bootstrap 68%: {p16:.4f}-{p84:.4f}, 95%: {lo:.4f}-{hi:.4f} ({boot['replicates']} replicates)"
+    )
+    print(
+        f"unmeasured tail beyond zeta_max (log-linear extrapolation): {curve.tail:.3g}; the paper's 0.77 is for its measured sample"
+    )
+    for g, r in study.collapse.items():
+        print(f"  rms ln(P3 / common curve), {g}: {r:.4f}")
+
+
 def _cmd_inversion(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from models import DetectorAperture
-    from models import scene as scene_mod
     from validation.atomic import atomic_savefig, atomic_write_json
-    from validation.fitting.datafile import load_data
-    from validation.fitting.fit import _scan_x
-    from validation.fitting.fitspec import FitSpec, parse_exclude
-    from validation.fitting.inversion import bootstrap, collapse, fit_curve, invert
-    from validation.fitting.likelihood import scene_for_data
+    from validation.fitting.inversion import inversion_figure, inversion_study
 
     if not _out_ok(args.out, args.force, None):
         return 2
     try:
-        sc = scene_mod.load(args.scene)
-        data = load_data(args.data)
-        spec = FitSpec(
-            (), {}, args.near_specular_deg or 0.0, tuple(parse_exclude(t) for t in args.exclude or [])
-        )
-        data = data.subset(spec.mask(data))
-        model = scene_for_data(sc, data).build()
-        if isinstance(model, DetectorAperture):
-            print(
-                f"note: the inversion (seed 000 Sec. 4) assumes a point detector; the "
-                f"{math.degrees(model.aperture):g} deg aperture is not deconvolved"
-            )
-            model = model.model
-        inv = invert(model, data)
-        curve = fit_curve(inv, bins=args.bins)
+        data, model = _inversion_model(args)
+        study = inversion_study(model, data, bins=args.bins, n_bootstrap=args.bootstrap, seed=args.seed)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    boot = bootstrap(inv, bins=args.bins, n=args.bootstrap, seed=args.seed)
-    _, groups = _scan_x(data)
-    col = collapse(inv, curve, groups)
-    res = {
-        "data": args.data,
-        "scene": args.scene,
-        "rows": len(data),
-        "normalization_measured_range": curve.normalization,
-        "interpolation_error_estimate": curve.interpolation_error,
-        "zeta_max": curve.zeta_max,
-        "tail_beyond_zeta_max_extrapolated": curve.tail,
-        "bootstrap": boot,
-        "rms_log_deviation_from_common_curve": col,
-        "paper_value": {"normalization": 0.77, "source": "seed 000 Sec. 4 (measured sample, Fig. 4)"},
-        "estimates": {"zeta_x": inv.zeta_x.tolist(), "zeta_y": inv.zeta_y.tolist(), "p3": inv.p3.tolist()},
-        "bins": args.bins,
-    }
     os.makedirs(args.out, exist_ok=True)
-    atomic_write_json(os.path.join(args.out, "inversion.json"), res)
-    fig, ax = plt.subplots(figsize=(6, 4.2))
-    for g in dict.fromkeys(groups):
-        s = groups == g
-        ax.semilogy(inv.zeta[s], inv.p3[s], ".", ms=4, label=g)
-    zz = np.linspace(0, curve.zeta_max, 400)
-    ax.semilogy(zz, curve(zz), "k-", lw=1, label="common curve (spline of ln P3)")
-    if hasattr(getattr(model, "slopes", None), "p3"):
-        ax.semilogy(zz, model.slopes.p3(zz, 0 * zz), "r--", lw=0.8, label="scene's P3 (for reference)")
-    ax.set_xlabel("facet slope |zeta|")
-    ax.set_ylabel("P3 estimate")
-    lo, hi = boot["normalization_p2.5_p97.5"]
-    ax.set_title(f"normalization {curve.normalization:.4f} (95% bootstrap {lo:.4f}-{hi:.4f})", fontsize=9)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+    atomic_write_json(
+        os.path.join(args.out, "inversion.json"), {"data": args.data, "scene": args.scene, **study.as_dict()}
+    )
+    fig = inversion_figure(study, model)
     atomic_savefig(fig, os.path.join(args.out, "inversion.png"), dpi=90)
     plt.close(fig)
-    print(f"{len(data)} rows; probed slopes 0-{curve.zeta_max:.3f}")
-    print(
-        f"normalization over the probed range (Eq. 33): {curve.normalization:.6f} "
-        f"(interpolation error estimate {curve.interpolation_error:.2g}); "
-        f"bootstrap 68%: {boot['normalization_p16_p50_p84'][0]:.4f}-{boot['normalization_p16_p50_p84'][2]:.4f}, "
-        f"95%: {lo:.4f}-{hi:.4f} ({boot['replicates']} replicates)"
-    )
-    print(
-        f"unmeasured tail beyond zeta_max (log-linear extrapolation): {curve.tail:.3g}; the paper's 0.77 is for its measured sample"
-    )
-    for g, r in col.items():
-        print(f"  rms ln(P3 / common curve), {g}: {r:.4f}")
+    _print_inversion(study)
     print(f"wrote {args.out}/inversion.json, inversion.png")
     return 0
 
 
 # ----------------------------------------------------------------------------- compare
-def _cmd_compare(args) -> int:
+def _compare_likelihoods(args):
+    """One likelihood per ``--scene`` on the data, named by the scene file."""
     from models import scene as scene_mod
-    from validation.atomic import atomic_write_json
-    from validation.fitting.compare import compare_fits, format_comparison
     from validation.fitting.datafile import load_data
-    from validation.fitting.executors import make_executor
     from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
 
+    data = load_data(args.data)
+    liks, names = [], []
+    for path in args.scene:
+        sc = scene_mod.load(path)
+        spec = fitspec_from(sc, None, args.noise, args.near_specular_deg, args.exclude)
+        liks.append(Likelihood(sc, spec, data))
+        names.append(os.path.basename(path))
+    return liks, names
+
+
+def _cmd_compare(args) -> int:
+    from validation.atomic import atomic_write_json
+    from validation.fitting.compare import check_comparable, compare_fits, format_comparison
+    from validation.fitting.executors import make_executor
+
     if not _out_ok(args.out, args.force, None):
         return 2
+    settings = _chain_settings(args)
+    if settings is None:
+        return 2
     try:
-        data = load_data(args.data)
-        liks, names = [], []
-        for path in args.scene:
-            sc = scene_mod.load(path)
-            spec = fitspec_from(sc, None, args.noise, args.near_specular_deg, args.exclude)
-            liks.append(Likelihood(sc, spec, data))
-            names.append(os.path.basename(path))
+        liks, names = _compare_likelihoods(args)
+        check_comparable(liks, names)
+        for lik in liks:
+            settings.require_walkers(len(lik.spec.free))
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -255,12 +258,7 @@ def _cmd_compare(args) -> int:
             f"{nm}: {len(lik.spec.free)} free ({', '.join(lik.spec.names)}); likelihood terms: {', '.join(lik.terms)}"
         )
     with make_executor(args.workers, args.scheduler) as ex:
-        rows, _ = compare_fits(
-            liks,
-            names,
-            executor=ex,
-            **_mcmc_kwargs(args),
-        )
+        rows, _ = compare_fits(liks, names, settings, executor=ex)
     os.makedirs(args.out, exist_ok=True)
     atomic_write_json(
         os.path.join(args.out, "compare.json"), {"data": args.data, "scenes": args.scene, "rows": rows}

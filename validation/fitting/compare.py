@@ -17,8 +17,9 @@ import numpy as np
 from scipy.special import logsumexp
 
 from .fit import information_criteria, predictive, predictive_checks, run_fit
+from .settings import ChainSettings
 
-__all__ = ["waic", "compare_fits", "format_comparison"]
+__all__ = ["waic", "check_comparable", "compare_fits", "format_comparison", "seed003_pairing"]
 
 
 def waic(fit, n_draws=200, seed=0):
@@ -31,11 +32,11 @@ def waic(fit, n_draws=200, seed=0):
     return {"WAIC": -2 * (lppd - p), "lppd": lppd, "p_waic": p}
 
 
-def compare_fits(liks, names, *, executor=None, **fit_kwargs):
-    """Fit every likelihood (same data, same used rows); return rows of the comparison."""
-    masks = [lk.mask for lk in liks]
-    for nm, m in zip(names[1:], masks[1:], strict=True):
-        if not np.array_equal(m, masks[0]):
+def check_comparable(liks, names):
+    """Raise ``ValueError`` unless the likelihoods use the same rows and the same terms
+    (scenes compared on the same data)."""
+    for nm, lk in zip(names[1:], liks[1:], strict=True):
+        if not np.array_equal(lk.mask, liks[0].mask):
             raise ValueError(
                 f"scene {nm}: its mask uses other rows than {names[0]}'s; compare on the same rows"
             )
@@ -45,24 +46,46 @@ def compare_fits(liks, names, *, executor=None, **fit_kwargs):
                 f"scene {nm}: its likelihood uses the terms {lk.terms}, {names[0]}'s {liks[0].terms}; "
                 "compare with the same terms"
             )
-    rows = []
-    fits = []
-    for nm, lik in zip(names, liks, strict=True):
-        f = run_fit(lik, executor=executor, **fit_kwargs)
-        fits.append(f)
-        pp = predictive(f, seed=fit_kwargs.get("seed", 0))
-        rows.append(
-            {
-                "scene": nm,
-                **information_criteria(f),
-                **waic(f, seed=fit_kwargs.get("seed", 0)),
-                "predictive": predictive_checks(f, pp),
-                "tau_max": float(np.max(f.chain.tau)),
-                "acceptance": float(f.chain.acceptance.mean()),
-                "stop_reason": f.chain.stop_reason,
-                "medians": {kk: v["median"] for kk, v in f.summary["parameters"].items()},
-            }
-        )
+
+
+def _comparison_row(name, fit, seed):
+    """One scene's row: information criteria, WAIC, predictive coverage, chain diagnostics."""
+    return {
+        "scene": name,
+        **information_criteria(fit),
+        **waic(fit, seed=seed),
+        "predictive": predictive_checks(fit, predictive(fit, seed=seed)),
+        "tau_max": float(np.max(fit.chain.tau)),
+        "acceptance": float(fit.chain.acceptance.mean()),
+        "stop_reason": fit.chain.stop_reason,
+        "medians": {k: v["median"] for k, v in fit.summary["parameters"].items()},
+    }
+
+
+def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor=None):
+    """Fit every likelihood (same data, same used rows) and rank them.
+
+    Parameters
+    ----------
+    liks : list of Likelihood
+    names : list of str
+        One per likelihood (the rows' ``scene``).
+    settings : ChainSettings, optional
+        Every fit's chain (default ``ChainSettings()``); its seed also seeds the
+        predictive draws and the WAIC.
+    executor : optional
+        Maps each chain's log posterior over walkers.
+
+    Returns
+    -------
+    rows : list of dict
+        The comparison, with ``dAIC``, ``dBIC``, ``dWAIC`` from the best.
+    fits : list of FitResult
+    """
+    settings = ChainSettings() if settings is None else settings
+    check_comparable(liks, names)
+    fits = [run_fit(lik, settings, executor=executor) for lik in liks]
+    rows = [_comparison_row(nm, f, settings.seed) for nm, f in zip(names, fits, strict=True)]
     for key in ("AIC", "BIC", "WAIC"):
         best = min(r[key] for r in rows)
         for r in rows:
@@ -91,10 +114,11 @@ SEED003_PAIRING = {
 _POLARIZATION_OFF = ("eta_deg=off", "P=off", "P_C=off")
 
 
-def seed003_pairing(*, rows=None, terms=("all", "brdf"), executor=None, **fit_kwargs):
+def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf"), executor=None):
     """Fit both scenes of :data:`SEED003_PAIRING` to both data sets, with every likelihood
     term the scenes declare (``"all"``: BRDF, eta, P, P_C) and/or the BRDF alone
-    (``"brdf"``), on ``rows`` evenly spread rows of each file (default all).
+    (``"brdf"``), on ``rows`` evenly spread rows of each file (default all), every
+    chain with ``settings``.
 
     Returns a list of ``{"data", "generator", "terms", "rows", "fits"}``, one per data
     set and term choice, ``rows`` being :func:`compare_fits`' table (scene names are
@@ -105,7 +129,7 @@ def seed003_pairing(*, rows=None, terms=("all", "brdf"), executor=None, **fit_kw
     """
     key = None
     if executor is None:
-        key = (rows, tuple(terms), tuple(sorted(fit_kwargs.items())))
+        key = (rows, tuple(terms), settings)
         if key in _PAIRING_CACHE:
             return _PAIRING_CACHE[key]
     import os
@@ -128,7 +152,7 @@ def seed003_pairing(*, rows=None, terms=("all", "brdf"), executor=None, **fit_kw
         for t in terms:
             noise = None if t == "all" else list(_POLARIZATION_OFF)
             liks = [Likelihood(sc, fitspec_from(sc, None, noise), data) for sc in scenes.values()]
-            table, fits = compare_fits(liks, list(scenes), executor=executor, **fit_kwargs)
+            table, fits = compare_fits(liks, list(scenes), settings, executor=executor)
             out.append({"data": fname, "generator": generator, "terms": t, "rows": table, "fits": fits})
     if key is not None:
         _PAIRING_CACHE[key] = out

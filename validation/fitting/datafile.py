@@ -218,92 +218,117 @@ def _range_text(lo, hi, lo_open, hi_open):
     return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
 
 
-def load_data(path) -> Dataset:
-    """Read and validate a data file (and its sidecar).  Raises :class:`DataFileError`."""
-    path = str(path)
+def _read_lines(path):
     try:
         with open(path, encoding="utf-8", newline="") as fh:
-            raw_lines = fh.read().splitlines()
+            return fh.read().splitlines()
     except OSError as exc:
         raise DataFileError(path, 0, None, f"cannot read the data file ({exc.strerror})") from exc
     except UnicodeDecodeError as exc:
         raise DataFileError(path, 0, None, f"not UTF-8 text ({exc.reason})") from exc
-    meta, side = _load_sidecar(path)
 
-    header = None
-    rows = []
+
+def _split(path, raw_lines):
+    """``(header, header_line, rows)``: the first non-comment line and the ``(line, fields)`` after it."""
+    header, header_line, rows = None, None, []
     for lineno, text in enumerate(raw_lines, 1):
         if not text.strip() or text.lstrip().startswith("#"):
             continue
         fields = next(csv.reader([text]))
         if header is None:
-            header = [f.strip() for f in fields]
-            header_line = lineno
-            continue
-        rows.append((lineno, fields))
+            header, header_line = [f.strip() for f in fields], lineno
+        else:
+            rows.append((lineno, fields))
     if header is None:
         raise DataFileError(path, len(raw_lines) or 1, None, "no header line (and no data)")
+    return header, header_line, rows
 
+
+def _columns(path, header, line):
+    """Column name -> 1-based position; every name known, none twice, the required ones present."""
     known = set(COLUMNS) | TEXT_COLUMNS
     col_of = {}
     for j, name in enumerate(header, 1):
         if name in col_of:
-            raise DataFileError(path, header_line, j, f"column {name!r} appears twice")
+            raise DataFileError(path, line, j, f"column {name!r} appears twice")
         if name not in known:
             hint = ""
             if name in ("theta_i", "theta_r", "phi_r", "eta", "eta_err"):
                 hint = f" (angles are in degrees in a column named {name}_deg)"
             raise DataFileError(
                 path,
-                header_line,
+                line,
                 j,
                 f"unknown column {name!r}{hint}; allowed: {', '.join(list(COLUMNS) + ['incident'])}",
             )
         col_of[name] = j
     for name, (*_, required) in COLUMNS.items():
         if required and name not in col_of:
-            raise DataFileError(path, header_line, None, f"missing required column {name!r}")
+            raise DataFileError(path, line, None, f"missing required column {name!r}")
+    return col_of
+
+
+def _check_polarization_columns(path, line, col_of):
+    """s1..s3 complete, or eta_deg/P/P_C, not both; error columns only beside their quantity."""
     have_s = [c for c in ("s1", "s2", "s3") if c in col_of]
     if have_s and len(have_s) != 3:
         missing = sorted({"s1", "s2", "s3"} - set(have_s))
         raise DataFileError(
-            path, header_line, None, f"missing column(s) {', '.join(missing)}: give s1, s2, s3 together"
+            path, line, None, f"missing column(s) {', '.join(missing)}: give s1, s2, s3 together"
         )
     have_e = [c for c in ("eta_deg", "P", "P_C") if c in col_of]
     if have_s and have_e:
         raise DataFileError(
             path,
-            header_line,
+            line,
             col_of[have_e[0]],
             "give the polarization as s1, s2, s3 OR as eta_deg, P, P_C, not both",
         )
     for err, base in (("eta_err_deg", "eta_deg"), ("P_err", "P"), ("P_C_err", "P_C")):
         if err in col_of and base not in col_of:
-            raise DataFileError(path, header_line, col_of[err], f"column {err!r} needs column {base!r}")
+            raise DataFileError(path, line, col_of[err], f"column {err!r} needs column {base!r}")
+
+
+def _check_incident_given_once(path, line, col_of, meta, side):
     if "incident" in col_of and "incident_polarization" in meta:
         raise DataFileError(
             path,
-            header_line,
+            line,
             col_of["incident"],
             f"incident polarization given twice (column and {side}); give it once",
         )
     if "incident" not in col_of and "incident_polarization" not in meta:
         raise DataFileError(
             path,
-            header_line,
+            line,
             None,
             "missing column 'incident' (the incident polarization, e.g. linear:45 or unpolarized); "
             "or set incident_polarization in the JSON sidecar",
         )
-    if not rows:
-        raise DataFileError(path, header_line, None, "no data rows")
 
+
+def _number(path, lineno, j, name, cell):
+    """The cell of numeric column ``name`` as a float inside the column's range."""
+    lo, hi, lo_open, hi_open, _ = COLUMNS[name]
+    if cell == "":
+        raise DataFileError(path, lineno, j, f"column {name!r}: missing value")
+    try:
+        x = float(cell)
+    except ValueError:
+        raise DataFileError(path, lineno, j, f"column {name!r}: not a number: {cell!r}") from None
+    if not math.isfinite(x):
+        raise DataFileError(path, lineno, j, f"column {name!r}: {cell!r} is not a finite number")
+    if x < lo or x > hi or (lo_open and x == lo) or (hi_open and x == hi):
+        raise DataFileError(
+            path, lineno, j, f"column {name!r}: {x:g} is outside {_range_text(lo, hi, lo_open, hi_open)}"
+        )
+    return x
+
+
+def _parse_rows(path, header, rows, col_of):
+    """``(values by numeric column, incident Stokes vectors)`` of the data rows."""
     values = {name: np.empty(len(rows)) for name in col_of if name in COLUMNS}
     incident = np.empty((len(rows), 4))
-    fixed_in = None
-    if "incident_polarization" in meta:
-        v = meta["incident_polarization"]
-        fixed_in = stokes(v if isinstance(v, str) else list(v))
     cache = {}
     for i, (lineno, fields) in enumerate(rows):
         if len(fields) != len(header):
@@ -313,42 +338,59 @@ def load_data(path) -> Dataset:
             )
         for name, j in col_of.items():
             cell = fields[j - 1].strip()
-            if name == "incident":
-                if cell not in cache:
-                    try:
-                        cache[cell] = stokes(cell)
-                    except ValueError as exc:
-                        raise DataFileError(path, lineno, j, f"column 'incident': {exc}") from exc
-                incident[i] = cache[cell]
+            if name != "incident":
+                values[name][i] = _number(path, lineno, j, name, cell)
                 continue
-            lo, hi, lo_open, hi_open, _ = COLUMNS[name]
-            if cell == "":
-                raise DataFileError(path, lineno, j, f"column {name!r}: missing value")
-            try:
-                x = float(cell)
-            except ValueError:
-                raise DataFileError(path, lineno, j, f"column {name!r}: not a number: {cell!r}") from None
-            if not math.isfinite(x):
-                raise DataFileError(path, lineno, j, f"column {name!r}: {cell!r} is not a finite number")
-            if x < lo or x > hi or (lo_open and x == lo) or (hi_open and x == hi):
-                raise DataFileError(
-                    path,
-                    lineno,
-                    j,
-                    f"column {name!r}: {x:g} is outside {_range_text(lo, hi, lo_open, hi_open)}",
-                )
-            values[name][i] = x
-    if fixed_in is not None:
-        incident[:] = fixed_in
+            if cell not in cache:
+                try:
+                    cache[cell] = stokes(cell)
+                except ValueError as exc:
+                    raise DataFileError(path, lineno, j, f"column 'incident': {exc}") from exc
+            incident[i] = cache[cell]
+    return values, incident
 
-    eta = P = PC = None
-    if have_s:
-        s = np.stack([np.ones(len(rows)), values["s1"], values["s2"], values["s3"]], axis=-1)
-        _, eta, PC, P = ellipsometric(s)
-    else:
-        eta = np.radians(values["eta_deg"]) if "eta_deg" in values else None
-        P = values.get("P")
-        PC = values.get("P_C")
+
+def _ellipsometric(values, n):
+    """``(eta, P, P_C)`` in radians from s1..s3 or eta_deg/P/P_C (``None`` where absent)."""
+    if "s1" in values:
+        s = np.stack([np.ones(n), values["s1"], values["s2"], values["s3"]], axis=-1)
+        _, eta, pc, p = ellipsometric(s)
+        return eta, p, pc
+    eta = np.radians(values["eta_deg"]) if "eta_deg" in values else None
+    return eta, values.get("P"), values.get("P_C")
+
+
+def load_data(path) -> Dataset:
+    """Read and validate a data file (and its sidecar).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The CSV file; ``NAME.json`` beside it is its sidecar.
+
+    Returns
+    -------
+    Dataset
+
+    Raises
+    ------
+    DataFileError
+        Any problem, its message starting with ``file:line:column``.
+    """
+    path = str(path)
+    raw_lines = _read_lines(path)
+    meta, side = _load_sidecar(path)
+    header, header_line, rows = _split(path, raw_lines)
+    col_of = _columns(path, header, header_line)
+    _check_polarization_columns(path, header_line, col_of)
+    _check_incident_given_once(path, header_line, col_of, meta, side)
+    if not rows:
+        raise DataFileError(path, header_line, None, "no data rows")
+    values, incident = _parse_rows(path, header, rows, col_of)
+    if "incident_polarization" in meta:
+        v = meta["incident_polarization"]
+        incident[:] = stokes(v if isinstance(v, str) else list(v))
+    eta, P, PC = _ellipsometric(values, len(rows))
     return Dataset(
         path=path,
         theta_i=np.radians(values["theta_i_deg"]),

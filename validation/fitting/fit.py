@@ -1,9 +1,10 @@
 """A fit from data file + scene + spec to a posterior: optimum, chain, summary, checks, plots.
 
-``run_fit`` does the work (no files except the checkpoint); ``write_fit`` writes
-``posterior.json``, ``chain.npz`` (the resumable checkpoint: chain, log
-posterior, acceptance counts, last ensemble and the sampler's random state) and
-the plots ``corner.png``, ``predictive.png``, ``residuals.png``.
+``run_fit`` does the work (no files except the resumable checkpoint, a
+:class:`~validation.fitting.checkpoint.CheckpointBackend`: chain, log posterior,
+acceptance counts, the sampler's random state, tau history; ``scatterbench fit``
+keeps it as ``chain.npz``); ``write_fit`` writes ``posterior.json`` and the
+plots ``corner.png``, ``predictive.png``, ``residuals.png``.
 """
 
 from __future__ import annotations
@@ -18,8 +19,10 @@ import numpy as np
 
 from models.polarization import wrap_axis
 
+from .checkpoint import CheckpointBackend
 from .likelihood import TERMS, Likelihood, replicate, term_variances
-from .sampling import ChainResult, check_walkers, initial_ball, optimize, run_chain, summarize
+from .sampling import ChainResult, initial_ball, optimize, run_chain, summarize
+from .settings import ChainSettings
 
 __all__ = [
     "FitResult",
@@ -29,23 +32,28 @@ __all__ = [
     "fingerprint",
     "corner_figure",
     "predictive_figure",
+    "scan_x",
 ]
 
 
 @dataclass
 class FitResult:
+    """A fit's likelihood, optimum, chain, posterior summary and the settings it ran with."""
+
     lik: Likelihood
     optimum: dict
     chain: ChainResult
     summary: dict
-    settings: dict
+    settings: ChainSettings
 
     @property
     def spec(self):
         return self.lik.spec
 
 
-def fingerprint(lik, settings) -> str:
+def fingerprint(lik, settings: ChainSettings) -> str:
+    """Hash of everything a resumed chain must share with the checkpoint: data, scene,
+    spec and the settings that shape the chain (the step budget may change)."""
     h = hashlib.sha256()
     d = lik.data_all
     for name in d._ARRAYS:  # every array the likelihood can read, by name
@@ -55,55 +63,54 @@ def fingerprint(lik, settings) -> str:
             h.update(np.ascontiguousarray(a).tobytes())
     h.update(json.dumps(lik.scene.raw, sort_keys=True, default=str).encode())
     h.update(json.dumps(lik.spec.as_dict(), sort_keys=True).encode())
-    keep = {k: settings[k] for k in ("walkers", "seed", "check_every", "tau_factor", "tau_rtol", "starts")}
-    h.update(json.dumps(keep, sort_keys=True).encode())
+    kept = ("walkers", "seed", "check_every", "tau_factor", "tau_rtol", "starts")
+    h.update(json.dumps({k: getattr(settings, k) for k in kept}, sort_keys=True).encode())
     return h.hexdigest()
 
 
 def run_fit(
     lik: Likelihood,
+    settings: ChainSettings | None = None,
     *,
-    walkers=32,
-    seed=0,
-    max_steps=20000,
-    check_every=100,
-    tau_factor=50.0,
-    tau_rtol=0.05,
-    starts=4,
     executor=None,
     checkpoint=None,
     resume=False,
     progress=False,
     resume_from=None,
 ):
-    check_walkers(walkers, len(lik.spec.free))
-    settings = dict(
-        walkers=walkers,
-        seed=seed,
-        max_steps=max_steps,
-        check_every=check_every,
-        tau_factor=tau_factor,
-        tau_rtol=tau_rtol,
-        starts=starts,
-    )
+    """Optimum, then an emcee chain from a ball around it, then the posterior summary.
+
+    Parameters
+    ----------
+    lik : Likelihood
+    settings : ChainSettings, optional
+        Default ``ChainSettings()`` (``scatterbench fit``'s defaults).
+    executor : optional
+        Maps the log posterior over walkers.
+    checkpoint : str, optional
+        Where the chain's checkpoint is written at every check.
+    resume : bool
+        Continue the chain saved in ``resume_from`` (default ``checkpoint``);
+        a :class:`~validation.fitting.checkpoint.CheckpointError` if it cannot be.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    FitResult
+    """
+    settings = ChainSettings() if settings is None else settings
+    settings.require_walkers(len(lik.spec.free))
     fp = fingerprint(lik, settings)
-    u_opt, lp_opt, info = optimize(lik, seed, n_starts=starts)
-    p0 = None if resume else initial_ball(u_opt, walkers, seed, lik.spec.u_bounds(), sd=info["sd_u"])
-    chain = run_chain(
-        lik,
-        p0=p0,
-        seed=seed,
-        max_steps=max_steps,
-        check_every=check_every,
-        tau_factor=tau_factor,
-        tau_rtol=tau_rtol,
-        executor=executor,
-        checkpoint=checkpoint,
-        resume=resume,
-        resume_from=resume_from,
-        fingerprint=fp,
-        progress=progress,
-    )
+    if resume:  # before the optimum: a checkpoint that cannot be resumed fails at once
+        backend = CheckpointBackend.load(resume_from or checkpoint, fp, save_to=checkpoint)
+    else:
+        backend = CheckpointBackend(checkpoint, fp)
+    u_opt, lp_opt, info = optimize(lik, settings.seed, n_starts=settings.starts)
+    p0 = None
+    if not resume:
+        p0 = initial_ball(u_opt, settings.walkers, settings.seed, lik.spec.u_bounds(), sd=info["sd_u"])
+    chain = run_chain(lik, settings, p0=p0, backend=backend, executor=executor, progress=progress)
     optimum = {
         "values": lik.spec.physical(u_opt),
         "u": [float(x) for x in u_opt],  # sampling coordinates
@@ -171,7 +178,7 @@ def predictive_checks(fit: FitResult, pp) -> dict:
     return out
 
 
-def _scan_x(data):
+def scan_x(data):
     """x coordinate for plots: signed theta_r (deg) in-plane, phi_r (deg) + 200 out-of-plane."""
     ti, tr, pr = np.degrees(data.theta_i), np.degrees(data.theta_r), np.degrees(data.phi_r)
     inplane = np.isclose(np.mod(pr, 180.0), 0.0)
@@ -189,7 +196,7 @@ def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", p
     from validation.atomic import atomic_write_json
 
     os.makedirs(out, exist_ok=True)
-    pp = predictive(fit, n_draws=n_draws, seed=fit.settings["seed"])
+    pp = predictive(fit, n_draws=n_draws, seed=fit.settings.seed)
     checks = predictive_checks(fit, pp)
     post = dict(fit.summary)
     truth = fit.lik.data_all.meta.get("truth")
@@ -218,7 +225,7 @@ def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", p
             "optimum": fit.optimum,
             "information_criteria": information_criteria(fit),
             "posterior_predictive": checks,
-            "settings": dict(fit.settings, executor=executor_desc),
+            "settings": dict(fit.settings.as_dict(), executor=executor_desc),
         }
     )
     atomic_write_json(os.path.join(out, "posterior.json"), post)
@@ -258,7 +265,7 @@ def predictive_figure(fit: FitResult, pp):
     import matplotlib.pyplot as plt
 
     data = fit.lik.data_all
-    xs, labels = _scan_x(data)
+    xs, labels = scan_x(data)
     groups = list(dict.fromkeys(labels))
     terms = [t for t in ("brdf", "eta", "P", "P_C") if _observed(data, t) is not None]
     fig, axes = plt.subplots(

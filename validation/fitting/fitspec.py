@@ -262,54 +262,44 @@ def parse_exclude(text) -> dict:
     return _exclude_box("--exclude", box)
 
 
-def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=None) -> FitSpec:
-    """Combine the scene's ``[fit]`` table with command-line entries and validate
-    them against the scene (every key exists; the bounds give valid scenes)."""
-    table = dict(scene.fit or {})
-    where = f"{scene.path}: [fit]"
-    unknown = set(table) - {"free", "noise", "mask"}
-    if unknown:
-        raise FitSpecError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: free, noise, mask")
-    params = []
+def _free_entries(where, table, free):
+    """The free scene parameters: the command line's ``free`` entries, else the table's."""
     if free:
-        params = [parse_free(t) for t in free]
-    else:
-        entries = table.get("free", [])
-        if not isinstance(entries, list):
-            raise FitSpecError(f"{where} free: expected a list of 'KEY:LOW:HIGH[:PRIOR]' strings or tables")
-        for e in entries:
-            if isinstance(e, dict):
-                missing = {"key", "low", "high"} - set(e)
-                if missing:
-                    raise FitSpecError(f"{where} free: table entry {e!r} lacks {sorted(missing)}")
-                key = ALIASES.get(e["key"], e["key"])
-                params.append(
-                    _free(
-                        f"{where} free",
-                        key,
-                        _num(where, e["low"]),
-                        _num(where, e["high"]),
-                        e.get("prior", "uniform"),
-                    )
-                )
-            else:
-                params.append(parse_free(e, f"{where} free"))
-    noise_fixed = {}
+        return [parse_free(t) for t in free]
+    entries = table.get("free", [])
+    if not isinstance(entries, list):
+        raise FitSpecError(f"{where} free: expected a list of 'KEY:LOW:HIGH[:PRIOR]' strings or tables")
+    params = []
+    for e in entries:
+        if not isinstance(e, dict):
+            params.append(parse_free(e, f"{where} free"))
+            continue
+        missing = {"key", "low", "high"} - set(e)
+        if missing:
+            raise FitSpecError(f"{where} free: table entry {e!r} lacks {sorted(missing)}")
+        key = ALIASES.get(e["key"], e["key"])
+        low, high = _num(where, e["low"]), _num(where, e["high"])
+        params.append(_free(f"{where} free", key, low, high, e.get("prior", "uniform")))
+    return params
+
+
+def _noise_entries(where, table, noise):
+    """``(free noise params, fixed levels by term, terms off)`` from the table's ``[fit.noise]``
+    with the command line's ``--noise`` entries replacing the table's for their term."""
     noise_tab = table.get("noise", {})
     if not isinstance(noise_tab, dict):
         raise FitSpecError(f"{where} noise: expected a table")
     items = list(noise_tab.items())
-    if noise:
-        for text in noise:
-            if "=" in text:
-                term, _, val = text.partition("=")
-            elif ":" in text:
-                term, _, val = text.partition(":")
-            else:
-                raise FitSpecError(f"--noise: expected TERM=VALUE or TERM:LOW:HIGH[:PRIOR]; got {text!r}")
-            items = [(k, v) for k, v in items if k != term.strip()]
-            items.append((term.strip(), val))
-    off = []
+    for text in noise or []:
+        if "=" in text:
+            term, _, val = text.partition("=")
+        elif ":" in text:
+            term, _, val = text.partition(":")
+        else:
+            raise FitSpecError(f"--noise: expected TERM=VALUE or TERM:LOW:HIGH[:PRIOR]; got {text!r}")
+        items = [(k, v) for k, v in items if k != term.strip()]
+        items.append((term.strip(), val))
+    params, fixed, off = [], {}, []
     for term, value in items:
         e = _noise_entry(f"{where} noise" if not noise else "--noise", term, value)
         if e == "off":
@@ -317,7 +307,13 @@ def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=N
         elif isinstance(e, FreeParam):
             params.append(e)
         else:
-            noise_fixed[term] = e
+            fixed[term] = e
+    return params, fixed, off
+
+
+def _check_free(scene, where, params, noise_fixed):
+    """No parameter twice, at least one scene parameter, every key in the scene and every
+    bound a valid scene."""
     keys = [p.key for p in params]
     dup = {k for k in keys if keys.count(k) > 1}
     if dup:
@@ -329,9 +325,7 @@ def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=N
     for p in params:
         if p.key.startswith("noise.") and p.key[6:] in noise_fixed:
             raise FitSpecError(f"{p.key}: both fixed and free")
-    for p in params:
-        if p.is_noise:
-            continue
+    for p in (p for p in params if not p.is_noise):
         try:
             cur = scene.get_value(p.key)
         except ValueError as exc:
@@ -345,7 +339,10 @@ def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=N
                 raise FitSpecError(
                     f"free parameter {p.key}: bound {bound:g} gives an invalid scene: {exc}"
                 ) from exc
-    params = [p for p in params if not p.is_noise] + [p for p in params if p.is_noise]
+
+
+def _mask_entries(where, table, near_specular_deg, exclude):
+    """``(near_specular_deg, exclude boxes)``: the command line's where given, else the table's."""
     mask = table.get("mask", {})
     if not isinstance(mask, dict):
         raise FitSpecError(f"{where} mask: expected a table")
@@ -359,6 +356,45 @@ def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=N
     boxes = [_exclude_box(f"{where} mask exclude", b) for b in mask.get("exclude", [])]
     if exclude:
         boxes = [parse_exclude(t) for t in exclude]
-    return FitSpec(
-        free=tuple(params), noise=noise_fixed, near_specular_deg=ns, exclude=tuple(boxes), off=tuple(off)
-    )
+    return ns, tuple(boxes)
+
+
+def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=None) -> FitSpec:
+    """Combine the scene's ``[fit]`` table with command-line entries and validate
+    them against the scene (every key exists; the bounds give valid scenes).
+
+    Parameters
+    ----------
+    scene : models.scene.Scene
+        Its ``[fit]`` table gives the defaults.
+    free : list of str, optional
+        ``KEY:LOW:HIGH[:PRIOR]`` entries replacing the table's free list.
+    noise : list of str, optional
+        ``TERM=VALUE``, ``TERM=off`` or ``TERM:LOW:HIGH[:PRIOR]`` entries replacing
+        the table's for their term.
+    near_specular_deg : float, optional
+        Mask rows within this angle of specular, in [0, 180] (replaces the table's).
+    exclude : list of str, optional
+        ``AXIS=LO:HI[,AXIS=LO:HI]`` boxes replacing the table's.
+
+    Returns
+    -------
+    FitSpec
+
+    Raises
+    ------
+    FitSpecError
+        An entry out of range or not in the scene; the message names it.
+    """
+    table = dict(scene.fit or {})
+    where = f"{scene.path}: [fit]"
+    unknown = set(table) - {"free", "noise", "mask"}
+    if unknown:
+        raise FitSpecError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: free, noise, mask")
+    params = _free_entries(where, table, free)
+    noise_params, noise_fixed, off = _noise_entries(where, table, noise)
+    params += noise_params
+    _check_free(scene, where, params, noise_fixed)
+    params = [p for p in params if not p.is_noise] + [p for p in params if p.is_noise]
+    ns, boxes = _mask_entries(where, table, near_specular_deg, exclude)
+    return FitSpec(free=tuple(params), noise=noise_fixed, near_specular_deg=ns, exclude=boxes, off=tuple(off))

@@ -34,7 +34,19 @@ from models.facet import _FacetModel
 from models.params import param
 from models.slopes import SlopeDistribution
 
-__all__ = ["UnitSlopes", "probed_slopes", "unit_response", "invert", "Curve", "fit_curve", "bootstrap"]
+__all__ = [
+    "UnitSlopes",
+    "probed_slopes",
+    "unit_response",
+    "invert",
+    "Curve",
+    "fit_curve",
+    "bootstrap",
+    "collapse",
+    "InversionStudy",
+    "inversion_study",
+    "inversion_figure",
+]
 
 
 @dataclass(frozen=True)
@@ -201,3 +213,90 @@ def collapse(inv: Inversion, curve: Curve, groups):
     """RMS of ``ln(P3_estimate / curve)`` per group of rows (do the scans fall on one curve?)."""
     r = np.log(inv.p3) - np.log(curve(inv.zeta))
     return {g: float(np.sqrt(np.mean(r[groups == g] ** 2))) for g in dict.fromkeys(groups)}
+
+
+@dataclass
+class InversionStudy:
+    """An inversion of measured data: the estimates, the common curve, its bootstrap and
+    how closely each scan falls on the curve (see :func:`inversion_study`)."""
+
+    inversion: Inversion
+    curve: Curve
+    bootstrap: dict
+    collapse: dict  # rms ln(P3 / curve) per scan
+    groups: np.ndarray  # each row's scan label
+    bins: int | None
+
+    def as_dict(self) -> dict:
+        """The numbers of ``inversion.json`` (without the input paths)."""
+        c, inv = self.curve, self.inversion
+        return {
+            "rows": len(inv.p3),
+            "normalization_measured_range": c.normalization,
+            "interpolation_error_estimate": c.interpolation_error,
+            "zeta_max": c.zeta_max,
+            "tail_beyond_zeta_max_extrapolated": c.tail,
+            "bootstrap": self.bootstrap,
+            "rms_log_deviation_from_common_curve": self.collapse,
+            "paper_value": {"normalization": 0.77, "source": "seed 000 Sec. 4 (measured sample, Fig. 4)"},
+            "estimates": {
+                "zeta_x": inv.zeta_x.tolist(),
+                "zeta_y": inv.zeta_y.tolist(),
+                "p3": inv.p3.tolist(),
+            },
+            "bins": self.bins,
+        }
+
+
+def inversion_study(model, data, bins=None, n_bootstrap=200, seed=0) -> InversionStudy:
+    """Seed 000 Sec. 4 on measured data: invert every row, fit the common curve, bootstrap it.
+
+    Parameters
+    ----------
+    model : FacetBRDF or SubsurfaceFacetBRDF
+        A single facet model (its slope distribution is not used).
+    data : Dataset
+        The rows to invert (already masked).
+    bins : int, optional
+        Bin ``ln P3`` in ``|zeta|`` (noisy data); default: every distinct slope.
+    n_bootstrap : int
+        Bootstrap replicates over rows.
+    seed : int
+        Seeds the bootstrap.
+
+    Returns
+    -------
+    InversionStudy
+    """
+    from .fit import scan_x
+
+    inv = invert(model, data)
+    curve = fit_curve(inv, bins=bins)
+    boot = bootstrap(inv, bins=bins, n=n_bootstrap, seed=seed)
+    _, groups = scan_x(data)
+    return InversionStudy(inv, curve, boot, collapse(inv, curve, groups), groups, bins)
+
+
+def inversion_figure(study: InversionStudy, model):
+    """The P3 estimates per scan, the common curve and, for reference, the model's own P3."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    inv, curve = study.inversion, study.curve
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    for g in dict.fromkeys(study.groups):
+        s = study.groups == g
+        ax.semilogy(inv.zeta[s], inv.p3[s], ".", ms=4, label=g)
+    zz = np.linspace(0, curve.zeta_max, 400)
+    ax.semilogy(zz, curve(zz), "k-", lw=1, label="common curve (spline of ln P3)")
+    if hasattr(getattr(model, "slopes", None), "p3"):
+        ax.semilogy(zz, model.slopes.p3(zz, 0 * zz), "r--", lw=0.8, label="scene's P3 (for reference)")
+    ax.set_xlabel("facet slope |zeta|")
+    ax.set_ylabel("P3 estimate")
+    lo, hi = study.bootstrap["normalization_p2.5_p97.5"]
+    ax.set_title(f"normalization {curve.normalization:.4f} (95% bootstrap {lo:.4f}-{hi:.4f})", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig

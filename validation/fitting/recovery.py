@@ -36,9 +36,17 @@ import numpy as np
 from .fit import run_fit
 from .fitspec import FitSpec
 from .likelihood import Likelihood, replicate, term_variances
-from .sampling import check_walkers
+from .settings import ChainSettings
 
-__all__ = ["simulate", "Member", "run_member", "recovery_study", "coverage_table", "subsample"]
+__all__ = [
+    "simulate",
+    "Member",
+    "run_member",
+    "check_inputs",
+    "recovery_study",
+    "coverage_table",
+    "subsample",
+]
 
 
 def subsample(data, n):
@@ -68,7 +76,11 @@ def simulate(scene, spec: FitSpec, data, truth: dict, noise: dict, rng):
 
 @dataclass(frozen=True)
 class Member:
-    """One injection: everything it needs, picklable, so any executor can run it."""
+    """One injection: everything it needs, picklable, so any executor can run it.
+
+    ``seed`` is ``(study seed, cell, injection)``; the chain's own seed derives from it
+    and replaces ``chain.seed``.
+    """
 
     scene: object
     spec: FitSpec
@@ -76,27 +88,16 @@ class Member:
     truth: dict
     noise: dict
     seed: tuple
-    walkers: int
-    max_steps: int
-    check_every: int
-    tau_factor: float
-    starts: int
+    chain: ChainSettings
 
 
 def run_member(m: Member) -> dict:
+    """Simulate the member's data set, fit it, and say which intervals contain the truth."""
     ss = np.random.SeedSequence(list(m.seed))
     noise_seed, chain_seed = (int(s.generate_state(1)[0]) for s in ss.spawn(2))
     data = simulate(m.scene, m.spec, m.data, m.truth, m.noise, np.random.default_rng(noise_seed))
     # the fit a user would run (the optimizer starts from the scene's values, the truth here)
-    fit = run_fit(
-        Likelihood(m.scene, m.spec, data),
-        walkers=m.walkers,
-        seed=chain_seed,
-        max_steps=m.max_steps,
-        check_every=m.check_every,
-        tau_factor=m.tau_factor,
-        starts=m.starts,
-    )
+    fit = run_fit(Likelihood(m.scene, m.spec, data), m.chain.replace(seed=chain_seed))
     res = fit.chain
     out = {
         "tau_max": float(np.max(res.tau)),
@@ -148,35 +149,23 @@ def coverage_table(results, keys):
     return out
 
 
-def recovery_study(
-    scene,
-    spec: FitSpec,
-    data,
-    *,
-    noise_levels=(0.05,),
-    n_geometries=(None,),
-    injections=50,
-    seed=0,
-    walkers=16,
-    max_steps=2000,
-    check_every=100,
-    tau_factor=50.0,
-    starts=1,
-    executor=None,
-    noise_extra=None,
-    progress=False,
-):
-    """Cells (noise level x number of geometries), ``injections`` members each.
+def check_inputs(spec, chain, noise_extra=None, injections=1):
+    """Raise ``ValueError`` unless a study of ``spec`` can run: enough walkers for its free
+    parameters, a level to simulate with (its truth) for every free polarization noise
+    level, at least one injection per cell.
 
-    The truth is the scene's value of every free scene parameter; noise levels
-    are the fractional BRDF noise ``noise.brdf`` (fixed in each cell's spec at
-    the simulated level unless the spec frees it, in which case its truth is
-    that level).  ``noise_extra``: fixed levels of polarization terms.
+    Parameters
+    ----------
+    spec : FitSpec
+    chain : ChainSettings
+    noise_extra : dict, optional
+        Fixed levels of polarization terms.
+    injections : int
+        Members per cell, >= 1.
     """
-    from .executors import SerialExecutor
-
-    executor = executor or SerialExecutor()
-    check_walkers(walkers, len(spec.free))
+    if isinstance(injections, bool) or not isinstance(injections, int) or injections < 1:
+        raise ValueError(f"injections must be an integer >= 1; got {injections!r}")
+    chain.require_walkers(len(spec.free))
     missing = [
         p.key
         for p in spec.free
@@ -187,54 +176,108 @@ def recovery_study(
             f"{', '.join(missing)}: a free polarization noise level needs the level to simulate with "
             "(noise_extra, e.g. {'eta_deg': 1.0}); its truth is that level"
         )
-    cells = []
-    members = []
-    for ci, (lvl, ng) in enumerate((lv, g) for lv in noise_levels for g in n_geometries):
-        d = data if ng is None else subsample(data, ng)
-        noise = {"brdf": float(lvl), **(noise_extra or {})}
-        free_noise = {p.key[6:] for p in spec.free if p.is_noise}
-        fixed = {k: v for k, v in noise.items() if k not in free_noise}
-        cell_spec = dataclasses.replace(spec, noise=fixed)
-        truth = {p.key: float(scene.get_value(p.key)) for p in spec.free if not p.is_noise}
-        truth.update({f"noise.{k}": v for k, v in noise.items() if k in free_noise})
-        cells.append({"noise_brdf": float(lvl), "geometries": len(d), "truth": truth})
-        for j in range(injections):
-            members.append(
-                Member(
-                    scene,
-                    cell_spec,
-                    d,
-                    truth,
-                    noise,
-                    (int(seed), ci, j),
-                    walkers,
-                    max_steps,
-                    check_every,
-                    tau_factor,
-                    starts,
-                )
-            )
-    # one map per cell: a progress bar that moves, and the same results (members are independent)
+
+
+def _cell(scene, spec, data, level, n_geometries, noise_extra):
+    """One cell's data rows, spec (simulated noise levels fixed unless free), truth and noise."""
+    d = data if n_geometries is None else subsample(data, n_geometries)
+    noise = {"brdf": float(level), **(noise_extra or {})}
+    free_noise = {p.key[6:] for p in spec.free if p.is_noise}
+    cell_spec = dataclasses.replace(spec, noise={k: v for k, v in noise.items() if k not in free_noise})
+    truth = {p.key: float(scene.get_value(p.key)) for p in spec.free if not p.is_noise}
+    truth.update({f"noise.{k}": v for k, v in noise.items() if k in free_noise})
+    return d, cell_spec, truth, noise
+
+
+def _run_members(executor, members, per_cell, progress):
+    """Every member's result, in order: one map per cell, so a progress bar moves
+    (members are independent: the results do not depend on the grouping)."""
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=len(members), unit="fit", desc="injections", mininterval=1.0)
     results = []
-    for start in range(0, len(members), injections):
-        results.extend(executor.map(run_member, members[start : start + injections]))
+    try:
+        for start in range(0, len(members), per_cell):
+            results.extend(executor.map(run_member, members[start : start + per_cell]))
+            if bar is not None:
+                bar.update(per_cell)
+    finally:
         if bar is not None:
-            bar.update(injections)
-    if bar is not None:
-        bar.close()
-    k = 0
-    for cell in cells:
-        rs = results[k : k + injections]
-        k += injections
-        cell["summary"] = coverage_table(rs, list(cell["truth"]))
-        cell["tau_max_median"] = float(np.median([r["tau_max"] for r in rs]))
-        cell["steps_median"] = float(np.median([r["steps"] for r in rs]))
-        cell["steps_over_tau_min"] = float(min(r["steps"] / r["tau_max"] for r in rs))
-        cell["acceptance_median"] = float(np.median([r["acceptance"] for r in rs]))
-        cell["members"] = rs
-    return cells
+            bar.close()
+    return results
+
+
+def _summarize_cell(cell, results):
+    """Coverage table and chain diagnostics of one cell's members (added to ``cell``)."""
+    cell["summary"] = coverage_table(results, list(cell["truth"]))
+    cell["tau_max_median"] = float(np.median([r["tau_max"] for r in results]))
+    cell["steps_median"] = float(np.median([r["steps"] for r in results]))
+    cell["steps_over_tau_min"] = float(min(r["steps"] / r["tau_max"] for r in results))
+    cell["acceptance_median"] = float(np.median([r["acceptance"] for r in results]))
+    cell["members"] = results
+    return cell
+
+
+def recovery_study(
+    scene,
+    spec: FitSpec,
+    data,
+    chain: ChainSettings,
+    *,
+    noise_levels=(0.05,),
+    n_geometries=(None,),
+    injections=50,
+    executor=None,
+    noise_extra=None,
+    progress=False,
+):
+    """Cells (noise level x number of geometries), ``injections`` members each.
+
+    The truth is the scene's value of every free scene parameter; noise levels
+    are the fractional BRDF noise ``noise.brdf`` (fixed in each cell's spec at
+    the simulated level unless the spec frees it, in which case its truth is
+    that level).
+
+    Parameters
+    ----------
+    scene, spec, data
+        The scene (and its truth), the fit spec, the rows whose geometries and
+        incident states the injections use.
+    chain : ChainSettings
+        Every member's chain; ``chain.seed`` is the study's seed (each member's
+        chain seed derives from it, the cell and the injection).
+    noise_levels : sequence of float
+        Fractional BRDF noise levels.
+    n_geometries : sequence of int or None
+        Evenly spread subsets of the rows (``None``: all).
+    injections : int
+        Members per cell.
+    executor : optional
+        Runs the members (default in-process).
+    noise_extra : dict, optional
+        Fixed levels of polarization terms.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    list of dict
+        One per cell: its level, geometries, truth, coverage summary, chain
+        diagnostics and members.
+    """
+    from .executors import SerialExecutor
+
+    check_inputs(spec, chain, noise_extra, injections)
+    cells, members = [], []
+    for ci, (lvl, ng) in enumerate((lv, g) for lv in noise_levels for g in n_geometries):
+        d, cell_spec, truth, noise = _cell(scene, spec, data, lvl, ng, noise_extra)
+        cells.append({"noise_brdf": float(lvl), "geometries": len(d), "truth": truth})
+        members += [
+            Member(scene, cell_spec, d, truth, noise, (chain.seed, ci, j), chain) for j in range(injections)
+        ]
+    results = _run_members(executor or SerialExecutor(), members, injections, progress)
+    return [
+        _summarize_cell(cell, results[i * injections : (i + 1) * injections]) for i, cell in enumerate(cells)
+    ]

@@ -6,16 +6,17 @@ seeded starts, then, when noise terms are free, a bounded maximization of the
 full log posterior from the best of them.
 
 ``run_chain`` runs an :class:`emcee.EnsembleSampler` (stretch move) in
-segments of ``check_every`` steps.  After each segment it estimates the
-integrated autocorrelation time ``tau`` of every parameter (emcee's
-``integrated_time`` on the whole chain, ``c = 5``) and writes a checkpoint (the
-chain, log-probabilities, acceptance counts, the last ensemble and the
-sampler's random state) atomically.  It stops when ``N >= tau_factor *
-max(tau)`` and ``max(tau)`` moved by less than ``tau_rtol`` since the previous
-check ("converged"), or at ``max_steps`` ("step budget") and says which.
-Segments are aligned to multiples of ``check_every`` steps, and the random
-state is saved with the ensemble, so a run resumed from its checkpoint
-produces the same chain, bit for bit, as an uninterrupted one.
+segments of ``check_every`` steps (:class:`~validation.fitting.settings.ChainSettings`),
+storing the chain in a :class:`~validation.fitting.checkpoint.CheckpointBackend`.
+After each segment the backend estimates the integrated autocorrelation time
+``tau`` of every parameter (emcee's ``integrated_time`` on the whole chain,
+``c = 5``) and, when it has a path, writes its checkpoint atomically.  The run
+stops when ``N >= tau_factor * max(tau)`` and ``max(tau)`` moved by less than
+``tau_rtol`` since the previous check ("converged"), or at ``max_steps``
+("step budget") and says which.  Segments are aligned to multiples of
+``check_every`` steps, and the random state is saved with the chain, so a run
+resumed from its checkpoint produces the same chain, bit for bit, as an
+uninterrupted one.
 
 All random draws (walker initialization, the stretch move) happen in this
 process from the seed; the executor only maps the log-probability over walkers.
@@ -23,18 +24,18 @@ process from the seed; the executor only maps the log-probability over walkers.
 
 from __future__ import annotations
 
-import io
-import json
+import contextlib
 import math
-import os
 import time
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import emcee
 import numpy as np
 from scipy import optimize as _opt
 
-from validation.atomic import atomic_write_bytes
+from .checkpoint import CheckpointBackend, CheckpointError
+from .settings import ChainSettings
 
 __all__ = [
     "optimize",
@@ -42,61 +43,96 @@ __all__ = [
     "run_chain",
     "ChainResult",
     "summarize",
+    "CheckpointBackend",
     "CheckpointError",
-    "check_walkers",
+    "ChainSettings",
 ]
 
 
-def check_walkers(walkers, ndim):
-    """The ensemble needs an even number of walkers, at least two per free parameter
-    (emcee's stretch move splits it in halves)."""
-    if isinstance(walkers, bool) or not isinstance(walkers, int) or walkers < 2 * ndim or walkers % 2:
-        raise ValueError(f"walkers must be even and >= 2 x free parameters ({2 * ndim}); got {walkers!r}")
-
-
-class CheckpointError(ValueError):
-    """A checkpoint that cannot be resumed (missing, or made with other settings)."""
-
-
 # ---------------------------------------------------------------------------- optimum
+def _default_start(lik, bounds):
+    """The scene's values, clipped into the bounds; free noise terms at the middle of their range."""
+    start = []
+    for p, (lo, hi) in zip(lik.spec.free, bounds, strict=True):
+        if p.is_noise:
+            start.append(0.5 * (lo + hi))
+        else:
+            v = float(p.to_u(lik.scene.get_value(p.key)))
+            start.append(min(max(v, lo), hi))
+    return np.asarray(start, float)
+
+
+def _least_squares(lik, s, bounds, model_idx):
+    """Scene parameters by bounded least squares from ``s`` (noise terms held at ``s``);
+    ``None`` when the start gives no finite residuals."""
+    s = np.clip(s, bounds[:, 0], bounds[:, 1])
+
+    def resid(v):
+        u = s.copy()
+        u[model_idx] = v
+        return lik.whitened(u)
+
+    lo, hi = bounds[model_idx, 0], bounds[model_idx, 1]
+    x0 = np.clip(s[model_idx], lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+    try:
+        r = _opt.least_squares(resid, x0, bounds=(lo, hi), x_scale=hi - lo, max_nfev=400)
+    except ValueError:
+        return None
+    u = s.copy()
+    u[model_idx] = r.x
+    return u
+
+
+def _polish_noise(lik, u, val, bounds):
+    """Free noise levels: maximize the full log posterior (Powell, bounded) from ``(u, val)``."""
+
+    def neg(v):
+        lp = lik(v)
+        return -lp if math.isfinite(lp) else 1e300
+
+    r = _opt.minimize(
+        neg,
+        u,
+        method="Powell",
+        bounds=list(map(tuple, bounds)),
+        options={"xtol": 1e-6, "ftol": 1e-10, "maxfev": 4000},
+    )
+    lp = lik(r.x)
+    return (np.asarray(r.x, float), float(lp)) if lp > val else (u, val)
+
+
 def optimize(lik, seed, n_starts=4, start=None):
     """Maximum of the log posterior ``lik(u)`` (a :class:`~validation.fitting.likelihood.Likelihood`).
 
-    Returns ``(u_best, log_post_best, info)``.  Starts: ``start`` (default the
-    scene's values, clipped into the bounds; free noise terms at the middle of
-    their sampling range) and ``n_starts - 1`` draws from the prior.
+    Parameters
+    ----------
+    lik : Likelihood
+    seed : int
+        Seeds the prior draws of the extra starts.
+    n_starts : int
+        ``start`` and ``n_starts - 1`` draws from the prior.
+    start : array_like, optional
+        Default: the scene's values, clipped into the bounds; free noise terms at
+        the middle of their sampling range.
+
+    Returns
+    -------
+    u_best : ndarray
+    log_post_best : float
+    info : dict
+        ``starts``, ``start_values`` (the log posterior reached from each) and
+        ``sd_u`` (rough posterior standard deviations at the optimum).
     """
-    spec = lik.spec
-    b = spec.u_bounds()
+    b = lik.spec.u_bounds()
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 1]))
     if start is None:
-        start = []
-        for p, (lo, hi) in zip(spec.free, b, strict=True):
-            if p.is_noise:
-                start.append(0.5 * (lo + hi))
-            else:
-                v = float(p.to_u(lik.scene.get_value(p.key)))
-                start.append(min(max(v, lo), hi))
+        start = _default_start(lik, b)
     starts = [np.asarray(start, float)] + [rng.uniform(b[:, 0], b[:, 1]) for _ in range(n_starts - 1)]
-    noise_idx = [i for i, p in enumerate(spec.free) if p.is_noise]
-    model_idx = [i for i, p in enumerate(spec.free) if not p.is_noise]
-    best = None
-    tried = []
+    model_idx = [i for i, p in enumerate(lik.spec.free) if not p.is_noise]
+    best, tried = None, []
     for s in starts:
-        s = np.clip(s, b[:, 0], b[:, 1])
-
-        def resid(v, s=s):
-            u = s.copy()
-            u[model_idx] = v
-            return lik.whitened(u)
-
-        lo, hi = b[model_idx, 0], b[model_idx, 1]
-        x0 = np.clip(s[model_idx], lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
-        try:
-            r = _opt.least_squares(resid, x0, bounds=(lo, hi), x_scale=hi - lo, max_nfev=400)
-            u = s.copy()
-            u[model_idx] = r.x
-        except ValueError:
+        u = _least_squares(lik, s, b, model_idx)
+        if u is None:
             continue
         val = lik(u)
         tried.append(float(val))
@@ -105,22 +141,8 @@ def optimize(lik, seed, n_starts=4, start=None):
     if best is None:
         raise ValueError("optimize: no start gave a finite likelihood; check the bounds and the data")
     u, val = best
-    if noise_idx:
-
-        def neg(v):
-            lp = lik(v)
-            return -lp if math.isfinite(lp) else 1e300
-
-        r = _opt.minimize(
-            neg,
-            u,
-            method="Powell",
-            bounds=list(map(tuple, b)),
-            options={"xtol": 1e-6, "ftol": 1e-10, "maxfev": 4000},
-        )
-        lp = lik(r.x)
-        if lp > val:
-            u, val = np.asarray(r.x, float), float(lp)
+    if len(model_idx) < len(lik.spec.free):
+        u, val = _polish_noise(lik, u, val, b)
     return u, float(val), {"starts": len(starts), "start_values": tried, "sd_u": _posterior_sd(lik, u)}
 
 
@@ -213,168 +235,118 @@ class ChainResult:
         return self.chain[burn::thin].reshape(-1, self.chain.shape[2])
 
 
-def _tau(chain):
-    if chain.shape[0] < 10:
-        return np.full(chain.shape[2], np.nan)
-    return emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
-
-
-def _converged(tau_history, tau_factor, tau_rtol):
+def _converged(tau_history, settings):
     """N >= tau_factor * max(tau), and max(tau) moved by < tau_rtol since the previous check."""
     if len(tau_history) < 2:
         return False
     (steps, tau), (_, prev) = tau_history[-1], tau_history[-2]
     if not (np.all(np.isfinite(tau)) and np.all(np.isfinite(prev))):
         return False
-    return bool(steps >= tau_factor * tau.max() and abs(tau.max() - prev.max()) < tau_rtol * tau.max())
-
-
-def _save_checkpoint(path, fingerprint, chain, log_prob, accepted, state, tau_history, seconds, evaluations):
-    rs = state.random_state
-    buf = io.BytesIO()
-    np.savez(
-        buf,
-        chain=chain,
-        log_prob=log_prob,
-        accepted=accepted,
-        coords=state.coords,
-        last_log_prob=state.log_prob,
-        rs_name=np.array(rs[0]),
-        rs_keys=rs[1],
-        rs_pos=np.array(rs[2]),
-        rs_has_gauss=np.array(rs[3]),
-        rs_cached=np.array(rs[4]),
-        fingerprint=np.array(fingerprint),
-        tau_history=json.dumps([[s, list(map(float, t))] for s, t in tau_history]),
-        seconds=np.array(seconds),
-        evaluations=np.array(evaluations),
+    return bool(
+        steps >= settings.tau_factor * tau.max()
+        and abs(tau.max() - prev.max()) < settings.tau_rtol * tau.max()
     )
-    atomic_write_bytes(path, buf.getvalue())
 
 
-def load_checkpoint(path, fingerprint=None):
-    if not os.path.exists(path):
-        raise CheckpointError(f"{path}: no checkpoint to resume")
-    with np.load(path) as z:
-        if fingerprint is not None and str(z["fingerprint"]) != fingerprint:
+def _first_state(backend, settings, p0):
+    """Where the sampler starts: the checkpoint's last ensemble and random state, or ``p0``
+    with a random state from the seed."""
+    if backend.initialized and backend.iteration > 0:
+        if backend.nwalkers != settings.walkers:
             raise CheckpointError(
-                f"{path}: the checkpoint was made with other data, scene, spec, walkers or seed; "
-                "resume with the same settings, or start a new run"
+                f"{backend.path}: the checkpoint has {backend.nwalkers} walkers, the settings {settings.walkers}"
             )
-        rs = (
-            str(z["rs_name"]),
-            z["rs_keys"],
-            int(z["rs_pos"]),
-            int(z["rs_has_gauss"]),
-            float(z["rs_cached"]),
-        )
-        state = emcee.State(z["coords"].copy(), log_prob=z["last_log_prob"].copy(), random_state=rs)
-        hist = [(s, np.array(t)) for s, t in json.loads(str(z["tau_history"]))]
-        return {
-            "chain": z["chain"].copy(),
-            "log_prob": z["log_prob"].copy(),
-            "accepted": z["accepted"].copy(),
-            "state": state,
-            "tau_history": hist,
-            "seconds": float(z["seconds"]),
-            "evaluations": int(z["evaluations"]),
-        }
+        settings.require_walkers(backend.ndim)
+        return backend.get_last_sample()
+    if p0 is None:
+        raise ValueError("p0: the walkers' starting positions are needed for a new chain")
+    p0 = np.asarray(p0, float)
+    if p0.ndim != 2 or p0.shape[0] != settings.walkers:
+        raise ValueError(f"p0: expected shape (walkers = {settings.walkers}, ndim); got {p0.shape}")
+    settings.require_walkers(p0.shape[1])
+    return emcee.State(p0, random_state=np.random.RandomState(settings.seed % 2**32).get_state())
 
 
-def run_chain(
-    log_prob,
-    *,
-    p0=None,
-    seed=0,
-    max_steps=20000,
-    check_every=100,
-    tau_factor=50.0,
-    tau_rtol=0.05,
-    executor=None,
-    checkpoint=None,
-    resume=False,
-    fingerprint="",
-    progress=False,
-    resume_from=None,
-):
-    """Run (or resume) the ensemble; see the module docstring.  ``p0``: (walkers, ndim).
+@contextlib.contextmanager
+def _progress_bar(show, total, initial):
+    """A tqdm bar over the step budget (``show``), else a stand-in that does nothing."""
+    if not show:
+        yield SimpleNamespace(update=lambda n: None)
+        return
+    from tqdm import tqdm
 
-    ``checkpoint``: where checkpoints are written; ``resume``: continue from
-    ``resume_from`` (default: ``checkpoint``)."""
-    if check_every < 1:
-        raise ValueError(f"check_every must be >= 1; got {check_every}")
-    if resume:
-        ck = load_checkpoint(resume_from or checkpoint, fingerprint)
-        chain, lps, accepted, state = ck["chain"], ck["log_prob"], ck["accepted"], ck["state"]
-        tau_history, seconds, evaluations = ck["tau_history"], ck["seconds"], ck["evaluations"]
-        nwalkers, ndim = state.coords.shape
-    else:
-        p0 = np.asarray(p0, float)
-        nwalkers, ndim = p0.shape
-        check_walkers(nwalkers, ndim)
-        state = emcee.State(p0, random_state=np.random.RandomState(int(seed) % 2**32).get_state())
-        chain = np.empty((0, nwalkers, ndim))
-        lps = np.empty((0, nwalkers))
-        accepted = np.zeros(nwalkers)
-        tau_history, seconds, evaluations = [], 0.0, 0
-    sampler = emcee.EnsembleSampler(nwalkers, ndim, log_prob, pool=executor)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=max_steps, initial=chain.shape[0], unit="step", desc="emcee", mininterval=1.0)
-    converged = False
-    reason = ""
+    bar = tqdm(total=total, initial=initial, unit="step", desc="emcee", mininterval=1.0)
     try:
-        while chain.shape[0] < max_steps:
-            if _converged(tau_history, tau_factor, tau_rtol):
-                converged = True
-                break
-            done = chain.shape[0]
-            n = min(check_every - done % check_every, max_steps - done)
-            t0 = time.perf_counter()
-            if state.log_prob is None:
-                evaluations += nwalkers  # emcee evaluates the initial ensemble
-            sampler.reset()
-            for st in sampler.sample(state, iterations=n, store=True):
-                state = st
-                if bar is not None:
-                    bar.update(1)
-            seconds += time.perf_counter() - t0
-            evaluations += n * nwalkers
-            chain = np.concatenate([chain, sampler.get_chain()])
-            lps = np.concatenate([lps, sampler.get_log_prob()])
-            accepted = accepted + sampler.backend.accepted
-            steps = chain.shape[0]
-            tau_history.append((steps, _tau(chain)))
-            if checkpoint:
-                _save_checkpoint(
-                    checkpoint, fingerprint, chain, lps, accepted, state, tau_history, seconds, evaluations
-                )
-        if not converged and _converged(tau_history, tau_factor, tau_rtol):
-            converged = True
-        if converged:
-            steps, tau = tau_history[-1]
-            reason = f"converged: N = {steps} >= {tau_factor:g} tau = {tau_factor * tau.max():.0f}"
-        else:
-            tau = tau_history[-1][1] if tau_history else np.full(ndim, np.nan)
-            reason = (
-                f"step budget reached: N = {chain.shape[0]} (max_steps), {tau_factor:g} tau = "
-                f"{tau_factor * np.max(tau):.0f}: NOT converged by the N >= {tau_factor:g} tau rule"
-            )
+        yield bar
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
+
+
+def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, progress=False):
+    """Run (or resume) the ensemble until converged or out of steps; see the module docstring.
+
+    Parameters
+    ----------
+    log_prob : callable
+        Log posterior of one walker's position (picklable for a process executor).
+    settings : ChainSettings, optional
+        Walkers, seed, step budget, check interval and stopping rule (default:
+        ``ChainSettings()``).
+    p0 : ndarray, shape (walkers, ndim), optional
+        Starting positions of a new chain (ignored when ``backend`` holds one).
+    backend : CheckpointBackend, optional
+        Where the chain is kept (and saved, if it has a path): a new one, or
+        :meth:`CheckpointBackend.load` to resume.  Default: memory only.
+    executor : optional
+        Maps the log posterior over walkers (``map(fn, items)``).
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    ChainResult
+    """
+    settings = ChainSettings() if settings is None else settings
+    backend = CheckpointBackend() if backend is None else backend
+    state = _first_state(backend, settings, p0)
+    sampler = emcee.EnsembleSampler(
+        settings.walkers, state.coords.shape[1], log_prob, pool=executor, backend=backend
+    )
+    with _progress_bar(progress, settings.max_steps, backend.iteration) as bar:
+        while backend.iteration < settings.max_steps and not _converged(backend.tau_history, settings):
+            done = backend.iteration
+            # segments end on multiples of check_every, so a resumed run checks where the original did
+            n = min(settings.check_every - done % settings.check_every, settings.max_steps - done)
+            t0 = time.perf_counter()
+            for _ in sampler.sample(state, iterations=n, store=True):
+                bar.update(1)
+            backend.end_segment(time.perf_counter() - t0)
+            state = backend.get_last_sample()  # the ensemble and random state after the segment
+    return _result(backend, settings)
+
+
+def _result(backend, settings) -> ChainResult:
+    """The chain in ``backend`` with its convergence verdict and the reason it stopped."""
+    hist, f = backend.tau_history, settings.tau_factor
+    tau = hist[-1][1] if hist else np.full(backend.ndim, np.nan)
+    converged = _converged(hist, settings)
+    if converged:
+        reason = f"converged: N = {hist[-1][0]} >= {f:g} tau = {f * tau.max():.0f}"
+    else:
+        reason = (
+            f"step budget reached: N = {backend.iteration} (max_steps), {f:g} tau = "
+            f"{f * np.max(tau):.0f}: NOT converged by the N >= {f:g} tau rule"
+        )
     return ChainResult(
-        chain=chain,
-        log_prob=lps,
-        accepted=accepted,
-        tau=tau_history[-1][1] if tau_history else np.full(ndim, np.nan),
-        tau_history=tau_history,
+        chain=backend.get_chain(),
+        log_prob=backend.get_log_prob(),
+        accepted=backend.accepted.copy(),
+        tau=tau,
+        tau_history=list(hist),
         converged=converged,
         stop_reason=reason,
-        seconds=seconds,
-        evaluations=evaluations,
+        seconds=backend.seconds,
+        evaluations=backend.evaluations,
     )
 
 

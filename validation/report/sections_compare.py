@@ -27,9 +27,12 @@ STRONG_DBIC = 10.0
 
 
 def _settings(quick):
+    """``(rows per file, chain settings)``."""
+    from validation.fitting.settings import ChainSettings
+
     if quick:  # the configuration of tests/test_recovery.py (same seed: fitted once per process)
-        return dict(rows=40, walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
-    return dict(rows=None, walkers=24, seed=3, max_steps=2000, check_every=100, starts=4)
+        return 40, ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
+    return None, ChainSettings(walkers=24, seed=3, max_steps=2000, check_every=100, starts=4)
 
 
 def _best_values(fit):
@@ -79,8 +82,8 @@ def section_model_comparison(ctx):
     from validation.fitting.compare import SEED003_PAIRING, seed003_pairing
 
     s = Section("model_comparison", "Model comparison: seed 003's combination against Maxwell-Beard")
-    st = _settings(ctx.quick)
-    cases = seed003_pairing(**st)
+    n_rows, st = _settings(ctx.quick)
+    cases = seed003_pairing(st, rows=n_rows)
     speckle = {c["fits"][0].lik.data_all.meta["provenance"]["noise_levels"]["brdf_frac"] for c in cases}
     (speckle,) = speckle  # both files were made with the same level
     s.blocks.append(
@@ -92,9 +95,9 @@ def section_model_comparison(ctx):
             f"hypothesis's generator: {', '.join(SEED003_PAIRING['data'].values())}; scenes references/scenes/"
             f"{' and references/scenes/'.join(SEED003_PAIRING['scenes'].values())}. Each pair is fitted with every "
             "likelihood term (BRDF, eta, P, P_C) and with the BRDF alone (eta, P, P_C off). "
-            f"{'All ' if st['rows'] is None else ''}{cases[0]['rows'][0]['n']} rows per file"
-            f"{'' if st['rows'] is None else ' (evenly spread)'}; emcee {st['walkers']} walkers, at most "
-            f"{st['max_steps']} steps, seed {st['seed']}. The data were made with {speckle:g} speckle (their "
+            f"{'All ' if n_rows is None else ''}{cases[0]['rows'][0]['n']} rows per file"
+            f"{'' if n_rows is None else ' (evenly spread)'}; emcee {st.walkers} walkers, at most "
+            f"{st.max_steps} steps, seed {st.seed}. The data were made with {speckle:g} speckle (their "
             "sidecars' provenance): a fitted "
             "noise.brdf far above it is a hypothesis absorbing its misfit into the noise. Lower AIC/BIC/WAIC "
             "is better; differences from the best per data set and term choice."

@@ -453,13 +453,17 @@ FIT_DATA = "scatmech_flake_measurement.csv"
 RECOVERY_SCENE = "aluminium_flakes_clearcoat.toml"
 
 
-def _fit_settings(quick):
+def _fit_settings(quick, seed):
+    from validation.fitting.settings import ChainSettings
+
     if quick:
-        return dict(walkers=16, max_steps=1000, check_every=100, starts=2)
-    return dict(walkers=32, max_steps=20000, check_every=100, starts=4)  # scatterbench fit's defaults
+        return ChainSettings(walkers=16, seed=seed, max_steps=1000, check_every=100, starts=2)
+    return ChainSettings(seed=seed)  # scatterbench fit's defaults: 32 walkers, 20000 steps, 4 starts
 
 
-def _recovery_settings(quick):
+def _recovery_settings(quick, seed):
+    from validation.fitting.settings import ChainSettings
+
     if quick:  # the configuration of tests/test_recovery.py
         return dict(
             free=["sigma:0.01:1:log"],
@@ -467,10 +471,7 @@ def _recovery_settings(quick):
             noise_levels=(0.1,),
             n_geometries=(8,),
             injections=50,
-            walkers=4,
-            max_steps=150,
-            check_every=150,
-            starts=1,
+            chain=ChainSettings(walkers=4, seed=seed, max_steps=150, check_every=150, starts=1),
         )
     # Two correlated parameters, 16 walkers run to N > 50 tau, on both cores: the same study over 4
     # cells (8 and 32 geometries) took 1315 s on a loaded machine; the 8-geometry cells are the cheaper half.
@@ -480,10 +481,7 @@ def _recovery_settings(quick):
         noise_levels=(0.05, 0.1),
         n_geometries=(8,),
         injections=50,
-        walkers=16,
-        max_steps=4000,
-        check_every=100,
-        starts=1,
+        chain=ChainSettings(walkers=16, seed=seed, max_steps=4000, check_every=100, starts=1),
         workers=2,
     )
 
@@ -503,8 +501,8 @@ def section_uncertainty(ctx):
     data = load_data(data_path)
     spec = fitspec_from(sc)
     lik = Likelihood(sc, spec, data)
-    st = _fit_settings(ctx.quick)
-    fit = run_fit(lik, seed=ctx.seed, tau_factor=50.0, **st)
+    st = _fit_settings(ctx.quick, ctx.seed)
+    fit = run_fit(lik, st)
     with tempfile.TemporaryDirectory() as tmp:  # write_fit's summary (truth check, predictive checks)
         post = write_fit(fit, tmp, data_path=FIT_DATA, scene_path=FIT_SCENE, plots=False)
     samp = post["sampling"]
@@ -512,8 +510,8 @@ def section_uncertainty(ctx):
         text_block(
             f"Data: references/data/{FIT_DATA} ({post['data']['rows']} rows, synthetic SCATMECH measurement, "
             f"truth in its JSON sidecar); scene references/scenes/{FIT_SCENE} with its [fit] table "
-            f"({', '.join(spec.names)} free). emcee: {samp['walkers']} walkers, at most {st['max_steps']} steps "
-            f"({'quick' if ctx.quick else 'full'} run), seed {ctx.seed}, {st['starts']} optimizer starts. "
+            f"({', '.join(spec.names)} free). emcee: {samp['walkers']} walkers, at most {st.max_steps} steps "
+            f"({'quick' if ctx.quick else 'full'} run), seed {ctx.seed}, {st.starts} optimizer starts. "
             f"Stop: {samp['stop_reason']}."
             + (
                 ""
@@ -605,24 +603,21 @@ def section_uncertainty(ctx):
         )
     )
     # --- recovery study
-    rs = _recovery_settings(ctx.quick)
+    rs = _recovery_settings(ctx.quick, ctx.seed)
     rsc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
     rspec = fitspec_from(rsc, rs["free"], rs["noise"])
     from validation.fitting.executors import make_executor
 
+    rchain = rs["chain"]
     with make_executor(rs.get("workers", 1), None) as ex:  # identical results on any executor (tested)
         cells = recovery_study(
             rsc,
             rspec,
             data,
+            rchain,
             noise_levels=rs["noise_levels"],
             n_geometries=rs["n_geometries"],
             injections=rs["injections"],
-            seed=ctx.seed,
-            walkers=rs["walkers"],
-            max_steps=rs["max_steps"],
-            check_every=rs["check_every"],
-            starts=rs["starts"],
             executor=ex,
         )
     crow = []
@@ -653,8 +648,8 @@ def section_uncertainty(ctx):
         text_block(
             f"Injection-recovery (validation/recovery.py): scene references/scenes/{RECOVERY_SCENE}, free "
             f"{', '.join(rs['free'])}, geometries from the data file (evenly spread subsets), log-normal speckle "
-            f"at the listed level; {rs['injections']} injections per cell, each fitted with {rs['walkers']} walkers "
-            f"and at most {rs['max_steps']} steps, seed {ctx.seed}"
+            f"at the listed level; {rs['injections']} injections per cell, each fitted with {rchain.walkers} walkers "
+            f"and at most {rchain.max_steps} steps, seed {ctx.seed}"
             + (" (quick mode: the configuration of tests/test_recovery.py)." if ctx.quick else ".")
             + " z = (coverage - nominal) / binomial SE. The curvature columns are the coverage, on the same "
             "data sets, of the optimum +- 1 and 2 Gauss-Newton standard deviations: when they are nominal and "

@@ -1,0 +1,111 @@
+"""The sampler's settings, stated once: :class:`ChainSettings`.
+
+A fit, a recovery study's members, a model comparison, the command line and
+the report all run chains with the same handful of settings; they pass one
+frozen, validated object instead of re-listing them.  The command line builds
+it from its flags in one place (``_chain_settings`` in :mod:`validation.cli.fit`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+from dataclasses import dataclass
+
+__all__ = ["ChainSettings"]
+
+
+def _integer(name, value, low):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+        raise ValueError(f"{name} must be an integer >= {low}; got {value!r}")
+    return int(value)
+
+
+def _positive(name, value):
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, numbers.Real)
+        or not math.isfinite(value)
+        or value <= 0
+    ):
+        raise ValueError(f"{name} must be a finite number > 0; got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class ChainSettings:
+    """Settings of an emcee run: ensemble, seed, stopping rule, optimizer starts.
+
+    Every field is checked on construction; a bad one raises ``ValueError``
+    naming the field and its allowed range.
+
+    Parameters
+    ----------
+    walkers : int
+        Ensemble size: even (emcee's stretch move updates it in two halves)
+        and >= 2; a fit also needs >= 2 x its free parameters
+        (:meth:`require_walkers`).
+    seed : int
+        >= 0.  Walker initialization, the stretch move and the optimizer's
+        starts all derive from it.
+    max_steps : int
+        Step budget, >= 1.
+    check_every : int
+        Steps between autocorrelation checks and checkpoints, >= 1.
+    tau_factor : float
+        Stop when ``N >= tau_factor * max(tau)`` (finite, > 0) ...
+    tau_rtol : float
+        ... and ``max(tau)`` moved by less than this fraction since the
+        previous check (finite, > 0).
+    starts : int
+        Least-squares starts for the optimum, >= 1.
+    """
+
+    walkers: int = 32
+    seed: int = 0
+    max_steps: int = 20000
+    check_every: int = 100
+    tau_factor: float = 50.0
+    tau_rtol: float = 0.05
+    starts: int = 4
+
+    def __post_init__(self):
+        set_ = object.__setattr__  # frozen: normalize numpy scalars to plain int/float once, here
+        walkers = _integer("walkers", self.walkers, 2)
+        if walkers % 2:
+            raise ValueError(f"walkers must be even and >= 2; got {walkers}")
+        set_(self, "walkers", walkers)
+        set_(self, "seed", _integer("seed", self.seed, 0))
+        set_(self, "max_steps", _integer("max_steps", self.max_steps, 1))
+        set_(self, "check_every", _integer("check_every", self.check_every, 1))
+        set_(self, "tau_factor", _positive("tau_factor", self.tau_factor))
+        set_(self, "tau_rtol", _positive("tau_rtol", self.tau_rtol))
+        set_(self, "starts", _integer("starts", self.starts, 1))
+
+    def require_walkers(self, ndim):
+        """Raise ``ValueError`` unless the ensemble has >= 2 walkers per free parameter.
+
+        Parameters
+        ----------
+        ndim : int
+            Number of free parameters.
+
+        Returns
+        -------
+        ChainSettings
+            ``self``, for chaining.
+        """
+        if self.walkers < 2 * ndim:
+            raise ValueError(
+                f"walkers must be even and >= 2 x free parameters ({2 * ndim}); got {self.walkers}"
+            )
+        return self
+
+    def replace(self, **changes) -> ChainSettings:
+        """A copy with ``changes`` applied (and validated)."""
+        return dataclasses.replace(self, **changes)
+
+    def as_dict(self) -> dict:
+        """The fields by name (``posterior.json``'s ``settings``)."""
+        return dataclasses.asdict(self)
