@@ -57,7 +57,6 @@ SEED = 20261122
 
 #: comparison operators a limit may use: ``measured OP tolerance`` is "within"
 _OPS = {"<=": operator.le, "<": operator.lt, ">=": operator.ge, ">": operator.gt}
-STATUSES = ("pass", "finding", "fail")
 
 
 @dataclass(frozen=True)
@@ -86,10 +85,6 @@ class Check:
     id: str = ""  # the registered check that returned it (set by run_checks)
     paper: str = ""
     slow: bool = False
-
-    @property
-    def passed(self) -> bool:
-        return self.status != "fail"
 
     def as_dict(self):
         return dataclasses.asdict(self)
