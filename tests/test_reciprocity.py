@@ -7,14 +7,14 @@ import numpy as np
 
 import models
 from models.base import Model
-from validation.checks.seed000 import _facet_suite
+from validation.checks.common import facet_suite
 from validation.numerics.reciprocity import reciprocity_error
 
 
 def test_facet_models_are_reciprocal(rng):
     ti, tr = rng.uniform(0, 1.5, (2, 500))
     pr = rng.uniform(-4, 4, 500)
-    for m in _facet_suite():
+    for m in facet_suite():
         r = reciprocity_error(m, ti, tr, pr)
         assert r.scalar < 1e-10 and r.mueller < 1e-10 and r.jones < 1e-10, (m, r)
         assert r.n > 0

@@ -8,7 +8,6 @@ import re
 import pytest
 
 import models.facet
-from validation.checks.seed000 import check_table1
 from validation.report import build_report, nightly
 
 
@@ -20,7 +19,7 @@ def _cells(page, key):
 
 @pytest.fixture(scope="module")
 def table1_report():
-    return build_report(quick=True, only=["table1"], checks=[check_table1])
+    return build_report(quick=True, only=["table1"], checks=["seed000.check_table1"])
 
 
 def test_sections_present_and_numbers_match_results(table1_report):
@@ -61,7 +60,7 @@ def test_scene_names_are_escaped(tmp_path):
 
 def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):
     hist = str(tmp_path / "hist")
-    kw = dict(quick=True, only=["table1"], checks=[check_table1])
+    kw = dict(quick=True, only=["table1"], checks=["seed000.check_table1"])
     code, reg, run1 = nightly(hist, stamp="2026-01-01T000000Z", **kw)
     assert code == 0 and reg == []
     assert os.path.realpath(os.path.join(hist, "latest")) == os.path.realpath(run1)

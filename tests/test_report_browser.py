@@ -10,8 +10,6 @@ import shutil
 
 import pytest
 
-from validation.report import write_report
-
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 ARGS = [
     "--no-sandbox",
@@ -37,18 +35,11 @@ def _need_browser():
         pytest.skip("no Chromium on this machine")
 
 
-@pytest.fixture(scope="module")
-def quick_report(tmp_path_factory):
-    _need_browser()  # before the build: a machine that skips should not pay for the report
-    out = tmp_path_factory.mktemp("report")
-    results = write_report(str(out), quick=True)
-    return out, results
-
-
-def test_quick_report_in_chromium(quick_report):
+def test_quick_report_in_chromium(request):
+    _need_browser()
     from playwright.sync_api import sync_playwright
 
-    out, results = quick_report
+    out, results, _ = request.getfixturevalue("quick_report")  # tests/conftest.py, built once
     shots = os.path.join(os.path.dirname(__file__), "..", "reports", "screenshots")
     os.makedirs(shots, exist_ok=True)
     with sync_playwright() as p:

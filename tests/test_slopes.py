@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 import models
-from validation.checks.seed000 import slope_conversion_errors, slope_normalization_errors
+from validation.checks.common import slope_conversion_errors, slope_normalization_errors
 
 DISTS = [
     models.ExponentialSlopes(sigma=0.2, coverage=0.8),

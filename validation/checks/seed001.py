@@ -1,9 +1,8 @@
 """Checks of the seed 001 models (Hebert, Emmel & Hersch: varnished metal plates).
 
-Run by ``scatterbench validate`` (``CHECKS``; ``SECTIONS`` print the
-varnish-vs-subsurface ratio map, the anisotropy comparison, the point-source
-non-reciprocity and the iron-plate preset).  The helpers are shared with
-``tests/test_seed001_*.py``.
+Registered with :func:`validation.checks.registry.check`; the text sections
+print the varnish-vs-subsurface ratio map, the anisotropy comparison and the
+iron-plate preset.  The helpers are shared with ``tests/test_seed001_*.py``.
 """
 
 from __future__ import annotations
@@ -18,12 +17,11 @@ from models.cook_torrance import fresnel_real_printed
 from validation.numerics.integrate import integrated_reflectance
 from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 
-from .seed000 import Check, _le, count_extremes, extreme_geometries, slope_normalization_errors
-from .seed000 import random_geometries as _geoms
+from .common import count_extremes, extreme_geometries, slope_normalization_errors
+from .common import random_geometries as _geoms
+from .registry import Finding, check, judge, text_section
 
 __all__ = [
-    "CHECKS",
-    "SECTIONS",
     "ct_vs_facet_error",
     "fresnel_real_error",
     "printed_fresnel_error",
@@ -72,26 +70,10 @@ def published_over_energy_error(n=20000):
     return worst
 
 
-def check_ct_vs_facet():
-    worst, mism, live = ct_vs_facet_error()
-    out = [
-        Check(
-            "seed001: CookTorrance(energy, G=1) = FacetBRDF(Gaussian m).M00",
-            worst,
-            1e-9,
-            "pass" if worst <= 1e-9 and mism == 0 else "fail",
-            f"relative, {live} geometries with both non-zero (m 1e-3..2, 5 substrates); "
-            f"{mism} geometries zero in one model only",
-        ),
-        _le(
-            "seed001: published / energy - 4 pi (relative)",
-            published_over_energy_error(),
-            1e-14,
-            "CookTorrance and varnished models",
-        ),
-    ]
-    # anisotropic roughness: varnish n_v = 1 against FacetBRDF with the Eq. 19 slope density
-    ti, tr, pr = _geoms(20000, 2)
+def stroke_vs_facet_error(n=20000, seed=2):
+    """Max relative |Varnished(n_v = 1, energy, G = 1) - FacetBRDF(StrokeSlopes)| where both
+    are non-zero (``inf`` if one model alone is zero somewhere): the Eq. 19 slope density."""
+    ti, tr, pr = _geoms(n, seed)
     worst = 0.0
     for mp, mq, ang in ((0.05, 0.3, 0.4), (0.01, 1.0, -1.2), (0.2, 0.02, 2.0)):
         v = models.VarnishedCookTorranceBRDF(
@@ -105,15 +87,34 @@ def check_ct_vs_facet():
         f = models.FacetBRDF(slopes=models.StrokeSlopes(mp, mq, ang), substrate=v.substrate)
         e, k, _ = _rel_where_both(v.brdf(ti, tr, pr), f.brdf(ti, tr, pr))
         worst = max(worst, e if k == 0 else math.inf)
-    out.append(
-        _le(
+    return worst
+
+
+@check(paper="seed 001 Eq. 7-17 and 19 (Cook-Torrance D and F; anisotropic m(beta))")
+def check_ct_vs_facet(ctx):
+    worst, mism, live = ct_vs_facet_error()
+    return [
+        judge(
+            "seed001: CookTorrance(energy, G=1) = FacetBRDF(Gaussian m).M00",
+            # a geometry where only one model is zero is a disagreement no ratio measures
+            worst if mism == 0 else math.inf,
+            1e-9,
+            f"relative, {live} geometries with both non-zero (m 1e-3..2, 5 substrates); "
+            f"{mism} geometries zero in one model only",
+        ),
+        judge(
+            "seed001: published / energy - 4 pi (relative)",
+            published_over_energy_error(),
+            1e-14,
+            "CookTorrance and varnished models",
+        ),
+        judge(
             "seed001: Varnished(n_v=1, Eq. 19) = FacetBRDF(StrokeSlopes).M00",
-            worst,
+            stroke_vs_facet_error(),
             1e-9,
             "anisotropic m(beta), beta = azimuth of H from the strokes",
-        )
-    )
-    return out
+        ),
+    ]
 
 
 # ------------------------------------------------------------------ Fresnel
@@ -148,18 +149,28 @@ def printed_fresnel_error():
     return out
 
 
-def check_fresnel():
-    pe = printed_fresnel_error()
+PRINTED_FRESNEL = "seed001: Eq. 15-16 as printed, max |F - F_true|"
+
+
+@check(paper="seed 001 Eq. 11-16 (slip: Eq. 15-16's second term)", findings=(PRINTED_FRESNEL,))
+def check_fresnel(ctx, printed=None):
+    """``printed``: :func:`printed_fresnel_error`'s ``{variant: (error, where)}``."""
+    pe = printed_fresnel_error() if printed is None else printed
+    agree = min(pe["printed"][0], pe["unsquared"][0]) <= 1e-12
     return [
-        _le("seed001: Eq. 13-16 (fixed) = complex Fresnel Eq. 11-12", fresnel_real_error(), 1e-12),
-        Check(
-            "seed001: Eq. 15-16 as printed, max |F - F_true|",
+        judge("seed001: Eq. 13-16 (fixed) = complex Fresnel Eq. 11-12", fresnel_real_error(), 1e-12),
+        judge(
+            PRINTED_FRESNEL,
             pe["printed"][0],
             1e-12,
-            "finding" if pe["printed"][0] > 1e-12 else "pass",
             f"printed second term (n0^2 + k0^2 - sin^2)^2 ({pe['printed'][1]}); with only the square "
             f"removed still {pe['unsquared'][0]:.3g} for absorbing media ({pe['unsquared'][1]}): "
             "the term is (n0^2 - k0^2 - sin^2)",
+            finding=Finding(
+                fails=agree,
+                fails_if="Eq. 15-16 as printed, or with only the square removed, equals the complex "
+                "Fresnel reflectance to 1e-12 (the documented slip would be wrong)",
+            ),
         ),
     ]
 
@@ -187,29 +198,89 @@ def energy_albedos(tol=1e-4):
     return out
 
 
-def check_energy():
-    pub = published_albedos()
-    lo = min(pub.values())
-    rows = energy_albedos()
+PUBLISHED_ALBEDO = "seed001: published Cook-Torrance albedo (iron, m = 0.03)"
+
+
+@check(paper="seed 001 Eq. 7-8 (normalization) and Eq. 18 (Blinn G)", findings=(PUBLISHED_ALBEDO,))
+def check_energy(ctx, published=None, energy=None):
+    """``published``: :func:`published_albedos`; ``energy``: :func:`energy_albedos`."""
+    pub = published_albedos() if published is None else published
+    rows = energy_albedos() if energy is None else energy
+    lo, hi = min(pub.values()), max(pub.values())
     # the largest excess over 1 allowed by the integral's own error estimate
     excess = max(v - e - 1.0 for *_, v, e in rows)
     top = max(rows, key=lambda r: r[3])
     return [
-        Check(
-            "seed001: published Cook-Torrance albedo (iron, m = 0.03)",
+        judge(
+            PUBLISHED_ALBEDO,
             lo,
             1.0,
-            "finding" if lo > 1.0 else "fail",
             "Eq. 7-8 as printed integrate to "
             + ", ".join(f"{v:.3f} at {t:g} deg" for t, v in pub.items())
             + ": 4 pi times the normalized BRDF (no 1/pi in D, no 4 in Eq. 7) -- a property of the paper",
+            finding=Finding(
+                fails=lo <= 1.0 or hi / (4 * math.pi) > 1.0,
+                fails_if="the published albedo is <= 1 at an angle (Eq. 7-8 would conserve energy) or "
+                f"above 4 pi (the normalized form would not; here {hi / (4 * math.pi):.3f} x 4 pi)",
+            ),
         ),
-        _le(
+        judge(
             "seed001: energy CT + Blinn G, max(albedo - error) - 1",
             excess,
             0.0,
             f"m 0.03..0.5, iron and perfect conductor, ti 0..89.9 deg; largest albedo {top[3]:.5f} "
             f"(m = {top[0]}, {top[1]}, {top[2]} deg)",
+        ),
+    ]
+
+
+def varnish_albedos(tol=1e-4):
+    """``[(m, solid_angle, ti_deg, value, error, T_in)]`` for the energy-normalized
+    varnished model on a perfect conductor (F = 1, so all loss is the varnish's)."""
+    out = []
+    for m in (0.03, 0.1, 0.5):
+        for sa in ("published", "refracted"):
+            model = models.VarnishedCookTorranceBRDF(
+                m_parallel=m, m_perpendicular=m, substrate=math.inf, normalization="energy", solid_angle=sa
+            )
+            for ti in (0.0, 30.0, 60.0, 80.0, 89.0):
+                r = integrated_reflectance(model, math.radians(ti), tol=tol)
+                rs, rp = models.fresnel_reflectance(math.cos(math.radians(ti)), 1.0, 1.5)
+                out.append((m, sa, ti, r.value, r.error, 1.0 - 0.5 * float(rs + rp)))
+    return out
+
+
+VARNISH_ALBEDO = "seed001: energy-normalized Eq. 24 albedo, perfect conductor"
+
+
+@check(paper="seed 001 Eq. 20-24 (varnish; Eq. 24's missing Jacobian)", findings=(VARNISH_ALBEDO,))
+def check_varnish_energy(ctx, rows=None):
+    """``rows``: :func:`varnish_albedos`."""
+    rows = varnish_albedos() if rows is None else rows
+    pub = [r for r in rows if r[1] == "published"]
+    ref = [r for r in rows if r[1] == "refracted"]
+    worst_pub = max(pub, key=lambda r: r[3])
+    normal = [r for r in pub if r[0] == 0.03 and r[2] == 0.0][0]
+    excess = max(v - e - t for *_, v, e, t in ref)
+    return [
+        judge(
+            VARNISH_ALBEDO,
+            worst_pub[3],
+            1.0,
+            f"{normal[3]:.3f} at normal incidence (m = 0.03; the varnish alone transmits {normal[5]:.2f}), "
+            f"{worst_pub[3]:.2f} at {worst_pub[2]:g} deg (m = {worst_pub[0]}): even with 1/(4 pi) the varnish "
+            "extension creates energy -- the missing refraction Jacobian n_v^2 cos Psi cos Theta / (cos psi cos theta)",
+            finding=Finding(
+                fails=worst_pub[3] <= 1.0 or excess > 0.0,
+                fails_if="the Eq. 24 albedo stays <= 1, or the refracted form (with the Jacobian) also "
+                "exceeds the light the varnish lets in (the Jacobian would not be the cause)",
+            ),
+        ),
+        judge(
+            "seed001: refracted varnish albedo - error - T_in (perfect conductor)",
+            excess,
+            0.0,
+            "m 0.03..0.5, ti 0..89 deg: never above the light the varnish lets in",
         ),
     ]
 
@@ -229,10 +300,11 @@ def seed001_models():
     ]
 
 
-def check_reciprocity():
+@check(paper="seed 001 Eq. 7-24 (Helmholtz reciprocity)")
+def check_reciprocity(ctx):
     ti, tr, pr = _geoms(300, 4)
     worst = max(reciprocity_error(m, ti, tr, pr).scalar for m in seed001_models())
-    return _le(
+    return judge(
         "seed001: reciprocity of CookTorrance and varnished models",
         worst,
         1e-10,
@@ -312,19 +384,20 @@ def inplane_coupling_error(m=0.1, nv=1.5, sub=IRON, n=4000, seed=6):
     return float(np.max(np.abs(pred[live] / b[live] - 1)))
 
 
-def check_varnish_vs_subsurface():
+@check(paper="seed 001 Eq. 20-24 (varnish) against seed 000's SubsurfaceFacetBRDF")
+def check_varnish_vs_subsurface(ctx):
     rmap = varnish_ratio_map(n_t=30, n_p=31)
     worst_jac = max(
         float(np.max(np.abs(d["ratio"] / d["residual"] / d["jacobian"] - 1))) for d in rmap.values()
     )
     return [
-        _le(
+        judge(
             "seed001: varnish(Eq. 24) / varnish(refracted) = refraction Jacobian",
             worst_jac,
             1e-12,
             "n_v^2 cos Psi cos Theta / (cos psi cos theta), over the hemisphere",
         ),
-        _le(
+        judge(
             "seed001: in-plane SubsurfaceFacet = refracted varnish x Jones/avg factor",
             inplane_coupling_error(),
             1e-9,
@@ -333,7 +406,8 @@ def check_varnish_vs_subsurface():
     ]
 
 
-def _varnish_section(results):
+@text_section
+def varnish_text(ctx):
     rmap = varnish_ratio_map()
     lines = [
         "VarnishedCookTorranceBRDF(energy, G = 1, m_par = m_perp = 0.1, n_v = 1.5, iron) vs",
@@ -361,10 +435,11 @@ def _varnish_section(results):
 
 
 # ------------------------------------------------------------------ anisotropy
-def check_anisotropy():
+@check(paper="seed 001 Eq. 19 (anisotropic roughness)")
+def check_anisotropy(ctx):
     errs = slope_normalization_errors(models.StrokeSlopes(0.05, 0.4, 0.3))
     worst = max(abs(v) for v in errs.values())
-    return _le("seed001: Eq. 19 slope density normalizations", worst, 1e-8, "StrokeSlopes(0.05, 0.4, 0.3)")
+    return judge("seed001: Eq. 19 slope density normalizations", worst, 1e-8, "StrokeSlopes(0.05, 0.4, 0.3)")
 
 
 def anisotropy_comparison(m_par=0.05, m_perp=0.25, ti_deg=(0.0, 30.0, 60.0)):
@@ -395,7 +470,8 @@ def anisotropy_comparison(m_par=0.05, m_perp=0.25, ti_deg=(0.0, 30.0, 60.0)):
     return rows, (rms_u, rms_v)
 
 
-def _anisotropy_section(results):
+@text_section
+def anisotropy_text(ctx):
     m_par, m_perp = 0.05, 0.25
     rows, (ru, rv) = anisotropy_comparison(m_par, m_perp)
     lines = [
@@ -449,9 +525,10 @@ def extremes_count():
     return bad, warned, len(ms) * len(ti)
 
 
-def check_extremes():
+@check(paper="seed 001 Eq. 7-30 at the extremes")
+def check_extremes(ctx):
     bad, warned, n = extremes_count()
-    return _le(
+    return judge(
         "seed001: extremes (m 1e-6..2, m_par/m_perp 100, 89.99 deg, d = R, 1e12 R, inf)",
         bad + warned,
         0,
@@ -492,16 +569,22 @@ def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     return out
 
 
-def check_point_source():
-    ex = point_source_collimated_error()
-    sh = point_source_collimated_error(method="shift")
+NONRECIPROCITY = "seed001: point-source non-reciprocity (d = 10 R)"
+
+
+@check(paper="seed 001 Eq. 25-30 (point source)", findings=(NONRECIPROCITY,))
+def check_point_source(ctx, collimated=None, shifted=None, nonreciprocity=None):
+    """``collimated``, ``shifted``: :func:`point_source_collimated_error` (exact, shift);
+    ``nonreciprocity``: :func:`point_source_nonreciprocity`."""
+    ex = point_source_collimated_error() if collimated is None else collimated
+    sh = point_source_collimated_error(method="shift") if shifted is None else shifted
+    nr = point_source_nonreciprocity() if nonreciprocity is None else nonreciprocity
     d_inf = models.PointSourceBRDF(model=models.CookTorranceBRDF(), distance=math.inf)
     ti, tr, pr = _geoms(500, 8)
     same = float(np.max(np.abs(d_inf.mueller(ti, tr, pr) - models.CookTorranceBRDF().mueller(ti, tr, pr))))
     order = ex[1e3] / ex[1e4]
-    nr = point_source_nonreciprocity()
     return [
-        _le(
+        judge(
             "seed001: point source -> collimated, exact at d = 1e4 R",
             ex[1e4],
             1e-6,
@@ -509,22 +592,24 @@ def check_point_source():
             + ", ".join(f"d = {d:g}: {e:.2e}" for d, e in ex.items())
             + f" (second order: ratio {order:.0f} per decade); d = inf identical ({same:g})",
         ),
-        _le(
+        judge(
             "seed001: point source -> collimated, shift Eq. 29 at d = 1e4 R",
             sh[1e4],
             1e-6,
             ", ".join(f"d = {d:g}: {e:.2e}" for d, e in sh.items()),
         ),
-        Check(
-            "seed001: point-source non-reciprocity (d = 10 R)",
+        judge(
+            NONRECIPROCITY,
             nr[10.0],
             1e-3,
-            # a finding while the extended source breaks reciprocity; reciprocal here would mean
-            # the wrapper no longer spreads the source (a failure)
-            "finding" if nr[10.0] > 1e-3 else "fail",
             "max |f(i->r) - f(r->i)| / max over geometries with >= 1e-3 of the peak: "
             + ", ".join(f"d = {d:g} R: {v:.3g}" for d, v in nr.items())
             + " (an extended source is not an extended detector; Eq. 28 is not reciprocal)",
+            finding=Finding(
+                fails=nr[10.0] <= 1e-3 or nr[100.0] >= nr[10.0],
+                fails_if="it is <= 1e-3 at d = 10 R (the wrapper would no longer spread the source) or "
+                "does not shrink from d = 10 R to 100 R (it would not vanish in the collimated limit)",
+            ),
         ),
     ]
 
@@ -545,34 +630,46 @@ def cauchy_disc_integrals(radii=(10.0, 100.0, 1000.0), d=1.0):
     return out
 
 
-def check_cauchy():
-    ci = cauchy_disc_integrals()
+CAUCHY = "seed001: Eq. 25 weight integrated over the plane"
+
+
+@check(paper="seed 001 Eq. 25 (point-source weight)", findings=(CAUCHY,))
+def check_cauchy(ctx, integrals=None):
+    """``integrals``: :func:`cauchy_disc_integrals`' ``{X: (Eq. 25, irradiance)}``."""
+    ci = cauchy_disc_integrals() if integrals is None else integrals
     grow = ci[1000.0][0] - ci[100.0][0]
-    return Check(
-        "seed001: Eq. 25 weight integrated over the plane",
+    irradiance = ci[1000.0][1]
+    return judge(
+        CAUCHY,
         grow,
-        0.0,
-        "finding" if grow > 1.0 else "fail",
+        1.0,
         "Eq. 25 is the 1-D Cauchy density: its integral over a disc of radius X (d = 1) is "
         + ", ".join(f"{a:.3f}" for a, _ in ci.values())
         + f" for X = {', '.join(f'{X:g}' for X in ci)} (grows like 2 ln X, never 1); a point source's "
         "irradiance d / (2 pi (d^2+x^2)^1.5) gives "
         + ", ".join(f"{b:.4f}" for _, b in ci.values())
         + " -> 1. PointSourceBRDF weights by the irradiance (cos^3 psi / d^2) over the sample area",
+        finding=Finding(
+            fails=grow <= 1.0 or abs(irradiance - 1.0) > 1e-2,
+            fails_if="Eq. 25's disc integral grows by <= 1 from X = 100 to 1000 (it would be a normalized "
+            "density) or the irradiance weight's is off 1 by more than 1e-2 at X = 1000",
+        ),
     )
 
 
-def check_preset():
+@check(paper="seed 001, Measurement Results (iron plate under a point source, Eq. 25-30)")
+def check_preset(ctx):
     worst = 0.0
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
         psi_c, d = references.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=models.CookTorranceBRDF(), distance=d, sample_radius=1.0)
         a, b = ps.incidence_range(psi_c)
         worst = max(worst, abs(math.degrees(a) - lo), abs(math.degrees(b) - hi))
-    return _le("seed001: iron-plate point-source geometry spans the printed ranges (deg)", worst, 1e-9)
+    return judge("seed001: iron-plate point-source geometry spans the printed ranges (deg)", worst, 1e-9)
 
 
-def _preset_section(results):
+@text_section
+def preset_text(ctx):
     ct_kw, vn_kw = references.iron_plate_models("published")
     ct = models.CookTorranceBRDF(**ct_kw)
     vn = models.VarnishedCookTorranceBRDF(**vn_kw)
@@ -596,62 +693,3 @@ def _preset_section(results):
             + " ".join(f"{c:>16}" for c in cells)
         )
     return ("Seed 001: iron-plate preset", "\n".join(lines))
-
-
-def varnish_albedos(tol=1e-4):
-    """``[(m, solid_angle, ti_deg, value, error, T_in)]`` for the energy-normalized
-    varnished model on a perfect conductor (F = 1, so all loss is the varnish's)."""
-    out = []
-    for m in (0.03, 0.1, 0.5):
-        for sa in ("published", "refracted"):
-            model = models.VarnishedCookTorranceBRDF(
-                m_parallel=m, m_perpendicular=m, substrate=math.inf, normalization="energy", solid_angle=sa
-            )
-            for ti in (0.0, 30.0, 60.0, 80.0, 89.0):
-                r = integrated_reflectance(model, math.radians(ti), tol=tol)
-                rs, rp = models.fresnel_reflectance(math.cos(math.radians(ti)), 1.0, 1.5)
-                out.append((m, sa, ti, r.value, r.error, 1.0 - 0.5 * float(rs + rp)))
-    return out
-
-
-def check_varnish_energy():
-    rows = varnish_albedos()
-    pub = [r for r in rows if r[1] == "published"]
-    ref = [r for r in rows if r[1] == "refracted"]
-    worst_pub = max(pub, key=lambda r: r[3])
-    normal = [r for r in pub if r[0] == 0.03 and r[2] == 0.0][0]
-    excess = max(v - e - t for *_, v, e, t in ref)
-    return [
-        Check(
-            "seed001: energy-normalized Eq. 24 albedo, perfect conductor",
-            worst_pub[3],
-            1.0,
-            "finding" if worst_pub[3] > 1.0 else "fail",
-            f"{normal[3]:.3f} at normal incidence (m = 0.03; the varnish alone transmits {normal[5]:.2f}), "
-            f"{worst_pub[3]:.2f} at {worst_pub[2]:g} deg (m = {worst_pub[0]}): even with 1/(4 pi) the varnish "
-            "extension creates energy -- the missing refraction Jacobian n_v^2 cos Psi cos Theta / (cos psi cos theta)",
-        ),
-        _le(
-            "seed001: refracted varnish albedo - error - T_in (perfect conductor)",
-            excess,
-            0.0,
-            "m 0.03..0.5, ti 0..89 deg: never above the light the varnish lets in",
-        ),
-    ]
-
-
-CHECKS = [
-    check_ct_vs_facet,
-    check_fresnel,
-    check_energy,
-    check_varnish_energy,
-    check_reciprocity,
-    check_varnish_vs_subsurface,
-    check_anisotropy,
-    check_extremes,
-    check_point_source,
-    check_cauchy,
-    check_preset,
-]
-
-SECTIONS = [_varnish_section, _anisotropy_section, _preset_section]

@@ -1,28 +1,68 @@
-"""``scatterbench validate``: every check with measured value, tolerance and status."""
+"""``scatterbench validate``: every registered check with measured value, tolerance and status.
+
+It judges exactly the checks ``report`` judges, with the same settings
+(``--quick`` as ``report --quick``), then prints the registered text blocks.
+"""
 
 from __future__ import annotations
 
 import time
 
-__all__ = ["register"]
+__all__ = ["register", "run"]
 
 
-def _cmd_validate(args) -> int:
-    from validation.checks.seed000 import all_sections, format_checks, run_checks
+def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
+    """Run the checks, print the table and the text blocks, write ``json_path`` (strict
+    JSON, atomically) if given; 1 if a check fails, else 0.
+
+    ``ctx``: a :class:`~validation.checks.registry.CheckContext` whose memo is shared
+    (e.g. with a report built on it); ``specs``: the checks (default: every registered
+    check, less the slow ones when ``quick``).
+    """
+    from validation.atomic import atomic_write_text
+    from validation.checks.registry import (
+        CheckContext,
+        check_record,
+        format_checks,
+        run_checks,
+        strict_json,
+        tally,
+        texts,
+    )
 
     t0 = time.perf_counter()
-    results = run_checks()
+    ctx = ctx if ctx is not None else CheckContext(quick=quick)
+    if ctx.quick != quick:
+        raise ValueError(f"ctx: its quick flag ({ctx.quick}) must be the run's ({quick})")
+    results = run_checks(specs, ctx)
     print(format_checks(results))
-    for section in all_sections():
-        out = section(results)
+    if json_path:
+        doc = {"quick": quick, "seed": ctx.seed, "summary": tally(results)}
+        doc["checks"] = [check_record(r) for r in results]
+        atomic_write_text(json_path, strict_json(doc))
+    for section in texts():
+        out = section(ctx)
         if out:
             title, text = out
             print(f"\n{title}:")
             print(text)
     print(f"\nvalidate finished in {time.perf_counter() - t0:.1f} s")
-    return 1 if any(c.status == "fail" for c in results) else 0
+    return 1 if tally(results)["n_fail"] else 0
+
+
+def _cmd_validate(args) -> int:
+    return run(quick=args.quick, json_path=args.json)
 
 
 def register(sub):
-    p = sub.add_parser("validate", help="run every check; print a table; exit 1 if any fails")
+    p = sub.add_parser(
+        "validate",
+        help="run every check (the report's set); print a table; exit 1 if any fails",
+    )
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="skip the slow checks and use the quick study settings (the set `report --quick` judges)",
+    )
+    p.add_argument("--json", metavar="FILE", help="also write every check as strict JSON to FILE")
     p.set_defaults(func=_cmd_validate)

@@ -10,9 +10,10 @@ import time
 import traceback
 
 from validation.atomic import atomic_write_json, atomic_write_text
+from validation.checks.registry import SEED, check_record, judge, select, tally
 
 from .core import Context, Section, render_html
-from .sections import SECTION_FUNCS, _git_commit
+from .sections import SECTION_FUNCS, _git_commit, report_checks
 
 __all__ = ["build_report", "write_report"]
 
@@ -25,29 +26,37 @@ def _progress(total, label):
     return tqdm(total=total, desc=label, disable=quiet, unit="section", leave=False)
 
 
-def build_report(quick=False, previous=None, seed=20261122, only=None, extra_scenes=(), checks=None):
-    """Run every section; returns ``(results, html)``.  A section that raises is kept
-    on the page with its error and counts as a failed check; the others still run.
+def _section_failure(name):
+    """A section that raised, as a failed entry of the report machinery (not a registered check)."""
+    r = judge(
+        f"report section '{name}' computed",
+        1.0,
+        0.0,
+        "the report machinery: this section raised\n" + traceback.format_exc(limit=3),
+    )
+    return {**check_record(r), "id": f"report.section_{name}", "paper": "report machinery"}
 
-    ``only``: names of the sections to compute (summary and provenance always run);
-    ``extra_scenes``: scene files shown beside the built-in examples;
-    ``checks``: the check functions of the summary (default: every check).
-    """
-    ctx = Context(quick=quick, previous=previous, seed=seed)
-    ctx.cache["extra_scenes"] = list(extra_scenes)
-    if checks is not None:
-        ctx.cache["check_funcs"] = list(checks)
-    t0 = time.perf_counter()
-    funcs = [
-        f
-        for f in SECTION_FUNCS
-        if only is None or f.__name__.removeprefix("section_") in set(only) | {"summary", "provenance"}
-    ]
+
+def _context(context, quick, previous, seed):
+    if context is None:
+        return Context(quick=quick, previous=previous, seed=seed)
+    if (context.quick, context.seed) != (quick, seed):
+        raise ValueError(
+            f"context: quick={context.quick}, seed={context.seed} must be the report's ({quick}, {seed})"
+        )
+    context.previous = previous
+    return context
+
+
+def _run_sections(ctx, funcs):
+    """Compute ``funcs`` (summary last: it shows every check and failure); a section
+    that raises is kept with its error and recorded in ``ctx.cache["section_failures"]``."""
     order = [f for f in funcs if f.__name__ not in ("section_summary", "section_provenance")]
     order += [f for f in funcs if f.__name__ == "section_provenance"]
     order += [f for f in funcs if f.__name__ == "section_summary"]
     done = {}
     times = ctx.cache.setdefault("section_times", {})
+    failures = ctx.cache.setdefault("section_failures", [])
     with _progress(len(order), "report") as bar:
         for fn in order:
             name = fn.__name__.removeprefix("section_")
@@ -58,27 +67,41 @@ def build_report(quick=False, previous=None, seed=20261122, only=None, extra_sce
             except Exception as exc:  # a broken section must not lose the rest of the report
                 sec = Section(name, name, error=f"{type(exc).__name__}: {exc}")
                 sec.blocks = []
-                ctx.cache.setdefault("extra_checks", []).append(
-                    {
-                        "name": f"report section '{name}' computed",
-                        "measured": 1.0,
-                        "tolerance": 0.0,
-                        "status": "fail",
-                        "detail": traceback.format_exc(limit=3),
-                    }
-                )
+                failures.append(_section_failure(name))
             sec.seconds = time.perf_counter() - t
             times[name] = sec.seconds
             done[fn.__name__] = sec
             bar.update(1)
-    sections = [done[f.__name__] for f in funcs]
-    checks = done["section_summary"].checks
-    summary = {
-        "n_checks": len(checks),
-        "n_pass": sum(c["status"] == "pass" for c in checks),
-        "n_finding": sum(c["status"] == "finding" for c in checks),
-        "n_fail": sum(c["status"] == "fail" for c in checks),
-    }
+    return [done[f.__name__] for f in funcs]
+
+
+def build_report(
+    quick=False, previous=None, seed=SEED, only=None, extra_scenes=(), checks=None, context=None
+):
+    """Run every section; returns ``(results, html)``.  A section that raises is kept
+    on the page with its error and counts as a failed check; the others still run.
+
+    ``only``: names of the sections to compute (summary and provenance always run);
+    ``extra_scenes``: scene files shown beside the built-in examples;
+    ``checks``: ids of the registered checks the summary judges (default: every one,
+    less the slow ones in a quick run: the set ``validate`` judges);
+    ``context``: a :class:`~validation.report.core.Context` to run in (its memo shared,
+    e.g. with ``validate``); default a new one.
+    """
+    ctx = _context(context, quick, previous, seed)
+    ctx.cache["extra_scenes"] = list(extra_scenes)
+    if checks is not None:
+        ctx.cache["check_specs"] = select(checks)
+    t0 = time.perf_counter()
+    funcs = [
+        f
+        for f in SECTION_FUNCS
+        if only is None or f.__name__.removeprefix("section_") in set(only) | {"summary", "provenance"}
+    ]
+    sections = _run_sections(ctx, funcs)
+    # every check is counted even if the summary section itself failed to draw them
+    checks = report_checks(ctx) + ctx.cache["section_failures"]
+    summary = tally(checks)
     meta = {
         "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
         "git_commit": _git_commit(),

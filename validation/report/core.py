@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 
 import jinja2
 
+from validation.checks.registry import CheckContext
+
 __all__ = [
     "Section",
     "Context",
@@ -28,10 +30,11 @@ __all__ = [
 
 
 @dataclass
-class Context:
-    quick: bool = False
+class Context(CheckContext):
+    """A report run: the checks' context (quick, seed, memo shared by checks and
+    sections) plus the previous results.json and the sections' scratch ``cache``."""
+
     previous: dict | None = None  # the previous results.json, if any
-    seed: int = 20261122
     cache: dict = field(default_factory=dict)
 
 
@@ -42,7 +45,7 @@ class Section:
     blocks: list = field(default_factory=list)
     numbers: dict = field(default_factory=dict)
     tracked: dict = field(default_factory=dict)  # key -> {"value": v, "tol": t}
-    checks: list = field(default_factory=list)  # Check.as_dict() entries
+    checks: list = field(default_factory=list)  # check records (registry.check_record)
     seconds: float = 0.0
     error: str | None = None
 

@@ -19,50 +19,44 @@ import models  # noqa: E402
 import references  # noqa: E402
 from models.geometry import signed_inplane  # noqa: E402
 from validation.checks import table1  # noqa: E402
-from validation.checks.seed000 import check_modules, run_checks  # noqa: E402
+from validation.checks.registry import check_record, registered, run_checks  # noqa: E402
 from validation.numerics.integrate import integrated_reflectance  # noqa: E402
 from validation.numerics.reciprocity import reciprocity_error, reversed_mueller  # noqa: E402
 
 from .core import Section, checks_block, figure_block, table_block, text_block  # noqa: E402
 
-__all__ = ["SECTION_FUNCS"]
+__all__ = ["SECTION_FUNCS", "report_checks"]
 
 AL = 1.37 + 7.62j
 
 
-def _checks(ctx):
-    if "checks" not in ctx.cache:
-        funcs = ctx.cache.get("check_funcs")
-        if funcs is None:
-            from validation.checks.seed000 import all_checks
-
-            funcs = all_checks()
-            if ctx.quick:
-                ctx.cache["skipped_checks"] = [f.__name__ for f in funcs if getattr(f, "slow", False)]
-                funcs = [f for f in funcs if not getattr(f, "slow", False)]
-        ctx.cache["checks"] = [c.as_dict() for c in run_checks(funcs)] if funcs else []
-    return ctx.cache["checks"]
+def report_checks(ctx):
+    """The records of the checks this report judges: ``ctx.cache["check_specs"]`` if set,
+    else every registered check for ``ctx.quick`` (the set ``validate`` runs).  Each runs
+    once per context, sharing its computations with the sections that draw them."""
+    specs = ctx.cache.get("check_specs")
+    return [check_record(r) for r in run_checks(registered(ctx.quick) if specs is None else specs, ctx)]
 
 
 def section_summary(ctx):
     s = Section("summary", "Summary: every check")
-    checks = [dict(c) for c in _checks(ctx)]
-    for c in checks:
-        c.pop("extra", None)
-    checks += ctx.cache.get("extra_checks", [])
+    checks = report_checks(ctx) + ctx.cache.get("section_failures", [])
     prev = (ctx.previous or {}).get("checks")
     s.blocks.append(
         text_block(
-            "Each check: the value this run measured, its tolerance, the status (FINDING marks a property "
-            "of a paper that the run established, not an implementation failure) and the change since the "
-            "previous report."
+            "Each check: the value this run measured, the limit it is held to, the status (FINDING marks a "
+            "property of a paper that the run established, not an implementation failure; each finding says "
+            "under which condition it would fail instead) and the change since the previous report. The "
+            "same checks, with the same settings, are run by `scatterbench validate` "
+            f"{'--quick ' if ctx.quick else ''}and the test suite."
         )
     )
-    if ctx.cache.get("skipped_checks"):
+    if ctx.quick and "check_specs" not in ctx.cache:
+        skipped = [spec.id for spec in registered() if spec.slow]
         s.blocks.append(
             text_block(
                 "Quick run: these slow checks were not run (the full report and `scatterbench validate` run them): "
-                + ", ".join(ctx.cache["skipped_checks"])
+                + ", ".join(skipped)
             )
         )
     s.blocks.append(checks_block(checks, prev))
@@ -72,13 +66,8 @@ def section_summary(ctx):
 
 def section_table1(ctx):
     s = Section("table1", "Seed 000 Table I: paper, scatterbench, SCATMECH")
-    rows = None
-    for c in _checks(ctx):
-        if c["name"].startswith("Table I: entries"):
-            rows = c["extra"]["rows"]
-            seconds = c["extra"]["seconds"]
-    if rows is None:
-        raise RuntimeError("the Table I check did not run")
+    computed, seconds = ctx.compute(table1.compute_table1)  # the Table I check's computation
+    rows = [r.as_dict() for r in computed]
     out = []
     for r in rows:
         key = f"{r['substrate']}|{r['coating']:g}|{r['sigma']:g}"
@@ -332,12 +321,11 @@ def section_conservation(ctx):
 
 def section_scatmech(ctx):
     from validation.checks.seed000 import scatmech_facet_errors
+    from validation.checks.seed003 import scatmech_error_distributions
 
     s = Section("scatmech", "Agreement with SCATMECH")
     errs = {f"{k} (committed)": v for k, v in scatmech_facet_errors().items()}
-    for mod in check_modules():
-        for fn in getattr(mod, "SCATMECH_ERRORS", []):
-            errs.update(fn())
+    errs.update(scatmech_error_distributions())
     fig, ax = plt.subplots(figsize=(7, 4))
     rows = []
     for label, e in errs.items():
@@ -463,10 +451,11 @@ def section_speed(ctx):
 
 
 def section_stability(ctx):
-    from validation.studies.stability import classify, sweep
+    from validation.checks.stability import sweep_findings
+    from validation.studies.stability import classify
 
     s = Section("stability", "Stability sweep at the extremes")
-    found = sweep(energy=not ctx.quick)
+    found = sweep_findings(ctx)  # the stability check's sweep, run once
     if ctx.quick:
         s.blocks.append(
             text_block(
@@ -492,15 +481,6 @@ def section_stability(ctx):
     )
     s.blocks.append(
         table_block(s, "stability", ["model", "kind", "value", "where", "accepted", "reason"], rows)
-    )
-    ctx.cache.setdefault("extra_checks", []).append(
-        {
-            "name": "stability sweep: unaccepted findings",
-            "measured": float(len(bad)),
-            "tolerance": 0.0,
-            "status": "pass" if not bad else "fail",
-            "detail": f"{len(ok)} accepted findings",
-        }
     )
     return s
 

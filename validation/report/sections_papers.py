@@ -450,7 +450,6 @@ def section_seed001(ctx):
 # ----------------------------------------------------------------------------- uncertainty
 FIT_SCENE = "aluminium_flakes_fit.toml"
 FIT_DATA = "scatmech_flake_measurement.csv"
-RECOVERY_SCENE = "aluminium_flakes_clearcoat.toml"
 
 
 def _fit_settings(quick, seed):
@@ -461,28 +460,64 @@ def _fit_settings(quick, seed):
     return ChainSettings(seed=seed)  # scatterbench fit's defaults: 32 walkers, 20000 steps, 4 starts
 
 
-def _recovery_settings(quick, seed):
-    from validation.fitting.settings import ChainSettings
+def _recovery_blocks(s, ctx):
+    """The injection-recovery coverage table: the recovery-coverage check's study."""
+    from validation.checks.fitting import RECOVERY_SCENE, recovery_cells, recovery_settings
 
-    if quick:  # the configuration of tests/test_recovery.py
-        return dict(
-            free=["sigma:0.01:1:log"],
-            noise=["brdf=0.1"],
-            noise_levels=(0.1,),
-            n_geometries=(8,),
-            injections=50,
-            chain=ChainSettings(walkers=4, seed=seed, max_steps=150, check_every=150, starts=1),
+    rs = recovery_settings(ctx.quick, ctx.seed)
+    cells = recovery_cells(ctx)  # the recovery-coverage check's study, run once
+    crow = []
+    for c in cells:
+        for k, v in c["summary"].items():
+            c68, c95 = v["coverage"]["68"], v["coverage"]["95"]
+            crow.append(
+                {
+                    "noise (brdf, fractional)": c["noise_brdf"],
+                    "geometries": c["geometries"],
+                    "parameter": k,
+                    "injections": v["injections"],
+                    "coverage 68%": c68["measured"],
+                    "z 68%": c68["z"],
+                    "coverage 95%": c95["measured"],
+                    "z 95%": c95["z"],
+                    "binomial SE 68%": c68["binomial_se"],
+                    "binomial SE 95%": c95["binomial_se"],
+                    "curvature coverage 68%": c68["curvature"],
+                    "curvature coverage 95%": c95["curvature"],
+                    "bias": v["bias"],
+                    "bias SE": v["bias_se"],
+                    "mean 68% width": v["width68_mean"],
+                    "min N / tau": c["steps_over_tau_min"],
+                }
+            )
+    s.blocks.append(
+        text_block(
+            f"Injection-recovery (validation/recovery.py): scene references/scenes/{RECOVERY_SCENE}, free "
+            f"{', '.join(rs['free'])}, geometries from the data file (evenly spread subsets), log-normal speckle "
+            f"at the listed level; {rs['injections']} injections per cell, each fitted with {rs['chain'].walkers} walkers "
+            f"and at most {rs['chain'].max_steps} steps, seed {ctx.seed}"
+            + (" (quick mode: the configuration of tests/test_recovery.py)." if ctx.quick else ".")
+            + " z = (coverage - nominal) / binomial SE. The curvature columns are the coverage, on the same "
+            "data sets, of the optimum +- 1 and 2 Gauss-Newton standard deviations: when they are nominal and "
+            "the posterior's are not, the sampler is at fault, not the data."
         )
-    # Two correlated parameters, 16 walkers run to N > 50 tau, on both cores: the same study over 4
-    # cells (8 and 32 geometries) took 1315 s on a loaded machine; the 8-geometry cells are the cheaper half.
-    return dict(
-        free=["sigma:0.01:1:log", "coating:1.2:2"],
-        noise=["brdf=0.1"],
-        noise_levels=(0.05, 0.1),
-        n_geometries=(8,),
-        injections=50,
-        chain=ChainSettings(walkers=16, seed=seed, max_steps=4000, check_every=100, starts=1),
-        workers=2,
+    )
+    s.blocks.append(
+        table_block(
+            s,
+            "recovery",
+            list(crow[0]),
+            crow,
+            caption="coverage of the 68% and 95% intervals (nominal 0.6827 and 0.9545)",
+            fmt={
+                "bias": ".2e",
+                "bias SE": ".2e",
+                "mean 68% width": ".3e",
+                "min N / tau": ".1f",
+                "z 68%": "+.2f",
+                "z 95%": "+.2f",
+            },
+        )
     )
 
 
@@ -492,7 +527,6 @@ def section_uncertainty(ctx):
     from validation.fitting.fit import corner_figure, predictive, predictive_figure, run_fit, write_fit
     from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
-    from validation.fitting.recovery import recovery_study
 
     s = Section("uncertainty", "Uncertainty: an example posterior and the recovery coverage")
     scene_path = os.path.join(os.path.dirname(references.__file__), "scenes", FIT_SCENE)
@@ -602,87 +636,7 @@ def section_uncertainty(ctx):
             caption="fraction of data inside the posterior-predictive intervals",
         )
     )
-    # --- recovery study
-    rs = _recovery_settings(ctx.quick, ctx.seed)
-    rsc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
-    rspec = fitspec_from(rsc, rs["free"], rs["noise"])
-    from validation.fitting.executors import make_executor
-
-    rchain = rs["chain"]
-    with make_executor(rs.get("workers", 1), None) as ex:  # identical results on any executor (tested)
-        cells = recovery_study(
-            rsc,
-            rspec,
-            data,
-            rchain,
-            noise_levels=rs["noise_levels"],
-            n_geometries=rs["n_geometries"],
-            injections=rs["injections"],
-            executor=ex,
-        )
-    crow = []
-    for c in cells:
-        for k, v in c["summary"].items():
-            c68, c95 = v["coverage"]["68"], v["coverage"]["95"]
-            crow.append(
-                {
-                    "noise (brdf, fractional)": c["noise_brdf"],
-                    "geometries": c["geometries"],
-                    "parameter": k,
-                    "injections": v["injections"],
-                    "coverage 68%": c68["measured"],
-                    "z 68%": c68["z"],
-                    "coverage 95%": c95["measured"],
-                    "z 95%": c95["z"],
-                    "binomial SE 68%": c68["binomial_se"],
-                    "binomial SE 95%": c95["binomial_se"],
-                    "curvature coverage 68%": c68["curvature"],
-                    "curvature coverage 95%": c95["curvature"],
-                    "bias": v["bias"],
-                    "bias SE": v["bias_se"],
-                    "mean 68% width": v["width68_mean"],
-                    "min N / tau": c["steps_over_tau_min"],
-                }
-            )
-    s.blocks.append(
-        text_block(
-            f"Injection-recovery (validation/recovery.py): scene references/scenes/{RECOVERY_SCENE}, free "
-            f"{', '.join(rs['free'])}, geometries from the data file (evenly spread subsets), log-normal speckle "
-            f"at the listed level; {rs['injections']} injections per cell, each fitted with {rchain.walkers} walkers "
-            f"and at most {rchain.max_steps} steps, seed {ctx.seed}"
-            + (" (quick mode: the configuration of tests/test_recovery.py)." if ctx.quick else ".")
-            + " z = (coverage - nominal) / binomial SE. The curvature columns are the coverage, on the same "
-            "data sets, of the optimum +- 1 and 2 Gauss-Newton standard deviations: when they are nominal and "
-            "the posterior's are not, the sampler is at fault, not the data."
-        )
-    )
-    s.blocks.append(
-        table_block(
-            s,
-            "recovery",
-            list(crow[0]),
-            crow,
-            caption="coverage of the 68% and 95% intervals (nominal 0.6827 and 0.9545)",
-            fmt={
-                "bias": ".2e",
-                "bias SE": ".2e",
-                "mean 68% width": ".3e",
-                "min N / tau": ".1f",
-                "z 68%": "+.2f",
-                "z 95%": "+.2f",
-            },
-        )
-    )
-    worst_z = max(max(abs(r["z 68%"]), abs(r["z 95%"])) for r in crow)
-    ctx.cache.setdefault("extra_checks", []).append(
-        {
-            "name": "uncertainty: recovery coverage within 3 binomial SE of nominal",
-            "measured": float(worst_z),
-            "tolerance": 3.0,
-            "status": "pass" if worst_z <= 3.0 else "fail",
-            "detail": f"{len(cells)} cell(s) x {rs['injections']} injections ({'quick' if ctx.quick else 'full'})",
-        }
-    )
+    _recovery_blocks(s, ctx)
     return s
 
 
