@@ -53,10 +53,22 @@ from .base import Model, _Wrapper
 from .geometry import disc_quadrature
 from .params import param
 
-__all__ = ["PointSourceBRDF"]
+__all__ = ["PointSourceBRDF", "point_source_geometry"]
 
 #: Inner-model geometries per block (bounds the temporaries of one block).
 _BLOCK = 1 << 16
+
+
+def point_source_geometry(lo_deg, hi_deg):
+    """``(psi_c, d / R)``: the central incidence (radians) and the source height in units
+    of the sample radius for which a disc sample spans incidences ``[lo_deg, hi_deg]``.
+
+    With ``x = d tan(psi)`` (Eq. 26) the disc spans ``x_c - R .. x_c + R``:
+    ``d / R = 2 / (tan hi - tan lo)`` and ``tan psi_c = (tan lo + tan hi) / 2``.
+    Seed 001 prints such ranges for its iron plate but no distance or sample size.
+    """
+    tl, th = math.tan(math.radians(lo_deg)), math.tan(math.radians(hi_deg))
+    return math.atan(0.5 * (tl + th)), 2.0 / (th - tl)
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,7 @@ __all__ = [
     "GaussianAngles",
     "ExponentialAngles",
     "TabulatedSlopes",
+    "UnitSlopes",
 ]
 
 _SQRT6 = math.sqrt(6.0)
@@ -417,3 +418,18 @@ class TabulatedSlopes(SlopeDistribution):
         f = lambda s: math.sqrt(1 + s * s) * float(self._p4_unit(np.array(s)))  # noqa: E731
         val, _ = integrate.quad(f, 0, z[-1], limit=800)
         return val
+
+
+@dataclass(frozen=True)
+class UnitSlopes(SlopeDistribution):
+    """``P3(zeta) = 1`` for every slope: a facet model's BRDF *per unit slope density*.
+
+    Not a probability distribution (it does not normalize); the facet BRDF is
+    linear in ``P3`` (seed 000 Eq. 49), so a model built with it gives the kernel
+    that slope-distribution inversion divides a measured BRDF by.
+    """
+
+    coverage: float = param(1.0, "fixed at 1", low=1.0, high=1.0)
+
+    def _p3_unit(self, zx, zy):
+        return np.ones(np.broadcast_shapes(np.shape(zx), np.shape(zy)))
