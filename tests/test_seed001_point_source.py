@@ -107,14 +107,14 @@ def test_not_reciprocal_and_by_how_much():
 
 def test_preset_ranges():
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
-        psi_c, d = references.point_source_geometry(lo, hi)
+        psi_c, d = models.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=BASE, distance=d)
         a, b = ps.incidence_range(psi_c)
         assert math.degrees(a) == pytest.approx(lo, abs=1e-9) and math.degrees(b) == pytest.approx(
             hi, abs=1e-9
         )
-    ct, vn = references.iron_plate_models()
-    assert models.CookTorranceBRDF(**ct).m == 0.03 and models.VarnishedCookTorranceBRDF(**vn).varnish == 1.5
+    assert references.IRON_PLATE["m"] == 0.03 and references.IRON_PLATE["varnish"] == 1.5
+    assert references.IRON_PLATE["substrate"] == 2.29 + 3.37j
 
 
 @pytest.mark.parametrize(

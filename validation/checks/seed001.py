@@ -565,7 +565,7 @@ def check_cauchy():
 def check_preset():
     worst = 0.0
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
-        psi_c, d = references.point_source_geometry(lo, hi)
+        psi_c, d = models.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=models.CookTorranceBRDF(), distance=d, sample_radius=1.0)
         a, b = ps.incidence_range(psi_c)
         worst = max(worst, abs(math.degrees(a) - lo), abs(math.degrees(b) - hi))
@@ -573,9 +573,15 @@ def check_preset():
 
 
 def _preset_section(results):
-    ct_kw, vn_kw = references.iron_plate_models("published")
-    ct = models.CookTorranceBRDF(**ct_kw)
-    vn = models.VarnishedCookTorranceBRDF(**vn_kw)
+    plate = references.IRON_PLATE
+    ct = models.CookTorranceBRDF(m=plate["m"], substrate=plate["substrate"], normalization="published")
+    vn = models.VarnishedCookTorranceBRDF(
+        m_parallel=plate["m"],
+        m_perpendicular=plate["m"],
+        varnish=plate["varnish"],
+        substrate=plate["substrate"],
+        normalization="published",
+    )
     lines = [
         "Iron plate of seed 001 (iron 2.29+3.37i at 650 nm, m = 0.03, n_v = 1.5), published normalization.",
         "Peak of the in-plane BRDF (1/sr) and its angle; point source sized to the printed incidence range:",
@@ -584,7 +590,7 @@ def _preset_section(results):
     ]
     tr = np.radians(np.linspace(0, 89, 1781))
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
-        psi_c, d = references.point_source_geometry(lo, hi)
+        psi_c, d = models.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=vn, distance=d, sample_radius=1.0, resolution=16)
         cells = []
         for m in (ct, vn, ps):
