@@ -43,6 +43,7 @@ observer turns an extended source into an extended detector and vice versa.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -94,7 +95,7 @@ class PointSourceBRDF(_Wrapper):
         Radial quadrature nodes over the disc (azimuthal nodes: twice as many).
     """
 
-    model: Model = param(None, "the collimated model", kind="object")
+    model: Model = param(dataclasses.MISSING, "the collimated model", kind="object")
     distance: float = param(100.0, "source height d above the sample plane (> 0, or inf)", kind="object")
     sample_radius: float = param(1.0, "sample radius R", low=0.0, low_open=True)
     method: str = param(

@@ -177,7 +177,7 @@ class ExponentialSlopes(SlopeDistribution):
     SCATMECH: ``Exponential_Slope_Distribution_Function`` (parameter ``s``).
     """
 
-    sigma: float = param(0.1, "rms slope", low=0.0, low_open=True)
+    sigma: float = param(0.1, "rms slope, sqrt(<|zeta|^2>)", low=0.0, low_open=True)
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _p3_unit(self, zx, zy):
@@ -194,7 +194,7 @@ class GaussianSlopes(SlopeDistribution):
     ``m`` (seed 001 Eq. 8).  SCATMECH: ``Gaussian_Slope_Distribution_Function``.
     """
 
-    sigma: float = param(0.1, "rms slope", low=0.0, low_open=True)
+    sigma: float = param(0.1, "rms slope, sqrt(<|zeta|^2>)", low=0.0, low_open=True)
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _p3_unit(self, zx, zy):
@@ -243,8 +243,18 @@ class AnisotropicExponentialSlopes(_Anisotropic):
     each axis the rms slope is ``sigma_x / sqrt(2)``, ``sigma_y / sqrt(2)``.
     """
 
-    sigma_x: float = param(0.1, "slope scale along the rotated x axis", low=0.0, low_open=True)
-    sigma_y: float = param(0.1, "slope scale along the rotated y axis", low=0.0, low_open=True)
+    sigma_x: float = param(
+        0.1,
+        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    sigma_y: float = param(
+        0.1,
+        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
     rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
@@ -266,8 +276,18 @@ class AnisotropicGaussianSlopes(_Anisotropic):
     with ``sigma = m`` (the Cook-Torrance / Beckmann distribution).
     """
 
-    sigma_x: float = param(0.1, "slope scale along the rotated x axis", low=0.0, low_open=True)
-    sigma_y: float = param(0.1, "slope scale along the rotated y axis", low=0.0, low_open=True)
+    sigma_x: float = param(
+        0.1,
+        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    sigma_y: float = param(
+        0.1,
+        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
     rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
@@ -332,7 +352,13 @@ class GaussianAngles(_AngleDistribution):
     approximation, so the two differ at large ``sigma``.)
     """
 
-    sigma: float = param(0.1, "angular width (rad)", low=0.0, high=math.pi, low_open=True)
+    sigma: float = param(
+        0.1,
+        "angular width (rad): the rms tilt in the small-angle limit",
+        low=0.0,
+        high=math.pi,
+        low_open=True,
+    )
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _shape(self, theta):
@@ -344,7 +370,13 @@ class ExponentialAngles(_AngleDistribution):
     """Exponential distribution of flake tilt angles, ``P1^A ~ exp(-sqrt(6) theta_n / sigma)``
     (``sigma`` is the rms tilt in the small-angle limit), declared on the flake area."""
 
-    sigma: float = param(0.1, "angular width (rad)", low=0.0, high=math.pi, low_open=True)
+    sigma: float = param(
+        0.1,
+        "angular width (rad): the rms tilt in the small-angle limit",
+        low=0.0,
+        high=math.pi,
+        low_open=True,
+    )
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _shape(self, theta):

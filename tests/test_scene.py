@@ -136,7 +136,7 @@ def test_cook_torrance_scenes_and_point_source_decision():
         _ct_scene("", "m_parallel = 0.03\nm_perpendicular = 0.3\nstroke_angle_deg = 30\n"), "b.toml"
     )
     b = brushed.build()
-    assert b.m_perpendicular == 0.3 and abs(b.stroke_angle - math.radians(30)) < 1e-15
+    assert b.slopes.m_perpendicular == 0.3 and abs(b.slopes.stroke_angle - math.radians(30)) < 1e-15
 
 
 @pytest.mark.parametrize(

@@ -146,8 +146,9 @@ def test_reciprocity(rng):
 def test_varnish_one_is_cook_torrance(rng):
     ti, tr = rng.uniform(0, 1.5, (2, 5000))
     pr = rng.uniform(-math.pi, math.pi, 5000)
+    # at n_v = 1 the corrected convention is the energy normalization (the Jacobian is 1)
     v = models.VarnishedCookTorranceBRDF(
-        m_parallel=0.1, m_perpendicular=0.1, varnish=1.0, normalization="energy"
+        m_parallel=0.1, m_perpendicular=0.1, varnish=1.0, convention="corrected"
     )
     ct = models.CookTorranceBRDF(m=0.1, normalization="energy")
     # Equal up to rounding; in the far tails (values ~1e-227) the exponent's rounding
@@ -207,7 +208,7 @@ def test_anisotropic_matches_facet_with_eq19_slopes(rng):
             m_perpendicular=mq,
             stroke_angle=ang,
             varnish=1.0,
-            normalization="energy",
+            convention="corrected",  # the Jacobian is 1 at n_v = 1
             shadowing="none",
         )
         f = models.FacetBRDF(slopes=models.StrokeSlopes(mp, mq, ang), substrate=IRON)
@@ -249,7 +250,7 @@ def test_strokes_rotated_by_90_swap_axes(rng):
     a = models.VarnishedCookTorranceBRDF(m_parallel=0.05, m_perpendicular=0.3, stroke_angle=0.2)
     b = models.VarnishedCookTorranceBRDF(m_parallel=0.3, m_perpendicular=0.05, stroke_angle=0.2 + math.pi / 2)
     np.testing.assert_allclose(a.brdf(ti, tr, pr), b.brdf(ti, tr, pr), rtol=1e-12, atol=1e-300)
-    assert not a.mirror_symmetric and a.rotated(0.5).stroke_angle == pytest.approx(0.7)
+    assert not a.mirror_symmetric and a.rotated(0.5).slopes.stroke_angle == pytest.approx(0.7)
     assert models.VarnishedCookTorranceBRDF().rotated(0.5) is not None
 
 
@@ -288,6 +289,12 @@ def test_extreme_values_are_sensible():
         (lambda: models.VarnishedCookTorranceBRDF(m_perpendicular=0), "m_perpendicular"),
         (lambda: models.VarnishedCookTorranceBRDF(stroke_angle=math.inf), "stroke_angle"),
         (lambda: models.VarnishedCookTorranceBRDF(solid_angle="x"), "solid_angle"),
+        (lambda: models.VarnishedCookTorranceBRDF(convention="energy"), "convention"),
+        (lambda: models.VarnishedCookTorranceBRDF(normalization="energy"), "solid_angle='published'"),
+        (lambda: models.VarnishedCookTorranceBRDF(solid_angle="refracted"), "normalization='published'"),
+        (lambda: models.CookTorranceBRDF(m=0.1, slopes=models.GaussianSlopes(0.1)), "give slopes alone"),
+        (lambda: models.CookTorranceBRDF(slopes=models.ExponentialSlopes(0.1)), "slopes"),
+        (lambda: models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.1, coverage=0.5)), "slopes"),
         (lambda: models.StrokeSlopes(m_parallel=-0.1), "m_parallel"),
     ],
 )
@@ -304,12 +311,26 @@ def test_bad_angles():
 def test_varnish_energy_form_still_creates_energy():
     """Eq. 24 with 1/(4 pi) on a perfect conductor: albedo ~2.08 at normal incidence
     although the varnish transmits 0.96 each way -- the missing refraction Jacobian.
-    With solid_angle='refracted' it is T_in T_out = 0.9216 (m -> 0 limit)."""
-    kw = dict(m_parallel=0.03, m_perpendicular=0.03, substrate=math.inf, normalization="energy")
-    pub = integrated_reflectance(models.VarnishedCookTorranceBRDF(**kw), 0.0, tol=1e-4)
+    With it (convention 'corrected') it is T_in T_out = 0.9216 (m -> 0 limit)."""
+    kw = dict(m_parallel=0.03, m_perpendicular=0.03, substrate=math.inf)
+    energy_printed = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF(convention="paper", **kw)
+    pub = integrated_reflectance(energy_printed, 0.0, tol=1e-4)
     ref = integrated_reflectance(
-        models.VarnishedCookTorranceBRDF(solid_angle="refracted", **kw), 0.0, tol=1e-4
+        models.VarnishedCookTorranceBRDF(convention="corrected", **kw), 0.0, tol=1e-4
     )
     assert pub.value > 2.0
     assert abs(ref.value - 0.96**2) < 2e-3  # slope spread loses a little through the varnish
     assert ref.value - ref.error <= 0.96
+
+
+def test_beckmann_m_is_the_gaussian_slope_sigma():
+    """Eq. 8's D / pi = exp(-tan^2 alpha / m^2) / (pi m^2 cos^4 alpha) is GaussianSlopes(sigma=m).p3
+    at zeta = tan(alpha) over cos^4(alpha): m is the sigma of P(z) = exp(-(z/sigma)^2)/(pi sigma^2)."""
+    m = 0.17
+    d_fn = models.CookTorranceBRDF(m=m)._d_fn()  # exp(-tan^2 alpha / m^2) / m^2 for h = (hx, hy, hz)
+    alpha = np.linspace(0.0, 1.2, 50)
+    phi = np.linspace(-3.0, 3.0, 50)
+    hx, hy = np.sin(alpha) * np.cos(phi), np.sin(alpha) * np.sin(phi)
+    hz2 = np.cos(alpha) ** 2
+    p3 = models.GaussianSlopes(sigma=m).p3(hx / np.cos(alpha), hy / np.cos(alpha))
+    np.testing.assert_allclose(d_fn(hx, hy, hz2) / math.pi, p3, rtol=1e-13)

@@ -10,7 +10,8 @@ import references
 from validation.checks import seed001 as c
 from validation.numerics.reciprocity import reciprocity_error
 
-BASE = models.VarnishedCookTorranceBRDF(normalization="energy")
+# energy normalization with Eq. 24's printed solid angle: the printed model over the exact 4 pi
+BASE = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF()
 
 
 def test_infinite_distance_is_the_model(rng):

@@ -107,5 +107,5 @@ def test_angle_validation_names_theta_t():
 
 
 def test_exact_normalization_refuses_anisotropic_slopes():
-    with pytest.raises(ValueError, match="normalization 'exact' needs isotropic slopes"):
+    with pytest.raises(ValueError, match="convention 'corrected' needs isotropic slopes"):
         models.FacetBTDF(slopes=models.AnisotropicGaussianSlopes(1.6, 0.2), normalization="exact")

@@ -37,6 +37,21 @@ IRON = 2.29 + 3.37j
 SUBSTRATES = (IRON, 1.37 + 7.62j, 1.5, 3.88 + 0.02j, math.inf)
 
 
+def _energy_published(model):
+    """Energy normalization with Eq. 24's printed solid angle: the printed (``paper``) varnished
+    model divided by the exact 4 pi (the model has no single convention for this pair)."""
+    return (1.0 / (4.0 * math.pi)) * model
+
+
+def _jacobian(ti, tr, nv):
+    """Refraction Jacobian ``n_v^2 cos Psi cos Theta / (cos psi cos theta)`` between Eq. 24's
+    denominator and the refraction-consistent one."""
+    ci, cr = np.cos(ti), np.cos(tr)
+    cI = np.sqrt(1 - (np.sin(ti) / nv) ** 2)
+    cR = np.sqrt(1 - (np.sin(tr) / nv) ** 2)
+    return nv * nv * cI * cR / (ci * cr)
+
+
 def _rel_where_both(a, b):
     both = (a > 0) & (b > 0)
     mismatch = int(np.sum((a > 0) != (b > 0)))
@@ -59,14 +74,18 @@ def ct_vs_facet_error(n=20000, seed=0):
 
 
 def published_over_energy_error(n=20000):
+    """Max relative |paper / corrected / (4 pi) - 1|; for the varnished model the corrected
+    form also carries the refraction Jacobian, divided out here."""
     ti, tr, pr = _geoms(n, 1)
     worst = 0.0
     for cls, kw in (
         (models.CookTorranceBRDF, {"m": 0.2}),
         (models.VarnishedCookTorranceBRDF, {"m_parallel": 0.05, "m_perpendicular": 0.4, "stroke_angle": 0.3}),
     ):
-        a = cls(normalization="published", **kw).brdf(ti, tr, pr)
-        b = cls(normalization="energy", **kw).brdf(ti, tr, pr)
+        a = cls(convention="paper", **kw).brdf(ti, tr, pr)
+        b = cls(convention="corrected", **kw).brdf(ti, tr, pr)
+        if cls is models.VarnishedCookTorranceBRDF:
+            b = b * _jacobian(ti, tr, 1.5)
         live = b > 0
         worst = max(worst, float(np.max(np.abs(a[live] / b[live] / (4 * math.pi) - 1))))
     return worst
@@ -87,7 +106,7 @@ def check_ct_vs_facet():
             "seed001: published / energy - 4 pi (relative)",
             published_over_energy_error(),
             1e-14,
-            "CookTorrance and varnished models",
+            "CookTorrance and varnished models (varnished: refraction Jacobian divided out)",
         ),
     ]
     # anisotropic roughness: varnish n_v = 1 against FacetBRDF with the Eq. 19 slope density
@@ -99,7 +118,7 @@ def check_ct_vs_facet():
             m_perpendicular=mq,
             stroke_angle=ang,
             varnish=1.0,
-            normalization="energy",
+            convention="corrected",  # at n_v = 1 the refraction Jacobian is 1: the energy normalization
             shadowing="none",
         )
         f = models.FacetBRDF(slopes=models.StrokeSlopes(mp, mq, ang), substrate=v.substrate)
@@ -220,8 +239,10 @@ def seed001_models():
         models.CookTorranceBRDF(m=0.03),
         models.CookTorranceBRDF(m=0.5, substrate=1.5, normalization="energy"),
         models.VarnishedCookTorranceBRDF(),
-        models.VarnishedCookTorranceBRDF(
-            m_parallel=0.05, m_perpendicular=0.4, stroke_angle=0.7, solid_angle="refracted"
+        # published normalization with the refracted solid angle: 4 pi times the corrected form
+        (4.0 * math.pi)
+        * models.VarnishedCookTorranceBRDF(
+            m_parallel=0.05, m_perpendicular=0.4, stroke_angle=0.7, convention="corrected"
         ),
         models.VarnishedCookTorranceBRDF(
             m_parallel=0.3, m_perpendicular=0.01, stroke_angle=-2.0, varnish=2.0
@@ -243,15 +264,18 @@ def check_reciprocity():
 
 # ------------------------------------------------------------------ varnish vs subsurface
 def _pair(m=0.1, nv=1.5, sub=IRON, solid_angle="published"):
+    """Energy-normalized varnished model with Eq. 24's (``published``) or the refracted
+    solid angle, and the subsurface facet model it is compared with."""
     v = models.VarnishedCookTorranceBRDF(
         m_parallel=m,
         m_perpendicular=m,
         varnish=nv,
         substrate=sub,
-        normalization="energy",
+        convention="paper" if solid_angle == "published" else "corrected",
         shadowing="none",
-        solid_angle=solid_angle,
     )
+    if solid_angle == "published":
+        v = _energy_published(v)
     s = models.SubsurfaceFacetBRDF(slopes=models.GaussianSlopes(sigma=m), coating=nv, substrate=sub)
     return v, s
 
@@ -417,16 +441,16 @@ def _anisotropy_section(results):
 
 # ------------------------------------------------------------------ extremes
 def extreme_seed001_models():
-    base = models.VarnishedCookTorranceBRDF(normalization="energy")
+    base = _energy_published(models.VarnishedCookTorranceBRDF())
     out = []
     for m in (1e-6, 0.03, 2.0):
         for sub in (IRON, 1.5, 1.0 + 0j, math.inf):
-            for norm in ("published", "energy"):
+            for conv in ("paper", "corrected"):
                 for sh in ("blinn", "none"):
-                    out.append(models.CookTorranceBRDF(m=m, substrate=sub, normalization=norm, shadowing=sh))
+                    out.append(models.CookTorranceBRDF(m=m, substrate=sub, convention=conv, shadowing=sh))
                     out.append(
                         models.VarnishedCookTorranceBRDF(
-                            m_parallel=m, m_perpendicular=m, substrate=sub, normalization=norm, shadowing=sh
+                            m_parallel=m, m_perpendicular=m, substrate=sub, convention=conv, shadowing=sh
                         )
                     )
     for mp, mq in ((0.01, 1.0), (1.0, 0.01), (1e-6, 1e-4), (0.02, 2.0)):
@@ -462,7 +486,7 @@ def check_extremes():
 # ------------------------------------------------------------------ point source
 def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_deg=17.0, resolution=8):
     """Max |f_g - f| / max f over an in-plane section, per source distance (R = 1)."""
-    base = models.VarnishedCookTorranceBRDF(normalization="energy")
+    base = _energy_published(models.VarnishedCookTorranceBRDF())
     tr = np.radians(np.linspace(0, 60, 241))
     ti = math.radians(ti_deg)
     f = base.brdf(ti, tr, 0.0)
@@ -478,7 +502,7 @@ def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_
 def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     """``{d: max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak}`` for the
     varnished iron plate, R = 1 (the reversed path from :mod:`validation.numerics.reciprocity`)."""
-    base = models.VarnishedCookTorranceBRDF(normalization="energy")
+    base = _energy_published(models.VarnishedCookTorranceBRDF())
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.4, (2, n))
     pr = rng.uniform(-0.3, 0.3, n)
@@ -611,8 +635,13 @@ def varnish_albedos(tol=1e-4):
     for m in (0.03, 0.1, 0.5):
         for sa in ("published", "refracted"):
             model = models.VarnishedCookTorranceBRDF(
-                m_parallel=m, m_perpendicular=m, substrate=math.inf, normalization="energy", solid_angle=sa
+                m_parallel=m,
+                m_perpendicular=m,
+                substrate=math.inf,
+                convention="paper" if sa == "published" else "corrected",
             )
+            if sa == "published":
+                model = _energy_published(model)
             for ti in (0.0, 30.0, 60.0, 80.0, 89.0):
                 r = integrated_reflectance(model, math.radians(ti), tol=tol)
                 rs, rp = models.fresnel_reflectance(math.cos(math.radians(ti)), 1.0, 1.5)
