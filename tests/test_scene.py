@@ -177,18 +177,18 @@ def test_preset_scenes_are_the_paper_models():
     """The scene files of seed 003's presets hold the models (and parameters) of the paper's
     Fig. 2-3 as the preset builder wrote them before the presets became data."""
     white = _scene("glossy_white_paint.toml").build()
-    assert white == models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.93)
+    assert white == models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.93)
     phase = models.HenyeyGreenstein(g=0.3, polarized=True)
     red = _scene("red_pigmented_paint.toml").build()
     assert red == (
         1.0 * models.FacetBRDF(slopes=models.GaussianSlopes(sigma=0.05), substrate=1.5)
-        + 1.0 * models.SingleScatterBRDF(n=1.5, phase=phase)
-        + 1.0 * models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.1)
+        + 1.0 * models.SingleScatterBRDF(coating=1.5, phase=phase)
+        + 1.0 * models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.1)
     )
     carc = _scene("green_carc.toml").build()
     assert carc == models.RoughDiffuseBRDF(
         slopes=models.ExponentialSlopes(sigma=2.0),
-        n=1.5,
+        coating=1.5,
         phase=phase,
         rho=0.05,
         pairs=5000,

@@ -57,7 +57,7 @@ def test_shift_grid_matches_pointwise_shift():
     """Eq. 30 by FFT correlation reproduces the pointwise Eq. 29 sum up to the
     bilinear interpolation of the central BRDF, which falls as the grid is refined
     (measured 2.9e-4, 9.5e-5, 5.3e-5 of the peak for 61, 121, 241 theta nodes)."""
-    m = models.CookTorranceBRDF(m=0.3, normalization="energy")
+    m = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.3), convention="corrected")
     ti = math.radians(30)
     errs = []
     for n in (61, 121, 241):

@@ -10,7 +10,7 @@ import references
 from models import scene
 from validation.checks import seed003 as c3
 
-KW = dict(slopes=models.ExponentialSlopes(0.5), n=1.5, phase=models.HenyeyGreenstein(0.3), rho=0.3)
+KW = dict(slopes=models.ExponentialSlopes(0.5), coating=1.5, phase=models.HenyeyGreenstein(0.3), rho=0.3)
 G = c3._GEOM
 
 
@@ -117,7 +117,7 @@ def test_presets():
 
 def test_combination_errors():
     mc = models.RoughDiffuseBRDF(pairs=500, seed=0, **KW)
-    det = models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.5)
+    det = models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.5)
     s = 0.5 * mc + 2.0 * det
     M, E = models.mueller_with_error(s, *G)
     Mm, Em = mc.mueller_with_error(*G)

@@ -66,7 +66,9 @@ def ct_vs_facet_error(n=20000, seed=0):
     worst, mism, live = 0.0, 0, 0
     for m in (1e-3, 0.03, 0.3, 1.0, 2.0):
         for sub in SUBSTRATES:
-            ct = models.CookTorranceBRDF(m=m, substrate=sub, normalization="energy", shadowing="none")
+            ct = models.CookTorranceBRDF(
+                slopes=models.GaussianSlopes(m), substrate=sub, convention="corrected", shadowing="none"
+            )
             fa = models.FacetBRDF(slopes=models.GaussianSlopes(sigma=m), substrate=sub)
             e, k, nl = _rel_where_both(ct.brdf(ti, tr, pr), fa.brdf(ti, tr, pr))
             worst, mism, live = max(worst, e), mism + k, live + nl
@@ -79,8 +81,8 @@ def published_over_energy_error(n=20000):
     ti, tr, pr = _geoms(n, 1)
     worst = 0.0
     for cls, kw in (
-        (models.CookTorranceBRDF, {"m": 0.2}),
-        (models.VarnishedCookTorranceBRDF, {"m_parallel": 0.05, "m_perpendicular": 0.4, "stroke_angle": 0.3}),
+        (models.CookTorranceBRDF, {"slopes": models.GaussianSlopes(0.2)}),
+        (models.VarnishedCookTorranceBRDF, {"slopes": models.StrokeSlopes(0.05, 0.4, 0.3)}),
     ):
         a = cls(convention="paper", **kw).brdf(ti, tr, pr)
         b = cls(convention="corrected", **kw).brdf(ti, tr, pr)
@@ -114,10 +116,8 @@ def check_ct_vs_facet():
     worst = 0.0
     for mp, mq, ang in ((0.05, 0.3, 0.4), (0.01, 1.0, -1.2), (0.2, 0.02, 2.0)):
         v = models.VarnishedCookTorranceBRDF(
-            m_parallel=mp,
-            m_perpendicular=mq,
-            stroke_angle=ang,
-            varnish=1.0,
+            slopes=models.StrokeSlopes(mp, mq, ang),
+            coating=1.0,
             convention="corrected",  # at n_v = 1 the refraction Jacobian is 1: the energy normalization
             shadowing="none",
         )
@@ -188,7 +188,9 @@ def published_albedos(tol=1e-3):
     out = {}
     for ti in (17.0, 44.0, 63.0):
         r = integrated_reflectance(
-            models.CookTorranceBRDF(m=0.03, normalization="published"), math.radians(ti), tol
+            models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="paper"),
+            math.radians(ti),
+            tol,
         )
         out[ti] = r.value
     return out
@@ -200,7 +202,9 @@ def energy_albedos(tol=1e-4):
     for m in (0.03, 0.1, 0.3, 0.5):
         for sub in (IRON, math.inf):
             for ti in (0.0, 30.0, 60.0, 80.0, 89.9):
-                model = models.CookTorranceBRDF(m=m, substrate=sub, normalization="energy")
+                model = models.CookTorranceBRDF(
+                    slopes=models.GaussianSlopes(m), substrate=sub, convention="corrected"
+                )
                 r = integrated_reflectance(model, math.radians(ti), tol=tol)
                 out.append((m, sub, ti, r.value, r.error))
     return out
@@ -236,17 +240,15 @@ def check_energy():
 # ------------------------------------------------------------------ reciprocity
 def seed001_models():
     return [
-        models.CookTorranceBRDF(m=0.03),
-        models.CookTorranceBRDF(m=0.5, substrate=1.5, normalization="energy"),
+        models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03)),
+        models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.5), substrate=1.5, convention="corrected"),
         models.VarnishedCookTorranceBRDF(),
         # published normalization with the refracted solid angle: 4 pi times the corrected form
         (4.0 * math.pi)
         * models.VarnishedCookTorranceBRDF(
-            m_parallel=0.05, m_perpendicular=0.4, stroke_angle=0.7, convention="corrected"
+            slopes=models.StrokeSlopes(0.05, 0.4, 0.7), convention="corrected"
         ),
-        models.VarnishedCookTorranceBRDF(
-            m_parallel=0.3, m_perpendicular=0.01, stroke_angle=-2.0, varnish=2.0
-        ),
+        models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.3, 0.01, -2.0), coating=2.0),
     ]
 
 
@@ -267,9 +269,8 @@ def _pair(m=0.1, nv=1.5, sub=IRON, solid_angle="published"):
     """Energy-normalized varnished model with Eq. 24's (``published``) or the refracted
     solid angle, and the subsurface facet model it is compared with."""
     v = models.VarnishedCookTorranceBRDF(
-        m_parallel=m,
-        m_perpendicular=m,
-        varnish=nv,
+        slopes=models.StrokeSlopes(m, m),
+        coating=nv,
         substrate=sub,
         convention="paper" if solid_angle == "published" else "corrected",
         shadowing="none",
@@ -447,16 +448,18 @@ def extreme_seed001_models():
         for sub in (IRON, 1.5, 1.0 + 0j, math.inf):
             for conv in ("paper", "corrected"):
                 for sh in ("blinn", "none"):
-                    out.append(models.CookTorranceBRDF(m=m, substrate=sub, convention=conv, shadowing=sh))
+                    out.append(
+                        models.CookTorranceBRDF(
+                            slopes=models.GaussianSlopes(m), substrate=sub, convention=conv, shadowing=sh
+                        )
+                    )
                     out.append(
                         models.VarnishedCookTorranceBRDF(
-                            m_parallel=m, m_perpendicular=m, substrate=sub, convention=conv, shadowing=sh
+                            slopes=models.StrokeSlopes(m, m), substrate=sub, convention=conv, shadowing=sh
                         )
                     )
     for mp, mq in ((0.01, 1.0), (1.0, 0.01), (1e-6, 1e-4), (0.02, 2.0)):
-        out.append(
-            models.VarnishedCookTorranceBRDF(m_parallel=mp, m_perpendicular=mq, stroke_angle=0.3, varnish=2.2)
-        )
+        out.append(models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(mp, mq, 0.3), coating=2.2))
     out.append(models.PointSourceBRDF(model=base, distance=math.inf, resolution=2))
     out.append(models.PointSourceBRDF(model=base, distance=1e12, resolution=2))
     out.append(models.PointSourceBRDF(model=base, distance=1.0, sample_radius=1.0, resolution=3))
@@ -598,13 +601,14 @@ def check_preset():
 
 def _preset_section(results):
     plate = references.IRON_PLATE
-    ct = models.CookTorranceBRDF(m=plate["m"], substrate=plate["substrate"], normalization="published")
+    ct = models.CookTorranceBRDF(
+        slopes=models.GaussianSlopes(plate["m"]), substrate=plate["substrate"], convention="paper"
+    )
     vn = models.VarnishedCookTorranceBRDF(
-        m_parallel=plate["m"],
-        m_perpendicular=plate["m"],
-        varnish=plate["varnish"],
+        slopes=models.StrokeSlopes(plate["m"], plate["m"]),
+        coating=plate["varnish"],
         substrate=plate["substrate"],
-        normalization="published",
+        convention="paper",
     )
     lines = [
         "Iron plate of seed 001 (iron 2.29+3.37i at 650 nm, m = 0.03, n_v = 1.5), published normalization.",
@@ -635,8 +639,7 @@ def varnish_albedos(tol=1e-4):
     for m in (0.03, 0.1, 0.5):
         for sa in ("published", "refracted"):
             model = models.VarnishedCookTorranceBRDF(
-                m_parallel=m,
-                m_perpendicular=m,
+                slopes=models.StrokeSlopes(m, m),
                 substrate=math.inf,
                 convention="paper" if sa == "published" else "corrected",
             )

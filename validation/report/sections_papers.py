@@ -300,7 +300,9 @@ def section_seed001(ctx):
     rows = []
     for t, v in pub.items():
         e = integrated_reflectance(
-            models.CookTorranceBRDF(m=0.03, normalization="energy"), math.radians(t), tol=1e-3
+            models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="corrected"),
+            math.radians(t),
+            tol=1e-3,
         )
         rows.append(
             {
@@ -389,11 +391,10 @@ def section_seed001(ctx):
     # --- point source vs collimated, iron plate
     plate = references.IRON_PLATE
     vn = models.VarnishedCookTorranceBRDF(
-        m_parallel=plate["m"],
-        m_perpendicular=plate["m"],
-        varnish=plate["varnish"],
+        slopes=models.StrokeSlopes(plate["m"], plate["m"]),
+        coating=plate["varnish"],
         substrate=plate["substrate"],
-        normalization="published",
+        convention="paper",
     )
     ranges = plate["incidence_ranges_deg"]
     fig, axes = plt.subplots(1, len(ranges), figsize=(13, 3.6))
