@@ -53,6 +53,7 @@ class ParamInfo:
     high_open: bool = False
     aliases: tuple = ()  # old keyword names that still set this parameter
     required: bool = False  # no default: must be given
+    check: Any = field(default=None, repr=False, compare=False)  # validator of an ``object`` parameter
 
     def range_text(self) -> str:
         if self.kind == "index":
@@ -81,13 +82,15 @@ def param(
     low_open: bool = False,
     high_open: bool = False,
     choices: tuple | None = None,
+    check: Callable | None = None,
 ):
     """Declare a model parameter (a dataclass field with validation metadata).
 
     ``default`` may be ``dataclasses.MISSING``: the parameter is then required.
     ``kind`` is one of ``real``, ``int``, ``index`` (complex refractive index,
     ``k >= 0``, ``math.inf`` allowed), ``real_index`` (non-absorbing index
-    ``>= low``), ``choice`` (``choices``), ``object`` (checked by the model).
+    ``>= low``), ``choice`` (``choices``), ``object`` (checked by ``check(name, value)``,
+    which returns the value or raises ``ValueError``, or by the model's ``_validate``).
     """
     info = dict(
         doc=doc,
@@ -96,6 +99,7 @@ def param(
         high=high,
         low_open=low_open,
         high_open=high_open,
+        check=check,
     )
     if isinstance(default, (list, dict, np.ndarray)):
         return field(default_factory=lambda: default, metadata={"scatterbench": info})
@@ -261,6 +265,16 @@ class Declared(metaclass=_DeclaredMeta):
         """Hook for cross-parameter checks in subclasses."""
 
     @classmethod
+    def check_parameter(cls, name: str, value):
+        """``value`` validated as the declared parameter ``name`` (a ``ValueError`` naming it
+        and its allowed range otherwise), without building an instance: for callers, such
+        as scene files, that hold a value for a model they build later."""
+        for f in dataclasses.fields(cls):
+            if f.name == name and "scatterbench" in f.metadata:
+                return _checked(name, value, f.metadata["scatterbench"])
+        raise ValueError(f"{name}: not a declared parameter of {cls.__name__}")
+
+    @classmethod
     def _alias(cls, old) -> Alias:
         a = cls.aliases[old]
         return Alias(a) if isinstance(a, str) else a
@@ -362,7 +376,12 @@ def _checked(name, value, info):
             z = complex(z).real
         return check_real(name, z, info["low"], None)
     if kind == "choice":
-        if value not in info["low"]:
-            allowed = ", ".join(repr(c) for c in info["low"])
+        choices = info["low"]
+        flags = all(isinstance(c, bool) for c in choices)
+        if value not in choices or (flags and not isinstance(value, (bool, np.bool_))):
+            allowed = ", ".join(repr(c) for c in choices)
             raise ValueError(f"{name} must be one of {allowed}; got {value!r}")
+        return bool(value) if flags else value
+    if info.get("check") is not None:
+        return info["check"](name, value)
     return value

@@ -72,6 +72,17 @@ def point_source_geometry(lo_deg, hi_deg):
     return math.atan(0.5 * (tl + th)), 2.0 / (th - tl)
 
 
+def _check_distance(name, d):
+    ok = (
+        isinstance(d, (int, float))
+        and not isinstance(d, bool)
+        and (d == math.inf or (math.isfinite(d) and d > 0))
+    )
+    if not ok:
+        raise ValueError(f"{name} must be a finite real number > 0 or math.inf; got {d!r}")
+    return float(d)
+
+
 @dataclass(frozen=True)
 class PointSourceBRDF(_Wrapper):
     """A model illuminated by a point source at height ``distance`` over a disc
@@ -96,24 +107,14 @@ class PointSourceBRDF(_Wrapper):
     """
 
     model: Model = param(dataclasses.MISSING, "the collimated model", kind="object")
-    distance: float = param(100.0, "source height d above the sample plane (> 0, or inf)", kind="object")
+    distance: float = param(
+        100.0, "source height d above the sample plane (> 0, or inf)", kind="object", check=_check_distance
+    )
     sample_radius: float = param(1.0, "sample radius R", low=0.0, low_open=True)
     method: str = param(
         "exact", "Eq. 28 superposition or Eq. 29-30 shift", kind="choice", choices=("exact", "shift")
     )
     resolution: int = param(16, "radial quadrature nodes over the disc", kind="int", low=1, high=4096)
-
-    def _validate(self):
-        super()._validate()
-        d = self.distance
-        ok = (
-            isinstance(d, (int, float))
-            and not isinstance(d, bool)
-            and (d == math.inf or (math.isfinite(d) and d > 0))
-        )
-        if not ok:
-            raise ValueError(f"distance must be a finite real number > 0 or math.inf; got {d!r}")
-        object.__setattr__(self, "distance", float(d))
 
     def lobe(self, theta_i):
         lb = self.model.lobe(theta_i)

@@ -120,6 +120,14 @@ def _normals(z):
     return np.stack([z[0] * inv, z[1] * inv, inv])[:, None, :]
 
 
+def _check_seed(name, s):
+    if isinstance(s, (bool, np.bool_)) or not (
+        isinstance(s, np.random.Generator) or (isinstance(s, (int, np.integer)) and s >= 0)
+    ):
+        raise ValueError(f"{name} must be an integer >= 0 or a numpy.random.Generator; got {s!r}")
+    return s
+
+
 @dataclass(frozen=True)
 class RoughDiffuseBRDF(Model):
     """Monte Carlo: volume scattering (single, Eq. 7, and totally diffuse, Eq. 21) beneath a
@@ -177,7 +185,7 @@ class RoughDiffuseBRDF(Model):
     phase: HenyeyGreenstein = param(HenyeyGreenstein(0.3), "single-scattering phase function", kind="object")
     rho: float = param(0.05, "diffuse reflectance of the material under the interface", low=0.0, high=1.0)
     pairs: int = param(5000, "facet pairs per geometry", kind="int", low=2, high=10**7)
-    seed: object = param(0, "seed (int >= 0) or numpy.random.Generator", kind="object")
+    seed: object = param(0, "seed (int >= 0) or numpy.random.Generator", kind="object", check=_check_seed)
     surface: bool = param(
         True, "add the exposed surface's facet reflection", kind="choice", choices=(True, False)
     )
@@ -213,13 +221,8 @@ class RoughDiffuseBRDF(Model):
             )
         if not isinstance(self.phase, HenyeyGreenstein):
             raise ValueError(f"phase must be a models.HenyeyGreenstein; got {self.phase!r}")
-        s = self.seed
-        if isinstance(s, (bool, np.bool_)) or not (
-            isinstance(s, np.random.Generator) or (isinstance(s, (int, np.integer)) and s >= 0)
-        ):
-            raise ValueError(f"seed must be an integer >= 0 or a numpy.random.Generator; got {s!r}")
         # Draw the facet pairs now: a Generator passed in is consumed once, here.
-        rng = np.random.default_rng(s)
+        rng = np.random.default_rng(self.seed)
         z1 = self.slopes.sample(self.pairs, rng)
         z2 = self.slopes.sample(self.pairs, rng)
         object.__setattr__(self, "_z1", np.stack(z1))

@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .cook_torrance import _INV_4PI, _CookTorranceBase, _grazing_safe, ct_kernel, fresnel_average
-from .params import Alias, convention_param, param
+from .params import Alias, check_real, convention_param, param
 from .slopes import GaussianSlopes
 from .stroke_slopes import StrokeSlopes
 
@@ -83,8 +83,15 @@ def _convention_from_old(given, current):
 
 
 def _slopes_from_strokes(given, current):
-    """The old ``m_parallel`` / ``m_perpendicular`` / ``stroke_angle`` keywords, completed
-    from the current slopes, as a :class:`models.StrokeSlopes`."""
+    """The old ``m_parallel`` / ``m_perpendicular`` / ``stroke_angle`` keywords (or ``m`` for
+    both ``m`` values, as :class:`CookTorranceBRDF`'s), completed from the current slopes, as a
+    :class:`models.StrokeSlopes`."""
+    given = dict(given)
+    if "m" in given:
+        if "m_parallel" in given or "m_perpendicular" in given:
+            raise ValueError("m: give either m or m_parallel and m_perpendicular, not both")
+        m = check_real("m", given.pop("m"), 0.0, low_open=True)
+        given.update(m_parallel=m, m_perpendicular=m)
     if isinstance(current, GaussianSlopes):
         current = StrokeSlopes(m_parallel=current.sigma, m_perpendicular=current.sigma)
     return current.replace(**given)
@@ -103,7 +110,8 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
         Brushed roughness of Eq. 19 (:class:`models.StrokeSlopes`: the paper's
         ``m_parallel``, ``m_perpendicular`` and the strokes' azimuth); equal ``m``
         values, or ``GaussianSlopes(sigma=m)``, give isotropic Cook-Torrance roughness
-        ``m``.  Old keywords ``m_parallel``, ``m_perpendicular``, ``stroke_angle``.
+        ``m``.  Old keywords ``m_parallel``, ``m_perpendicular``, ``stroke_angle`` (and ``m``
+        for both ``m`` values, as :class:`CookTorranceBRDF`'s).
     coating : float
         Real varnish index ``n_v >= 1`` (``1``: :class:`CookTorranceBRDF`).  Old name
         ``varnish``.
@@ -131,6 +139,7 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
 
     aliases = {
         "varnish": "coating",
+        "m": Alias("slopes", _slopes_from_strokes),
         "m_parallel": Alias("slopes", _slopes_from_strokes),
         "m_perpendicular": Alias("slopes", _slopes_from_strokes),
         "stroke_angle": Alias("slopes", _slopes_from_strokes),

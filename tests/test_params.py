@@ -136,7 +136,7 @@ def test_old_names_are_listed_read_and_named_in_errors():
     info = {p.name: p for p in models.VarnishedCookTorranceBRDF.parameters()}
     assert info["coating"].aliases == ("varnish",)
     assert info["convention"].aliases == ("normalization", "solid_angle")
-    assert info["slopes"].aliases == ("m_parallel", "m_perpendicular", "stroke_angle")
+    assert info["slopes"].aliases == ("m", "m_parallel", "m_perpendicular", "stroke_angle")
     assert "old name n" in models.SingleScatterBRDF.info()
     assert models.SingleScatterBRDF(coating=1.7).n == 1.7  # a plain rename reads as before
     with pytest.raises(AttributeError):
