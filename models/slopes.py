@@ -208,7 +208,25 @@ class GaussianSlopes(SlopeDistribution):
         return 12.0 * self.sigma
 
 
+@dataclass(frozen=True)
 class _Anisotropic(SlopeDistribution):
+    """Shared parameters of the anisotropic families: scales along axes rotated by ``rotation``."""
+
+    sigma_x: float = param(
+        0.1,
+        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    sigma_y: float = param(
+        0.1,
+        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
+    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
+
     isotropic = False
 
     def _local(self, zx, zy):
@@ -243,21 +261,6 @@ class AnisotropicExponentialSlopes(_Anisotropic):
     each axis the rms slope is ``sigma_x / sqrt(2)``, ``sigma_y / sqrt(2)``.
     """
 
-    sigma_x: float = param(
-        0.1,
-        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
-        low=0.0,
-        low_open=True,
-    )
-    sigma_y: float = param(
-        0.1,
-        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
-        low=0.0,
-        low_open=True,
-    )
-    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
-
     def _p3_unit(self, zx, zy):
         u, v = self._local(zx, zy)
         r = np.sqrt((u / self.sigma_x) ** 2 + (v / self.sigma_y) ** 2)
@@ -275,21 +278,6 @@ class AnisotropicGaussianSlopes(_Anisotropic):
     ``sigma_x / sqrt(2)``; ``sigma_x = sigma_y = m`` is :class:`GaussianSlopes`
     with ``sigma = m`` (the Cook-Torrance / Beckmann distribution).
     """
-
-    sigma_x: float = param(
-        0.1,
-        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
-        low=0.0,
-        low_open=True,
-    )
-    sigma_y: float = param(
-        0.1,
-        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
-        low=0.0,
-        low_open=True,
-    )
-    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _p3_unit(self, zx, zy):
         u, v = self._local(zx, zy)
