@@ -289,11 +289,21 @@ class AnisotropicGaussianSlopes(_Anisotropic):
         return GaussianSlopes(sigma=1.0)
 
 
+@dataclass(frozen=True)
 class _AngleDistribution(SlopeDistribution):
     """Distributions declared as ``P1^A`` (sampled on the actual flake area), as
     flakes are usually characterized.  ``P3^xy = C <sec> cos^4 P1^A`` (Eq. 41)
     with ``<sec> = 1 / <cos theta_n>_A``, both normalizations exact on the
     hemisphere of normals."""
+
+    sigma: float = param(
+        0.1,
+        "angular width (rad): the rms tilt in the small-angle limit",
+        low=0.0,
+        high=math.pi,
+        low_open=True,
+    )
+    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _shape(self, theta):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -340,15 +350,6 @@ class GaussianAngles(_AngleDistribution):
     approximation, so the two differ at large ``sigma``.)
     """
 
-    sigma: float = param(
-        0.1,
-        "angular width (rad): the rms tilt in the small-angle limit",
-        low=0.0,
-        high=math.pi,
-        low_open=True,
-    )
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
-
     def _shape(self, theta):
         return _exp_neg((np.asarray(theta) / self.sigma) ** 2)
 
@@ -357,15 +358,6 @@ class GaussianAngles(_AngleDistribution):
 class ExponentialAngles(_AngleDistribution):
     """Exponential distribution of flake tilt angles, ``P1^A ~ exp(-sqrt(6) theta_n / sigma)``
     (``sigma`` is the rms tilt in the small-angle limit), declared on the flake area."""
-
-    sigma: float = param(
-        0.1,
-        "angular width (rad): the rms tilt in the small-angle limit",
-        low=0.0,
-        high=math.pi,
-        low_open=True,
-    )
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _shape(self, theta):
         return _exp_neg(_SQRT6 * np.asarray(theta) / self.sigma)
