@@ -317,7 +317,8 @@ def section_seed001(ctx):
         text_block(
             "Eq. 7-8 as printed have no 1/pi in D and no 4 in the denominator: the published BRDF is 4 pi times "
             f"the energy-normalized one. Measured max |published / energy / (4 pi) - 1| = {ratio_err:.2e} over "
-            "20000 random geometries (CookTorranceBRDF m = 0.2 and an anisotropic varnished model). Albedos "
+            "20000 random geometries (CookTorranceBRDF m = 0.2 and an anisotropic varnished model, its refraction "
+            "Jacobian divided out). Albedos "
             "(hemispherical integral of M00 cos theta_r, tol 1e-3) of the iron plate model (m = 0.03, iron "
             "2.29+3.37i, Blinn shadowing):"
         )
