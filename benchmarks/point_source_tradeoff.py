@@ -41,7 +41,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer distances and resolutions")
     args = ap.parse_args(argv)
-    base = models.VarnishedCookTorranceBRDF(normalization="energy")
+    # energy normalization with Eq. 24's printed solid angle: the printed model over the exact 4 pi
+    base = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF()
     ti = math.radians(17.0)
     tr = np.radians(np.linspace(0, 40, 161))
     pr = np.radians(np.linspace(-10, 10, 41))

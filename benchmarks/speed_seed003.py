@@ -72,16 +72,16 @@ def main():
     )
     print("per-geometry Mueller cost over 10^6 geometries (best of 3):")
     for label, kind, m in (
-        ("DiffuseSubsurfaceBRDF", "diffuse", models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.93)),
+        ("DiffuseSubsurfaceBRDF", "diffuse", models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.93)),
         (
             "SingleScatterBRDF depolarizing",
             "single",
-            models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3, polarized=False)),
+            models.SingleScatterBRDF(coating=1.5, phase=models.HenyeyGreenstein(0.3, polarized=False)),
         ),
         (
             "SingleScatterBRDF polarized",
             "single",
-            models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3)),
+            models.SingleScatterBRDF(coating=1.5, phase=models.HenyeyGreenstein(0.3)),
         ),
     ):
         us = best_of(lambda m=m: m.mueller(*geo)) / n * 1e6

@@ -16,13 +16,13 @@ import models
 
 
 def test_cook_torrance_brdf_1e6(benchmark, geometries_1e6):
-    m = models.CookTorranceBRDF(m=0.03, substrate=2.29 + 3.37j)
+    m = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), substrate=2.29 + 3.37j)
     benchmark.pedantic(m.brdf, args=geometries_1e6, rounds=5, warmup_rounds=1)
     per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_varnished_brdf_1e6(benchmark, geometries_1e6):
-    m = models.VarnishedCookTorranceBRDF(m_parallel=0.03, m_perpendicular=0.1, stroke_angle=0.3)
+    m = models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.03, 0.1, 0.3))
     benchmark.pedantic(m.brdf, args=geometries_1e6, rounds=5, warmup_rounds=1)
     per_geometry(benchmark, geometries_1e6[0].size)
 
@@ -34,7 +34,7 @@ def test_varnished_isotropic_brdf_1e6(benchmark, geometries_1e6):
 
 
 def test_cook_torrance_mueller_1e6(benchmark, geometries_1e6):
-    m = models.CookTorranceBRDF(m=0.03, substrate=2.29 + 3.37j)
+    m = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), substrate=2.29 + 3.37j)
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
     per_geometry(benchmark, geometries_1e6[0].size)
 

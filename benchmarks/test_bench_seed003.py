@@ -16,19 +16,19 @@ import models
 
 
 def test_diffuse_subsurface_mueller_1e6(benchmark, geometries_1e6):
-    m = models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.93)
+    m = models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.93)
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
     per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_single_scatter_depolarizing_mueller_1e6(benchmark, geometries_1e6):
-    m = models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3, polarized=False))
+    m = models.SingleScatterBRDF(coating=1.5, phase=models.HenyeyGreenstein(0.3, polarized=False))
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
     per_geometry(benchmark, geometries_1e6[0].size)
 
 
 def test_single_scatter_polarized_mueller_1e6(benchmark, geometries_1e6):
-    m = models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3, polarized=True))
+    m = models.SingleScatterBRDF(coating=1.5, phase=models.HenyeyGreenstein(0.3, polarized=True))
     benchmark.pedantic(m.mueller, args=geometries_1e6, rounds=3, warmup_rounds=1)
     per_geometry(benchmark, geometries_1e6[0].size)
 
@@ -43,7 +43,7 @@ def in_plane_curve():
 def test_rough_diffuse_curve_181x5000(benchmark):
     m = models.RoughDiffuseBRDF(
         slopes=models.ExponentialSlopes(2.0),
-        n=1.5,
+        coating=1.5,
         phase=models.HenyeyGreenstein(0.3),
         rho=0.05,
         pairs=5000,

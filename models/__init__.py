@@ -4,8 +4,26 @@ rough and diffuse surfaces (seeds 000, 001, 003; conventions in DESIGN.md).
 Angles are radians; results broadcast and have shape ``broadcast + (4, 4)``.
 """
 
+# isort: off
+# Model.registry lists the model classes in the order they are defined, which is the
+# order of these imports: seed 000, seed 001, seed 003, then the detector aperture.
 from .base import CHUNK, Model, Sum
 from .facet import FacetBRDF
+from .subsurface_facet import SubsurfaceFacetBRDF
+from .cook_torrance import CookTorranceBRDF, fresnel_real
+from .point_source import PointSourceBRDF, point_source_geometry
+from .stroke_slopes import StrokeSlopes
+from .varnished import VarnishedCookTorranceBRDF
+from .diffuse_subsurface import DiffuseSubsurfaceBRDF
+from .facet_btdf import FacetBTDF
+from .phase import HenyeyGreenstein
+from .single_scatter import SingleScatterBRDF
+from .rough_diffuse import RoughDiffuseBRDF
+from .combination import mueller_with_error
+from .maxwell_beard import MaxwellBeardBRDF
+from .aperture import DetectorAperture
+
+# isort: on
 from .fresnel import fresnel_coefficients, fresnel_reflectance, fresnel_transmittance
 from .params import ParamInfo
 from .polarization import (
@@ -25,8 +43,8 @@ from .slopes import (
     GaussianSlopes,
     SlopeDistribution,
     TabulatedSlopes,
+    UnitSlopes,
 )
-from .subsurface_facet import SubsurfaceFacetBRDF
 
 __all__ = [
     "CHUNK",
@@ -43,6 +61,7 @@ __all__ = [
     "GaussianAngles",
     "ExponentialAngles",
     "TabulatedSlopes",
+    "UnitSlopes",
     "fresnel_coefficients",
     "fresnel_reflectance",
     "fresnel_transmittance",
@@ -52,44 +71,24 @@ __all__ = [
     "reciprocal_jones",
     "reciprocal_mueller",
     "stokes",
+    "CookTorranceBRDF",
+    "VarnishedCookTorranceBRDF",
+    "StrokeSlopes",
+    "PointSourceBRDF",
+    "point_source_geometry",
+    "fresnel_real",
+    "HenyeyGreenstein",
+    "SingleScatterBRDF",
+    "DiffuseSubsurfaceBRDF",
+    "FacetBTDF",
+    "RoughDiffuseBRDF",
+    "mueller_with_error",
+    "MaxwellBeardBRDF",
+    "DetectorAperture",
+    "list_models",
 ]
 
 
 def list_models():
     """Names and parameter listings of every model class (like SCATMECH's model lists)."""
     return "\n\n".join(c.info() for c in Model.registry)
-
-
-# --- issue 4 (seed 001: varnished metal) -------------------------------------------
-from .cook_torrance import CookTorranceBRDF, fresnel_real  # noqa: E402
-from .point_source import PointSourceBRDF  # noqa: E402
-from .stroke_slopes import StrokeSlopes  # noqa: E402
-from .varnished import VarnishedCookTorranceBRDF  # noqa: E402
-
-__all__ += [
-    "CookTorranceBRDF",
-    "VarnishedCookTorranceBRDF",
-    "StrokeSlopes",
-    "PointSourceBRDF",
-    "fresnel_real",
-]
-
-# --- issue 3: seed 003 diffuse-paint models -------------------------------------------
-from .diffuse_subsurface import DiffuseSubsurfaceBRDF  # noqa: E402
-from .facet_btdf import FacetBTDF  # noqa: E402
-from .phase import HenyeyGreenstein  # noqa: E402
-from .single_scatter import SingleScatterBRDF  # noqa: E402
-
-__all__ += ["HenyeyGreenstein", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF", "FacetBTDF"]
-from .rough_diffuse import RoughDiffuseBRDF  # noqa: E402
-
-__all__ += ["RoughDiffuseBRDF"]
-from .combination import mueller_with_error  # noqa: E402
-
-__all__ += ["mueller_with_error"]
-from .maxwell_beard import MaxwellBeardBRDF  # noqa: E402
-
-__all__ += ["MaxwellBeardBRDF"]
-from .aperture import DetectorAperture  # noqa: E402
-
-__all__ += ["DetectorAperture"]

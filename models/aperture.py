@@ -32,6 +32,7 @@ aperture is on the detector only).  ``aperture = 0`` is the model itself.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -63,7 +64,7 @@ class DetectorAperture(_Wrapper):
         Radial quadrature nodes over the cone (azimuthal nodes: twice as many).
     """
 
-    model: Model = param(None, "the model seen through the aperture", kind="object")
+    model: Model = param(dataclasses.MISSING, "the model seen through the aperture", kind="object")
     aperture: float = param(
         math.radians(0.7), "full cone angle of the detector (rad)", low=0.0, high=0.5 * math.pi
     )

@@ -207,7 +207,9 @@ class Model(Declared):
         head = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else cls.__name__
         lines = [f"{cls.__name__}: {head}"]
         for p in cls.parameters():
-            lines.append(f"    {p.name:<12} default={p.default!r:<14} {p.doc} ({p.range_text()})")
+            old = f"; old name{'s' if len(p.aliases) > 1 else ''} {', '.join(p.aliases)}" if p.aliases else ""
+            default = f"{'(required)':<22}" if p.required else f"default={p.default!r:<14}"
+            lines.append(f"    {p.name:<12} {default} {p.doc} ({p.range_text()}{old})")
         return "\n".join(lines)
 
 

@@ -8,17 +8,23 @@
 with ``H`` the bisector of the light and view directions (Eq. 5), ``alpha`` the
 angle between ``H`` and the mean normal and ``cos psi' = L . H``.
 
-Normalization.  As printed, Eq. 8 has no ``1/pi`` and Eq. 7 no factor 4 in the
+Normalization (``convention``).  As printed, Eq. 8 has no ``1/pi`` and Eq. 7 no factor 4 in the
 denominator.  The normalized microfacet BRDF (Torrance-Sparrow / Walter et al.)
 is ``D F G / (4 pi m^2 ...)``-i.e. Eq. 7 divided by ``4 pi``: its ``D/pi`` is
 the Beckmann density of facet normals per projected area
 (``int D/pi cos alpha dOmega = 1``) and the ``1/4`` is the Jacobian
 ``dOmega_h / dOmega_r = 1 / (4 cos psi')`` times the ``cos psi'`` projected facet
-area.  ``normalization="published"`` keeps the printed form (it is ``4 pi``
+area.  ``convention="paper"`` keeps the printed form (it is ``4 pi``
 times the normalized BRDF and its albedo exceeds 1 -- a property of the paper);
-``"energy"`` is the normalized form, which equals the M00 of
+``"corrected"`` is the normalized form, which equals the M00 of
 :class:`models.FacetBRDF` with ``GaussianSlopes(sigma=m)`` when there is no
 shadowing.
+
+Roughness (``slopes``).  Eq. 8's ``m`` is the ``sigma`` of
+:class:`models.GaussianSlopes`: ``D / pi = exp(-tan^2 alpha / m^2) / (pi m^2 cos^4
+alpha)`` is Beckmann's density of facet normals, and ``cos^4 alpha D / pi`` is the
+Gaussian slope density ``P3(zeta) = exp(-(zeta/m)^2) / (pi m^2)`` at ``zeta = tan
+alpha`` (``<zeta^2> = m^2``).  :class:`models.StrokeSlopes` gives Eq. 19's brushed D.
 
 Fresnel.  ``F`` is computed with the real-valued form Eq. 13-16
 (:func:`fresnel_real`), tested equal to the complex Born & Wolf form
@@ -38,8 +44,9 @@ import numpy as np
 
 from .base import Model
 from .fresnel import fresnel_reflectance
-from .params import param
-from .stroke_slopes import stroke_d
+from .params import Alias, check_real, choice_alias, convention_param, param
+from .slopes import GaussianSlopes
+from .stroke_slopes import StrokeSlopes, stroke_d
 
 __all__ = [
     "CookTorranceBRDF",
@@ -170,10 +177,40 @@ def ct_kernel(ci, cr, cp, sp, d_fn, index, shadowing):
     return val
 
 
+def _slopes_from_m(given, current):
+    """The old ``m=`` keyword: Eq. 8's rms slope, ``GaussianSlopes(sigma=m)``."""
+    return GaussianSlopes(sigma=check_real("m", given["m"], 0.0, low_open=True))
+
+
 class _CookTorranceBase(Model):
-    """Shared parts of the scalar Cook-Torrance models (depolarizing, M00 only)."""
+    """Shared parts of the scalar Cook-Torrance models (depolarizing, M00 only): the
+    roughness is a declared ``slopes`` (:class:`models.GaussianSlopes`, Eq. 8, or
+    :class:`models.StrokeSlopes`, Eq. 19), whose density D is evaluated by
+    :func:`models.stroke_slopes.stroke_d`."""
 
     depolarizing = True
+
+    def _validate(self):
+        s = self.slopes
+        if not isinstance(s, (GaussianSlopes, StrokeSlopes)) or s.coverage != 1.0:
+            raise ValueError(
+                "slopes must be models.GaussianSlopes(sigma=m) (Eq. 8) or models.StrokeSlopes (Eq. 19), "
+                f"with coverage 1; got {s!r}"
+            )
+
+    def _d_fn(self):
+        s = self.slopes
+        if isinstance(s, GaussianSlopes):
+            return stroke_d(s.sigma, s.sigma, 0.0)
+        return stroke_d(s.m_parallel, s.m_perpendicular, s.stroke_angle)
+
+    @property
+    def mirror_symmetric(self) -> bool:
+        s = self.slopes
+        return s.isotropic or math.sin(2.0 * s.stroke_angle) == 0.0
+
+    def rotated(self, angle):
+        return self._rotated_slopes(angle)
 
     def _brdf_flat(self, ti, tr, pr):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -200,44 +237,47 @@ class CookTorranceBRDF(_CookTorranceBase):
 
     Parameters
     ----------
-    m : float
-        rms facet slope (Eq. 3, 8); the Beckmann ``alpha`` and the ``sigma`` of
-        :class:`models.GaussianSlopes`.
+    slopes : GaussianSlopes or StrokeSlopes
+        Facet slopes of D: ``GaussianSlopes(sigma=m)`` is Eq. 8 with rms slope ``m``
+        (Beckmann's ``alpha``), :class:`models.StrokeSlopes` Eq. 19's brushed
+        roughness.  Old keyword ``m=`` (a number: ``GaussianSlopes(sigma=m)``).
     substrate : complex or math.inf
         Metal index ``n + ik`` relative to the ambient (Eq. 10); ``inf``: ``F = 1``.
-    normalization : "published" | "energy"
-        ``published``: Eq. 7-8 as printed (no ``1/pi`` in D, no 4 in the
-        denominator; ``4 pi`` times the normalized BRDF, albedo > 1).
-        ``energy``: divided by ``4 pi``, the normalized microfacet BRDF.
+    convention : "paper" | "corrected"
+        ``paper``: Eq. 7-8 as printed (no ``1/pi`` in D, no 4 in the denominator;
+        ``4 pi`` times the normalized BRDF, albedo > 1).  ``corrected``: divided by
+        ``4 pi``, the normalized microfacet BRDF.  Either way F is the corrected
+        Eq. 13-16 (the complex Fresnel reflectance; see :func:`fresnel_real`).
+        Old keyword ``normalization`` (``"published"``, ``"energy"``).
     shadowing : "blinn" | "none"
         Eq. 18 (Blinn's V-groove ``G``) or ``G = 1``.
     """
 
-    m: float = param(0.03, "rms facet slope m (Eq. 8)", low=0.0, low_open=True)
-    substrate: complex = param(2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", kind="index")
-    normalization: str = param(
-        "published", "Eq. 7-8 as printed or energy-normalized", kind="choice", choices=("published", "energy")
+    slopes: GaussianSlopes | StrokeSlopes = param(
+        GaussianSlopes(0.03),
+        "facet slopes of D: GaussianSlopes(sigma=m) (Eq. 8) or StrokeSlopes",
+        kind="object",
     )
+    substrate: complex = param(2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", kind="index")
+    convention: str = convention_param("Eq. 7-8 as printed (paper) or divided by 4 pi (corrected)")
     shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=("blinn", "none"))
+
+    aliases = {
+        "m": Alias("slopes", _slopes_from_m),
+        "normalization": choice_alias(
+            "convention", "normalization", {"published": "paper", "energy": "corrected"}
+        ),
+    }
 
     def _brdf_flat(self, ti, tr, pr):
         ci, cr, live = _grazing_safe(ti, tr)
-        val = ct_kernel(
-            ci, cr, np.cos(pr), np.sin(pr), stroke_d(self.m, self.m, 0.0), self.substrate, self.shadowing
-        )
-        scale = _INV_4PI if self.normalization == "energy" else 1.0
+        val = ct_kernel(ci, cr, np.cos(pr), np.sin(pr), self._d_fn(), self.substrate, self.shadowing)
+        scale = _INV_4PI if self.convention == "corrected" else 1.0
         val *= scale / (ci * cr)
         if live is not None:
             val[~live] = 0.0
         return val
 
-    @property
-    def slopes(self):
-        """The facet slope density D describes: Beckmann (Gaussian slopes) with rms ``m``."""
-        from .slopes import GaussianSlopes
-
-        return GaussianSlopes(sigma=self.m)
-
     def lobe(self, theta_i):
         """Specular lobe: centre ``(theta_i, 0)``, width ``~ 2 m`` in theta_r."""
-        return (theta_i, 0.0, 2.0 * self.m)
+        return (theta_i, 0.0, 2.0 * self.slopes.scale)

@@ -1,7 +1,8 @@
 """Totally diffuse scattering beneath a smooth interface (seed 003 Sec. 2.3, Eq. 21-28).
 
 A Lambertian, totally depolarizing reflector of reflectance ``rho`` sits under
-a smooth interface of real index ``n``; light diffusely reflected back by the
+a smooth interface of real index ``n`` (the ``coating``: the binder above the
+diffuser); light diffusely reflected back by the
 interface's underside returns to the diffuser (Eq. 23, geometric series with
 the internal hemispherical reflectance ``R-bar``).  The Mueller BRDF (Eq. 27-28)
 is
@@ -39,21 +40,28 @@ class DiffuseSubsurfaceBRDF(Model):
 
     Parameters
     ----------
-    n : float
-        Real index of the medium above the diffuser (``n = 1``: bare Lambertian).
+    coating : float
+        Real index ``n`` of the binder above the diffuser, the medium light enters through
+        the smooth interface (``1``: a bare Lambertian).  Old name ``n``.
     rho : float
         Diffuse reflectance of the underlying material, in [0, 1].
     """
 
-    n: float = param(1.5, "index of the medium (real, non-absorbing)", kind="real_index", low=1.0)
+    coating: float = param(
+        1.5,
+        "index n of the binder above the diffuser, entered through the smooth interface (real)",
+        kind="real_index",
+        low=1.0,
+    )
     rho: float = param(0.93, "diffuse reflectance of the material under the interface", low=0.0, high=1.0)
 
     depolarizing = True
+    aliases = {"n": "coating"}
 
     @cached_property
     def rbar(self) -> float:
         """Internal hemispherical reflectance ``R-bar`` (Eq. 22 with 1/pi)."""
-        return internal_hemispherical_reflectance(self.n)
+        return internal_hemispherical_reflectance(self.coating)
 
     @cached_property
     def _scale(self) -> float:
@@ -61,7 +69,7 @@ class DiffuseSubsurfaceBRDF(Model):
 
     def _amps(self, ti, tr):
         """Interface amplitudes ``(a_s, a_p)``, rows incidence then scattering."""
-        _, _, a_s, a_p = interface_amplitudes(np.cos(np.stack([ti, tr])), self.n)
+        _, _, a_s, a_p = interface_amplitudes(np.cos(np.stack([ti, tr])), self.coating)
         return a_s, a_p
 
     def _mueller16(self, ti, tr, pr):

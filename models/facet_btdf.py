@@ -46,7 +46,7 @@ import numpy as np
 
 from .base import Model
 from .geometry import sp_basis
-from .params import param
+from .params import choice_alias, convention_param, param
 from .polarization import mueller16_from_jones
 from .slopes import GaussianSlopes, SlopeDistribution
 
@@ -162,22 +162,27 @@ class FacetBTDF(Model):
         Facet slope distribution ``P3^xy``.
     substrate : float
         Real index ``n > 1`` of the substrate.
-    normalization : str
-        ``"paper"``: Eq. 37, the slope distribution seen by the incident ray
-        normalized by ``cos(theta_i)`` (assumes ``<cos i_t> ~ cos theta_i``;
-        SCATMECH's choice).  Its integrated transmittance exceeds 1 for wide
-        distributions at oblique incidence (``validate`` reports it).
-        ``"exact"``: Eq. 36 normalized exactly, by ``N = <(cos theta_i -
-        k_xy . zeta)_+>`` (:func:`projected_area`): every incident ray meets
-        one facet, and reflection plus transmission integrate to 1.
+    convention : "paper" | "corrected"
+        ``"paper"``: Eq. 37 as printed, the slope distribution seen by the incident ray
+        normalized by ``cos(theta_i)`` (assumes ``<cos i_t> ~ cos theta_i``; SCATMECH's
+        choice).  Its integrated transmittance exceeds 1 for wide distributions at
+        oblique incidence (``validate`` reports it).  ``"corrected"``: Eq. 36
+        normalized exactly, by ``N = <(cos theta_i - k_xy . zeta)_+>``
+        (:func:`projected_area`): every incident ray meets one facet, and reflection
+        plus transmission integrate to 1.  Either way the printed slips listed in the
+        module docstring (Eq. 39, 41, 43) are corrected.  Old name ``normalization``
+        (``"paper"``, ``"exact"``).
     """
 
     slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", kind="object")
     substrate: float = param(1.5, "substrate index (real, > 1)", kind="real_index", low=1.0)
-    normalization: str = param(
-        "paper", "Eq. 37 (paper, SCATMECH) or exact Eq. 36", kind="choice", choices=("paper", "exact")
+    convention: str = convention_param(
+        "normalization of the slopes seen by the ray: Eq. 37 (paper, SCATMECH) or exact Eq. 36 (corrected)"
     )
 
+    aliases = {
+        "normalization": choice_alias("convention", "normalization", {"paper": "paper", "exact": "corrected"})
+    }
     transmission = True
     _angle_names = ("theta_i", "theta_t", "phi_t")
 
@@ -190,10 +195,10 @@ class FacetBTDF(Model):
             raise ValueError(
                 "substrate must be a real index > 1 (at n = 1 the interface vanishes and the BTDF is a delta)"
             )
-        if self.normalization == "exact" and not self.slopes.isotropic:
+        if self.convention == "corrected" and not self.slopes.isotropic:
             raise ValueError(
-                "normalization 'exact' needs isotropic slopes (its projected area is the isotropic "
-                f"average); got {self.slopes!r}; use normalization='paper'"
+                "convention 'corrected' needs isotropic slopes (its exact projected area is the isotropic "
+                f"average); got {self.slopes!r}; use convention='paper'"
             )
 
     def _parts(self, ti, tt, pt):
@@ -224,7 +229,7 @@ class FacetBTDF(Model):
         inv_cc = 1.0 / np.where(live, ci * ct, 1.0)
         # Eq. 43 (with cos t_t) and the Jacobian n^2 cos(iota_t)/D^2 (Eq. 39)
         S = p3 * n * c_out * inv_cc / mz_l**4 * (n * n * c_out / np.where(live, D2, 1.0))
-        if self.normalization == "exact":
+        if self.convention == "corrected":
             S = S * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))
         S = np.where(live, S, 0.0)
         root = np.sqrt(S)

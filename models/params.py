@@ -6,19 +6,29 @@ that fixes the allowed range.  ``Declared.__post_init__`` validates every field
 and raises a ``ValueError`` that names the parameter and its allowed range, so a
 bad value never reaches the physics.  ``Cls.parameters()`` lists the declared
 parameters the way SCATMECH's ``AskUser``/``ListParameters`` does.
+
+Old keyword names keep working through :class:`Alias` entries in a class's
+``aliases`` table (``aliases = {"n": "coating"}``): they are translated when the
+model is built or replaced (:meth:`Declared.replace`), listed by ``parameters()`` and
+``info()``, and, for plain renames, readable as attributes.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import numbers
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 __all__ = [
+    "Alias",
+    "choice_alias",
+    "convention_param",
     "Declared",
     "ParamInfo",
     "param",
@@ -41,6 +51,9 @@ class ParamInfo:
     high: float | None = None
     low_open: bool = False
     high_open: bool = False
+    aliases: tuple = ()  # old keyword names that still set this parameter
+    required: bool = False  # no default: must be given
+    check: Any = field(default=None, repr=False, compare=False)  # validator of an ``object`` parameter
 
     def range_text(self) -> str:
         if self.kind == "index":
@@ -69,12 +82,15 @@ def param(
     low_open: bool = False,
     high_open: bool = False,
     choices: tuple | None = None,
+    check: Callable | None = None,
 ):
     """Declare a model parameter (a dataclass field with validation metadata).
 
+    ``default`` may be ``dataclasses.MISSING``: the parameter is then required.
     ``kind`` is one of ``real``, ``int``, ``index`` (complex refractive index,
     ``k >= 0``, ``math.inf`` allowed), ``real_index`` (non-absorbing index
-    ``>= low``), ``choice`` (``choices``), ``object`` (checked by the model).
+    ``>= low``), ``choice`` (``choices``), ``object`` (checked by ``check(name, value)``,
+    which returns the value or raises ``ValueError``, or by the model's ``_validate``).
     """
     info = dict(
         doc=doc,
@@ -83,6 +99,7 @@ def param(
         high=high,
         low_open=low_open,
         high_open=high_open,
+        check=check,
     )
     if isinstance(default, (list, dict, np.ndarray)):
         return field(default_factory=lambda: default, metadata={"scatterbench": info})
@@ -168,65 +185,203 @@ def check_finite_array(name, value) -> np.ndarray:
     return a
 
 
-class Declared:
+@dataclass(frozen=True)
+class Alias:
+    """An old keyword name that still sets the declared parameter ``target``.
+
+    ``convert`` is None for a plain rename.  Otherwise it receives the old keywords
+    given (a dict; several old names may share one target and one ``convert``) and
+    the target's current value (its default at construction), and returns the
+    target's value, raising ``ValueError`` when the old values have no equivalent.
+    """
+
+    target: str
+    convert: Callable[[dict, Any], Any] | None = None
+
+
+def choice_alias(target: str, old: str, mapping: dict) -> Alias:
+    """An :class:`Alias` for an old ``choice`` keyword whose values map one to one onto
+    ``target``'s (e.g. ``normalization="exact"`` -> ``convention="corrected"``)."""
+
+    def convert(given, current):
+        value = given[old]
+        if not isinstance(value, str) or value not in mapping:
+            allowed = ", ".join(repr(k) for k in mapping)
+            raise ValueError(f"{old} (old name of {target}) must be one of {allowed}; got {value!r}")
+        return mapping[value]
+
+    return Alias(target, convert)
+
+
+def convention_param(doc: str):
+    """The ``convention`` parameter of a model whose paper prints a form that is corrected here:
+    ``"paper"`` keeps the printed equations, ``"corrected"`` applies the corrections (the
+    model's docstring says exactly which)."""
+    return param("paper", doc, kind="choice", choices=("paper", "corrected"))
+
+
+class _DeclaredMeta(type):
+    """Translates old keyword names (``cls.aliases``) before the dataclass ``__init__``."""
+
+    def __call__(cls, *args, **kwargs):
+        renamed = {}
+        if cls.aliases:
+            kwargs, renamed = cls._resolve_aliases(kwargs, current=None)
+        if dataclasses.is_dataclass(cls):
+            for f in dataclasses.fields(cls)[len(args) :]:
+                if f.name not in kwargs and f.default is f.default_factory is dataclasses.MISSING:
+                    doc = f.metadata.get("scatterbench", {}).get("doc", "")
+                    raise ValueError(f"{f.name} is required ({doc}); it has no default")
+        with _naming_old(renamed):
+            return super().__call__(*args, **kwargs)
+
+
+@contextlib.contextmanager
+def _naming_old(renamed):
+    """A ValueError about a parameter that was given by an old name also names the old name."""
+    try:
+        yield
+    except ValueError as exc:
+        for target, old in renamed.items():
+            if str(exc).startswith(f"{target} "):
+                raise ValueError(f"{old} (old name of {target}): {exc}") from exc
+        raise
+
+
+class Declared(metaclass=_DeclaredMeta):
     """Mixin for frozen dataclasses whose fields were declared with :func:`param`."""
+
+    #: old keyword name -> :class:`Alias` (or the new name, for a plain rename)
+    aliases: dict = {}
 
     def __post_init__(self):
         for f in dataclasses.fields(self):
             info = f.metadata.get("scatterbench")
-            if info is None:
-                continue
-            value = getattr(self, f.name)
-            kind = info["kind"]
-            if kind == "real":
-                v = check_real(f.name, value, info["low"], info["high"], info["low_open"], info["high_open"])
-            elif kind == "int":
-                if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-                    raise ValueError(f"{f.name} must be an integer; got {value!r}")
-                check_real(f.name, value, info["low"], info["high"], info["low_open"], info["high_open"])
-                v = int(value)
-            elif kind == "index":
-                v = check_index(f.name, value)
-            elif kind == "real_index":
-                z = value
-                if isinstance(z, numbers.Complex) and not isinstance(z, numbers.Real):
-                    if complex(z).imag != 0:
-                        raise ValueError(
-                            f"{f.name} must be a real (non-absorbing) index >= {info['low']:g}; got {value!r}"
-                        )
-                    z = complex(z).real
-                v = check_real(f.name, z, info["low"], None)
-            elif kind == "choice":
-                if value not in info["low"]:
-                    allowed = ", ".join(repr(c) for c in info["low"])
-                    raise ValueError(f"{f.name} must be one of {allowed}; got {value!r}")
-                v = value
-            else:
-                v = value
-            object.__setattr__(self, f.name, v)
+            if info is not None:
+                object.__setattr__(self, f.name, _checked(f.name, getattr(self, f.name), info))
         self._validate()
 
     def _validate(self):
         """Hook for cross-parameter checks in subclasses."""
 
     @classmethod
+    def check_parameter(cls, name: str, value):
+        """``value`` validated as the declared parameter ``name`` (a ``ValueError`` naming it
+        and its allowed range otherwise), without building an instance: for callers, such
+        as scene files, that hold a value for a model they build later."""
+        for f in dataclasses.fields(cls):
+            if f.name == name and "scatterbench" in f.metadata:
+                return _checked(name, value, f.metadata["scatterbench"])
+        raise ValueError(f"{name}: not a declared parameter of {cls.__name__}")
+
+    @classmethod
+    def _alias(cls, old) -> Alias:
+        a = cls.aliases[old]
+        return Alias(a) if isinstance(a, str) else a
+
+    @classmethod
+    def _resolve_aliases(cls, kwargs, current):
+        """``(kwargs, renamed)``: ``kwargs`` with old names replaced by the declared ones, and
+        ``{target: old names}`` of those given; ``current`` is the instance being replaced
+        (None at construction: the defaults)."""
+        groups = {}
+        for k, v in kwargs.items():
+            if k in cls.aliases:
+                groups.setdefault(cls._alias(k).target, {})[k] = v
+        if not groups:
+            return kwargs, {}
+        out = {k: v for k, v in kwargs.items() if k not in cls.aliases}
+        for target, given in groups.items():
+            if target in out:
+                raise ValueError(f"{', '.join(given)}: old name of {target}; give {target} alone")
+            convert = cls._alias(next(iter(given))).convert
+            if convert is None:
+                (value,) = given.values()
+            else:
+                value = convert(given, cls._current(target, current))
+            out[target] = value
+        return out, {target: ", ".join(given) for target, given in groups.items()}
+
+    @classmethod
+    def _current(cls, name, instance):
+        if instance is not None:
+            return getattr(instance, name)
+        f = {f.name: f for f in dataclasses.fields(cls)}[name]
+        return f.default if f.default is not dataclasses.MISSING else f.default_factory()
+
+    def __getattr__(self, name):
+        # Only reached when normal lookup fails: old names of plain renames read the new one.
+        a = type(self).aliases.get(name)
+        if isinstance(a, str) or (isinstance(a, Alias) and a.convert is None):
+            return getattr(self, a if isinstance(a, str) else a.target)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    @classmethod
     def parameters(cls) -> list[ParamInfo]:
-        """The declared parameters: name, default, description and allowed range."""
+        """The declared parameters: name, default, description, allowed range and old names."""
+        old = {}
+        for k in cls.aliases:
+            old.setdefault(cls._alias(k).target, []).append(k)
         out = []
         for f in dataclasses.fields(cls):
             info = f.metadata.get("scatterbench")
             if info is None:
                 continue
-            default = f.default if f.default is not dataclasses.MISSING else None
-            out.append(ParamInfo(name=f.name, default=default, **info))
+            required = f.default is dataclasses.MISSING
+            out.append(
+                ParamInfo(
+                    name=f.name,
+                    default=None if required else f.default,
+                    aliases=tuple(old.get(f.name, ())),
+                    required=required,
+                    **info,
+                )
+            )
         return out
 
     def replace(self, **changes):
-        """A copy with some parameters changed (validated again)."""
-        return dataclasses.replace(self, **changes)
+        """A copy with some parameters changed (validated again; old names accepted)."""
+        renamed = {}
+        if type(self).aliases:
+            changes, renamed = self._resolve_aliases(changes, current=self)
+        with _naming_old(renamed):
+            return dataclasses.replace(self, **changes)
 
     def describe(self) -> str:
         lines = [type(self).__name__]
         for p in self.parameters():
             lines.append(f"  {p.name} = {getattr(self, p.name)!r}  # {p.doc}; {p.range_text()}")
         return "\n".join(lines)
+
+
+def _checked(name, value, info):
+    """``value`` validated against a declared parameter's kind and range."""
+    kind = info["kind"]
+    if kind == "real":
+        return check_real(name, value, info["low"], info["high"], info["low_open"], info["high_open"])
+    if kind == "int":
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise ValueError(f"{name} must be an integer; got {value!r}")
+        check_real(name, value, info["low"], info["high"], info["low_open"], info["high_open"])
+        return int(value)
+    if kind == "index":
+        return check_index(name, value)
+    if kind == "real_index":
+        z = value
+        if isinstance(z, numbers.Complex) and not isinstance(z, numbers.Real):
+            if complex(z).imag != 0:
+                raise ValueError(
+                    f"{name} must be a real (non-absorbing) index >= {info['low']:g}; got {value!r}"
+                )
+            z = complex(z).real
+        return check_real(name, z, info["low"], None)
+    if kind == "choice":
+        choices = info["low"]
+        flags = all(isinstance(c, bool) for c in choices)
+        if value not in choices or (flags and not isinstance(value, (bool, np.bool_))):
+            allowed = ", ".join(repr(c) for c in choices)
+            raise ValueError(f"{name} must be one of {allowed}; got {value!r}")
+        return bool(value) if flags else value
+    if info.get("check") is not None:
+        return info["check"](name, value)
+    return value

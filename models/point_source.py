@@ -43,6 +43,7 @@ observer turns an extended source into an extended detector and vice versa.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -53,10 +54,33 @@ from .base import Model, _Wrapper
 from .geometry import disc_quadrature
 from .params import param
 
-__all__ = ["PointSourceBRDF"]
+__all__ = ["PointSourceBRDF", "point_source_geometry"]
 
 #: Inner-model geometries per block (bounds the temporaries of one block).
 _BLOCK = 1 << 16
+
+
+def point_source_geometry(lo_deg, hi_deg):
+    """``(psi_c, d / R)``: the central incidence (radians) and the source height in units
+    of the sample radius for which a disc sample spans incidences ``[lo_deg, hi_deg]``.
+
+    With ``x = d tan(psi)`` (Eq. 26) the disc spans ``x_c - R .. x_c + R``:
+    ``d / R = 2 / (tan hi - tan lo)`` and ``tan psi_c = (tan lo + tan hi) / 2``.
+    Seed 001 prints such ranges for its iron plate but no distance or sample size.
+    """
+    tl, th = math.tan(math.radians(lo_deg)), math.tan(math.radians(hi_deg))
+    return math.atan(0.5 * (tl + th)), 2.0 / (th - tl)
+
+
+def _check_distance(name, d):
+    ok = (
+        isinstance(d, (int, float))
+        and not isinstance(d, bool)
+        and (d == math.inf or (math.isfinite(d) and d > 0))
+    )
+    if not ok:
+        raise ValueError(f"{name} must be a finite real number > 0 or math.inf; got {d!r}")
+    return float(d)
 
 
 @dataclass(frozen=True)
@@ -82,25 +106,15 @@ class PointSourceBRDF(_Wrapper):
         Radial quadrature nodes over the disc (azimuthal nodes: twice as many).
     """
 
-    model: Model = param(None, "the collimated model", kind="object")
-    distance: float = param(100.0, "source height d above the sample plane (> 0, or inf)", kind="object")
+    model: Model = param(dataclasses.MISSING, "the collimated model", kind="object")
+    distance: float = param(
+        100.0, "source height d above the sample plane (> 0, or inf)", kind="object", check=_check_distance
+    )
     sample_radius: float = param(1.0, "sample radius R", low=0.0, low_open=True)
     method: str = param(
         "exact", "Eq. 28 superposition or Eq. 29-30 shift", kind="choice", choices=("exact", "shift")
     )
     resolution: int = param(16, "radial quadrature nodes over the disc", kind="int", low=1, high=4096)
-
-    def _validate(self):
-        super()._validate()
-        d = self.distance
-        ok = (
-            isinstance(d, (int, float))
-            and not isinstance(d, bool)
-            and (d == math.inf or (math.isfinite(d) and d > 0))
-        )
-        if not ok:
-            raise ValueError(f"distance must be a finite real number > 0 or math.inf; got {d!r}")
-        object.__setattr__(self, "distance", float(d))
 
     def lobe(self, theta_i):
         lb = self.model.lobe(theta_i)

@@ -46,7 +46,7 @@ inverse CDF (2048 midpoint quantiles; relative error < 1e-6).
 The mean over pairs is the estimate and ``std / sqrt(pairs)`` its standard
 error (:meth:`RoughDiffuseBRDF.mueller_with_error`).  With ``surface=True`` the
 direct reflection by the exposed rough surface (:class:`models.FacetBRDF`
-with substrate ``n``) is added (deterministic, zero error).  No shadowing, as
+with substrate ``n``, the coating's index) is added (deterministic, zero error).  No shadowing, as
 in the paper.
 """
 
@@ -61,7 +61,7 @@ import numpy as np
 from .base import Model
 from .facet import FacetBRDF
 from .facet_btdf import _dot, angle_basis, facet_transmission_jones, projected_area, ray_basis
-from .params import param
+from .params import choice_alias, convention_param, param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
 from .slopes import ExponentialSlopes, SlopeDistribution
@@ -120,6 +120,14 @@ def _normals(z):
     return np.stack([z[0] * inv, z[1] * inv, inv])[:, None, :]
 
 
+def _check_seed(name, s):
+    if isinstance(s, (bool, np.bool_)) or not (
+        isinstance(s, np.random.Generator) or (isinstance(s, (int, np.integer)) and s >= 0)
+    ):
+        raise ValueError(f"{name} must be an integer >= 0 or a numpy.random.Generator; got {s!r}")
+    return s
+
+
 @dataclass(frozen=True)
 class RoughDiffuseBRDF(Model):
     """Monte Carlo: volume scattering (single, Eq. 7, and totally diffuse, Eq. 21) beneath a
@@ -129,8 +137,9 @@ class RoughDiffuseBRDF(Model):
     ----------
     slopes : SlopeDistribution
         Isotropic facet slope distribution of the interface.
-    n : float
-        Real index of the binder.
+    coating : float
+        Real index ``n`` of the binder around the scatterers, the medium light enters
+        through the rough interface.  Old name ``n``.
     phase : HenyeyGreenstein
         Single-scattering phase function.
     rho : float
@@ -149,26 +158,34 @@ class RoughDiffuseBRDF(Model):
         model's own exit facets (then the diffuse term alone conserves energy:
         ``rho = 1`` returns everything that entered).  ``"flat"``: Sec. 2.3's flat R-bar
         (what Eq. 21 + 23 say literally; then light is gained under rough interfaces).
-    surface_normalization : str
-        ``"paper"``: the surface term is :class:`models.FacetBRDF` (Eq. 37-style
-        ``1/cos(theta_i)`` normalization, as the paper and SCATMECH); ``"exact"``:
-        scaled by ``cos(theta_i) / N(theta_i)`` to the exact Eq. 36 normalization that
-        the volume terms use (energy then stays <= 1 for wide slopes at grazing), at
-        the price of reciprocity: without shadowing, ``1/N(theta_i)`` is not symmetric
-        in the two directions (``reciprocal`` is then False).  The volume terms are
-        reciprocal either way: their weight ``w_i w_r / (N(theta_i) N(theta_r))`` is
-        symmetric, and with the exact normalization each incident ray, and each line
-        of sight of the detector, meets exactly one facet.
+        Not part of ``convention``: the default is the rough R-bar, and joining the two
+        would change what a model built with defaults computes.
+    convention : "paper" | "corrected"
+        The surface term.  ``"paper"``: :class:`models.FacetBRDF` as printed, with
+        Eq. 37's ``1/cos(theta_i)`` normalization of the slopes seen by the incident ray
+        (as SCATMECH).  ``"corrected"``: scaled by ``cos(theta_i) / N(theta_i)`` to the
+        exact Eq. 36 normalization that the volume terms use (energy then stays <= 1 for
+        wide slopes at grazing), at the price of reciprocity: without shadowing,
+        ``1/N(theta_i)`` is not symmetric in the two directions (``reciprocal`` is then
+        False).  The volume terms are reciprocal either way: their weight ``w_i w_r /
+        (N(theta_i) N(theta_r))`` is symmetric, and with the exact normalization each
+        incident ray, and each line of sight of the detector, meets exactly one facet.
+        Old name ``surface_normalization`` (``"paper"``, ``"exact"``).
     """
 
     slopes: SlopeDistribution = param(
-        ExponentialSlopes(2.0), "isotropic facet slope distribution", kind="object"
+        ExponentialSlopes(2.0), "isotropic facet slope distribution of the interface", kind="object"
     )
-    n: float = param(1.5, "index of the binder (real)", kind="real_index", low=1.0)
+    coating: float = param(
+        1.5,
+        "index n of the binder around the scatterers, entered through the rough interface (real)",
+        kind="real_index",
+        low=1.0,
+    )
     phase: HenyeyGreenstein = param(HenyeyGreenstein(0.3), "single-scattering phase function", kind="object")
-    rho: float = param(0.05, "diffuse reflectance of the material", low=0.0, high=1.0)
+    rho: float = param(0.05, "diffuse reflectance of the material under the interface", low=0.0, high=1.0)
     pairs: int = param(5000, "facet pairs per geometry", kind="int", low=2, high=10**7)
-    seed: object = param(0, "seed (int >= 0) or numpy.random.Generator", kind="object")
+    seed: object = param(0, "seed (int >= 0) or numpy.random.Generator", kind="object", check=_check_seed)
     surface: bool = param(
         True, "add the exposed surface's facet reflection", kind="choice", choices=(True, False)
     )
@@ -179,18 +196,21 @@ class RoughDiffuseBRDF(Model):
         kind="choice",
         choices=("rough", "flat"),
     )
-    surface_normalization: str = param(
-        "paper",
-        "surface term: FacetBRDF as printed (Eq. 37) or exact Eq. 36",
-        kind="choice",
-        choices=("paper", "exact"),
+    convention: str = convention_param(
+        "surface term: FacetBRDF with Eq. 37's normalization (paper) or exact Eq. 36 (corrected)"
     )
 
+    aliases = {
+        "n": "coating",
+        "surface_normalization": choice_alias(
+            "convention", "surface_normalization", {"paper": "paper", "exact": "corrected"}
+        ),
+    }
     depolarizing = True
 
     @property
     def reciprocal(self):  # type: ignore[override]
-        return not (self.surface and self.surface_normalization == "exact")
+        return not (self.surface and self.convention == "corrected")
 
     def _validate(self):
         if not isinstance(self.slopes, SlopeDistribution) or not self.slopes.isotropic:
@@ -201,13 +221,8 @@ class RoughDiffuseBRDF(Model):
             )
         if not isinstance(self.phase, HenyeyGreenstein):
             raise ValueError(f"phase must be a models.HenyeyGreenstein; got {self.phase!r}")
-        s = self.seed
-        if isinstance(s, (bool, np.bool_)) or not (
-            isinstance(s, np.random.Generator) or (isinstance(s, (int, np.integer)) and s >= 0)
-        ):
-            raise ValueError(f"seed must be an integer >= 0 or a numpy.random.Generator; got {s!r}")
         # Draw the facet pairs now: a Generator passed in is consumed once, here.
-        rng = np.random.default_rng(s)
+        rng = np.random.default_rng(self.seed)
         z1 = self.slopes.sample(self.pairs, rng)
         z2 = self.slopes.sample(self.pairs, rng)
         object.__setattr__(self, "_z1", np.stack(z1))
@@ -216,12 +231,12 @@ class RoughDiffuseBRDF(Model):
     @cached_property
     def _rbar(self):
         if self.feedback == "flat" or self.rho == 0.0:
-            return internal_hemispherical_reflectance(self.n)
+            return internal_hemispherical_reflectance(self.coating)
         return self._rough_rbar()
 
     def _exit_transmittance(self, tr, pr):
         """``<w_r M_out[0, 0]>`` over the exit facets, ``(g,)`` for flat ``tr``, ``pr``."""
-        n = self.n
+        n = self.coating
         z2 = self._z2
         cr, sr = np.cos(tr)[:, None], np.sin(tr)[:, None]
         cp, sp = np.cos(pr)[:, None], np.sin(pr)[:, None]
@@ -253,16 +268,16 @@ class RoughDiffuseBRDF(Model):
             [self._exit_transmittance(tr[k : k + per], pr[k : k + per]) for k in range(0, tr.size, per)]
         )
         total = np.sum(t.reshape(U.shape) * (wu * u)[:, None]) * (2.0 * math.pi / n_phi)
-        return 1.0 - total / (math.pi * self.n * self.n)
+        return 1.0 - total / (math.pi * self.coating * self.coating)
 
     @cached_property
     def _surface_model(self):
-        return FacetBRDF(slopes=self.slopes, substrate=self.n)
+        return FacetBRDF(slopes=self.slopes, substrate=self.coating)
 
     # ------------------------------------------------------------------ one block
     def _block(self, ti, tr, pr, z1, z2):
         """Per-pair Mueller estimates ``(16, g, p)`` for geometries ``(g,)`` and pairs ``(p,)``."""
-        n = self.n
+        n = self.coating
         g, p = ti.size, z1.shape[1]
         ci, si = np.cos(ti)[:, None], np.sin(ti)[:, None]
         cr, sr = np.cos(tr)[:, None], np.sin(tr)[:, None]
@@ -358,7 +373,7 @@ class RoughDiffuseBRDF(Model):
 
     def _surface16(self, ti, tr, pr):
         out = self._surface_model._mueller16(ti, tr, pr)
-        if self.surface_normalization == "exact":
+        if self.convention == "corrected":
             ci = np.cos(ti)
             out = out * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))
         return out

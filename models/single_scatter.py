@@ -1,6 +1,7 @@
 """Single volume scattering beneath a smooth interface (seed 003 Sec. 2.2, Eq. 8-20).
 
-A ray refracts into a half-space of real index ``n``, scatters once with the
+A ray refracts into a half-space of real index ``n`` (the ``coating``: the binder
+around the scatterers), scatters once with the
 phase function of :mod:`models.phase` at a depth with the exponential
 probability of Eq. 16-19, and refracts out.  The Mueller BRDF (Eq. 20) is
 
@@ -50,14 +51,22 @@ class SingleScatterBRDF(Model):
 
     Parameters
     ----------
-    n : float
-        Real index of the medium (``n = 1``: no interface).
+    coating : float
+        Real index ``n`` of the binder around the scatterers, the medium light enters
+        through the smooth interface (``1``: no interface).  Old name ``n``.
     phase : HenyeyGreenstein
         Phase function (polarized Eq. 7 or depolarizing).
     """
 
-    n: float = param(1.5, "index of the scattering medium (real, non-absorbing)", kind="real_index", low=1.0)
+    coating: float = param(
+        1.5,
+        "index n of the binder around the scatterers, entered through the smooth interface (real)",
+        kind="real_index",
+        low=1.0,
+    )
     phase: HenyeyGreenstein = param(HenyeyGreenstein(0.3), "volume phase function", kind="object")
+
+    aliases = {"n": "coating"}
 
     def _validate(self):
         if not isinstance(self.phase, HenyeyGreenstein):
@@ -69,7 +78,9 @@ class SingleScatterBRDF(Model):
 
     def _parts(self, ti, tr, pr):
         """Internal geometry, the amplitude factors and the scalar weight ``K``."""
-        (si, sr), (ci, cr), (asi, asr), (api, apr) = interface_amplitudes(np.cos(np.stack([ti, tr])), self.n)
+        (si, sr), (ci, cr), (asi, asr), (api, apr) = interface_amplitudes(
+            np.cos(np.stack([ti, tr])), self.coating
+        )
         cp, sp = np.cos(pr), np.sin(pr)
         cos_scat = si * sr * cp - ci * cr  # k_i' . k_r'
         # Eq. 19-20: p4 / cos(tr) with the solid-angle factor, cos'/cos carried by the amplitudes.

@@ -39,6 +39,7 @@ __all__ = [
     "GaussianAngles",
     "ExponentialAngles",
     "TabulatedSlopes",
+    "UnitSlopes",
 ]
 
 _SQRT6 = math.sqrt(6.0)
@@ -176,7 +177,7 @@ class ExponentialSlopes(SlopeDistribution):
     SCATMECH: ``Exponential_Slope_Distribution_Function`` (parameter ``s``).
     """
 
-    sigma: float = param(0.1, "rms slope", low=0.0, low_open=True)
+    sigma: float = param(0.1, "rms slope, sqrt(<|zeta|^2>)", low=0.0, low_open=True)
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _p3_unit(self, zx, zy):
@@ -193,7 +194,7 @@ class GaussianSlopes(SlopeDistribution):
     ``m`` (seed 001 Eq. 8).  SCATMECH: ``Gaussian_Slope_Distribution_Function``.
     """
 
-    sigma: float = param(0.1, "rms slope", low=0.0, low_open=True)
+    sigma: float = param(0.1, "rms slope, sqrt(<|zeta|^2>)", low=0.0, low_open=True)
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _p3_unit(self, zx, zy):
@@ -207,7 +208,25 @@ class GaussianSlopes(SlopeDistribution):
         return 12.0 * self.sigma
 
 
+@dataclass(frozen=True)
 class _Anisotropic(SlopeDistribution):
+    """Shared parameters of the anisotropic families: scales along axes rotated by ``rotation``."""
+
+    sigma_x: float = param(
+        0.1,
+        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    sigma_y: float = param(
+        0.1,
+        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
+    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
+
     isotropic = False
 
     def _local(self, zx, zy):
@@ -242,11 +261,6 @@ class AnisotropicExponentialSlopes(_Anisotropic):
     each axis the rms slope is ``sigma_x / sqrt(2)``, ``sigma_y / sqrt(2)``.
     """
 
-    sigma_x: float = param(0.1, "slope scale along the rotated x axis", low=0.0, low_open=True)
-    sigma_y: float = param(0.1, "slope scale along the rotated y axis", low=0.0, low_open=True)
-    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
-
     def _p3_unit(self, zx, zy):
         u, v = self._local(zx, zy)
         r = np.sqrt((u / self.sigma_x) ** 2 + (v / self.sigma_y) ** 2)
@@ -265,11 +279,6 @@ class AnisotropicGaussianSlopes(_Anisotropic):
     with ``sigma = m`` (the Cook-Torrance / Beckmann distribution).
     """
 
-    sigma_x: float = param(0.1, "slope scale along the rotated x axis", low=0.0, low_open=True)
-    sigma_y: float = param(0.1, "slope scale along the rotated y axis", low=0.0, low_open=True)
-    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
-
     def _p3_unit(self, zx, zy):
         u, v = self._local(zx, zy)
         return _exp_neg((u / self.sigma_x) ** 2 + (v / self.sigma_y) ** 2) / (
@@ -280,11 +289,21 @@ class AnisotropicGaussianSlopes(_Anisotropic):
         return GaussianSlopes(sigma=1.0)
 
 
+@dataclass(frozen=True)
 class _AngleDistribution(SlopeDistribution):
     """Distributions declared as ``P1^A`` (sampled on the actual flake area), as
     flakes are usually characterized.  ``P3^xy = C <sec> cos^4 P1^A`` (Eq. 41)
     with ``<sec> = 1 / <cos theta_n>_A``, both normalizations exact on the
     hemisphere of normals."""
+
+    sigma: float = param(
+        0.1,
+        "angular width (rad): the rms tilt in the small-angle limit",
+        low=0.0,
+        high=math.pi,
+        low_open=True,
+    )
+    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _shape(self, theta):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -331,9 +350,6 @@ class GaussianAngles(_AngleDistribution):
     approximation, so the two differ at large ``sigma``.)
     """
 
-    sigma: float = param(0.1, "angular width (rad)", low=0.0, high=math.pi, low_open=True)
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
-
     def _shape(self, theta):
         return _exp_neg((np.asarray(theta) / self.sigma) ** 2)
 
@@ -342,9 +358,6 @@ class GaussianAngles(_AngleDistribution):
 class ExponentialAngles(_AngleDistribution):
     """Exponential distribution of flake tilt angles, ``P1^A ~ exp(-sqrt(6) theta_n / sigma)``
     (``sigma`` is the rms tilt in the small-angle limit), declared on the flake area."""
-
-    sigma: float = param(0.1, "angular width (rad)", low=0.0, high=math.pi, low_open=True)
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _shape(self, theta):
         return _exp_neg(_SQRT6 * np.asarray(theta) / self.sigma)
@@ -417,3 +430,18 @@ class TabulatedSlopes(SlopeDistribution):
         f = lambda s: math.sqrt(1 + s * s) * float(self._p4_unit(np.array(s)))  # noqa: E731
         val, _ = integrate.quad(f, 0, z[-1], limit=800)
         return val
+
+
+@dataclass(frozen=True)
+class UnitSlopes(SlopeDistribution):
+    """``P3(zeta) = 1`` for every slope: a facet model's BRDF *per unit slope density*.
+
+    Not a probability distribution (it does not normalize); the facet BRDF is
+    linear in ``P3`` (seed 000 Eq. 49), so a model built with it gives the kernel
+    that slope-distribution inversion divides a measured BRDF by.
+    """
+
+    coverage: float = param(1.0, "fixed at 1", low=1.0, high=1.0)
+
+    def _p3_unit(self, zx, zy):
+        return np.ones(np.broadcast_shapes(np.shape(zx), np.shape(zy)))

@@ -1,7 +1,7 @@
 """Brushed-metal roughness of seed 001 Eq. 19 as a facet slope distribution.
 
-Eq. 19 interpolates the rms slope between ``m_parallel`` (along the strokes)
-and ``m_perpendicular`` (across them) on an ellipse in polar form,
+Eq. 19 interpolates the roughness ``m`` of Eq. 8 between ``m_parallel`` (along
+the strokes) and ``m_perpendicular`` (across them) on an ellipse in polar form,
 
     m(beta) = m_par m_perp / sqrt(m_perp^2 cos^2 beta + m_par^2 sin^2 beta),
 
@@ -25,6 +25,17 @@ density depends on the direction of approach (``1/(pi m(beta)^2)``); the value
 at exactly ``zeta = 0`` is taken as its azimuthal mean
 ``(1/m_par^2 + 1/m_perp^2) / (2 pi)``.  Sampling is exact: ``beta`` is uniform
 and ``|zeta|`` Rayleigh with scale ``m(beta)/sqrt(2)``.
+
+``m_parallel`` and ``m_perpendicular`` are the paper's ``m`` values, not the rms
+slopes along and across the strokes: with ``a = m_par``, ``b = m_perp`` the second
+moments of this density are
+
+    <u^2> = a^2 b / (a + b),   <v^2> = b^2 a / (a + b),   <u v> = 0,
+
+and ``<|zeta|^2> = a b`` (``beta`` is uniform and ``<|zeta|^2>`` at fixed ``beta`` is
+``m(beta)^2``; the mean over ``beta`` of ``cos^2 beta / (b^2 cos^2 beta + a^2 sin^2
+beta)`` is ``1 / (b (a + b))``).  Only for ``a = b = m`` are both ``m^2 / 2``, the
+per-axis moments of ``GaussianSlopes(sigma=m)``.
 """
 
 from __future__ import annotations
@@ -74,8 +85,18 @@ class StrokeSlopes(SlopeDistribution):
     ``m_par = m_perp = m`` is :class:`models.GaussianSlopes` with ``sigma = m``.
     """
 
-    m_parallel: float = param(0.03, "rms slope along the strokes", low=0.0, low_open=True)
-    m_perpendicular: float = param(0.03, "rms slope across the strokes", low=0.0, low_open=True)
+    m_parallel: float = param(
+        0.03,
+        "the paper's m along the strokes (Eq. 19); slope moment <u^2> = m_par^2 m_perp / (m_par + m_perp)",
+        low=0.0,
+        low_open=True,
+    )
+    m_perpendicular: float = param(
+        0.03,
+        "the paper's m across the strokes (Eq. 19); slope moment <v^2> = m_perp^2 m_par / (m_par + m_perp)",
+        low=0.0,
+        low_open=True,
+    )
     stroke_angle: float = param(0.0, "azimuth of the strokes from the sample x axis (rad)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 

@@ -13,8 +13,13 @@ with ``n_v`` and ``1/n_v``; ``F_out(Theta) = F_in(theta)`` by Stokes' relations)
 ``m(beta)`` is Eq. 19 with ``beta`` the azimuth of the (internal) bisector from
 the strokes (:mod:`models.stroke_slopes`).
 
-Normalizations as for :class:`models.CookTorranceBRDF`: ``published`` is Eq. 24
-as printed, ``energy`` divides by ``4 pi``.
+``convention="paper"`` is Eq. 24 as printed; ``"corrected"`` divides by ``4 pi``
+(the normalization of :class:`models.CookTorranceBRDF`) and applies the refraction
+Jacobian below.  The old keywords ``normalization`` (``published``/``energy``) and
+``solid_angle`` (``published``/``refracted``) map onto it when they agree; their
+mixed pairs are no model of their own: scale one of the two conventions by the
+exact ``4 pi`` (``(1 / (4 pi)) * VarnishedCookTorranceBRDF()`` is the energy
+normalization with the printed solid angle).
 
 What Eq. 24 leaves out (measured against :class:`models.SubsurfaceFacetBRDF`,
 see ``validation.checks.seed001``):
@@ -27,8 +32,8 @@ see ``validation.checks.seed001``):
   the external ``cos theta cos psi`` and has no ``1 / n_v^2``: it exceeds the
   consistent form by ``n_v^2 cos Psi cos Theta / (cos psi cos theta)`` (2.25 at
   normal incidence for ``n_v = 1.5``, -> infinity at grazing).
-  ``solid_angle="refracted"`` applies the consistent denominator
-  ``n_v^2 cos Psi cos Theta``; the default ``"published"`` keeps Eq. 24.
+  ``convention="corrected"`` applies the consistent denominator
+  ``n_v^2 cos Psi cos Theta``; the default ``"paper"`` keeps Eq. 24.
 * polarization: F' multiplies natural-light averages, whereas the transmission
   in, the metal reflection and the transmission out act on s and p in three
   different frames (a Jones product, as in seed 000).
@@ -42,10 +47,54 @@ from dataclasses import dataclass
 import numpy as np
 
 from .cook_torrance import _INV_4PI, _CookTorranceBase, _grazing_safe, ct_kernel, fresnel_average
-from .params import param
-from .stroke_slopes import stroke_d
+from .params import Alias, check_real, convention_param, param
+from .slopes import GaussianSlopes
+from .stroke_slopes import StrokeSlopes
 
 __all__ = ["VarnishedCookTorranceBRDF"]
+
+
+#: (normalization, solid_angle) of the old keywords -> convention
+_OLD_PAIRS = {("published", "published"): "paper", ("energy", "refracted"): "corrected"}
+
+
+def _convention_from_old(given, current):
+    """The old ``normalization`` / ``solid_angle`` keywords, completed from the current
+    convention, as one convention; their mixed pairs are refused (see the module docstring)."""
+    now = {v: k for k, v in _OLD_PAIRS.items()}[current]
+    pair = (given.get("normalization", now[0]), given.get("solid_angle", now[1]))
+    for key, value, allowed in zip(
+        ("normalization", "solid_angle"),
+        pair,
+        (("published", "energy"), ("published", "refracted")),
+        strict=True,
+    ):
+        if value not in allowed:
+            raise ValueError(f"{key} (old name of convention) must be one of {allowed}; got {value!r}")
+    if pair in _OLD_PAIRS:
+        return _OLD_PAIRS[pair]
+    raise ValueError(
+        f"normalization={pair[0]!r} with solid_angle={pair[1]!r}: this pair is no longer a model of its own. "
+        "convention='paper' is Eq. 24 as printed (published, published); convention='corrected' divides by 4 pi "
+        "and applies the refraction Jacobian (energy, refracted).  For a mixed pair scale one of them by the "
+        "exact 4 pi: (1 / (4 pi)) * VarnishedCookTorranceBRDF(convention='paper') is energy with the printed "
+        "solid angle, 4 pi * VarnishedCookTorranceBRDF(convention='corrected') published with the refracted one"
+    )
+
+
+def _slopes_from_strokes(given, current):
+    """The old ``m_parallel`` / ``m_perpendicular`` / ``stroke_angle`` keywords (or ``m`` for
+    both ``m`` values, as :class:`CookTorranceBRDF`'s), completed from the current slopes, as a
+    :class:`models.StrokeSlopes`."""
+    given = dict(given)
+    if "m" in given:
+        if "m_parallel" in given or "m_perpendicular" in given:
+            raise ValueError("m: give either m or m_parallel and m_perpendicular, not both")
+        m = check_real("m", given.pop("m"), 0.0, low_open=True)
+        given.update(m_parallel=m, m_perpendicular=m)
+    if isinstance(current, GaussianSlopes):
+        current = StrokeSlopes(m_parallel=current.sigma, m_perpendicular=current.sigma)
+    return current.replace(**given)
 
 
 @dataclass(frozen=True)
@@ -57,88 +106,71 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
 
     Parameters
     ----------
-    m_parallel, m_perpendicular : float
-        rms slopes along and across the strokes (Eq. 19); equal values give
-        isotropic Cook-Torrance roughness ``m``.
-    varnish : float
-        Real varnish index ``n_v >= 1`` (``1``: :class:`CookTorranceBRDF`).
+    slopes : StrokeSlopes or GaussianSlopes
+        Brushed roughness of Eq. 19 (:class:`models.StrokeSlopes`: the paper's
+        ``m_parallel``, ``m_perpendicular`` and the strokes' azimuth); equal ``m``
+        values, or ``GaussianSlopes(sigma=m)``, give isotropic Cook-Torrance roughness
+        ``m``.  Old keywords ``m_parallel``, ``m_perpendicular``, ``stroke_angle`` (and ``m``
+        for both ``m`` values, as :class:`CookTorranceBRDF`'s).
+    coating : float
+        Real varnish index ``n_v >= 1`` (``1``: :class:`CookTorranceBRDF`).  Old name
+        ``varnish``.
     substrate : complex or math.inf
         Metal index ``n + ik`` (relative to air; Eq. 22 divides it by ``n_v``).
-    stroke_angle : float
-        Azimuth of the strokes from the sample x axis (rad).
-    normalization : "published" | "energy"
+    convention : "paper" | "corrected"
+        ``paper``: Eq. 24 as printed, denominator ``cos theta cos psi`` and no ``1/pi``
+        in D, no 4 in the denominator (the normalization of Eq. 7-8).  ``corrected``:
+        divided by ``4 pi`` and with the radiometrically consistent denominator
+        ``n_v^2 cos Theta cos Psi`` (see module docstring).  Either way F is the
+        corrected Eq. 13-16.  Old keywords ``normalization`` and ``solid_angle``.
     shadowing : "blinn" | "none"
         Eq. 18 with the internal angles (Eq. 24's ``G(Psi, Theta)``) or ``G = 1``.
-    solid_angle : "published" | "refracted"
-        Denominator ``cos theta cos psi`` (Eq. 24) or the radiometrically
-        consistent ``n_v^2 cos Theta cos Psi`` (see module docstring).
     """
 
-    m_parallel: float = param(0.03, "rms slope along the strokes (Eq. 19)", low=0.0, low_open=True)
-    m_perpendicular: float = param(0.03, "rms slope across the strokes (Eq. 19)", low=0.0, low_open=True)
-    varnish: float = param(1.5, "varnish index n_v (real)", kind="real_index", low=1.0)
+    slopes: StrokeSlopes | GaussianSlopes = param(
+        StrokeSlopes(), "brushed facet slopes of D: StrokeSlopes (Eq. 19) or GaussianSlopes", kind="object"
+    )
+    coating: float = param(1.5, "varnish index n_v (real)", kind="real_index", low=1.0)
     substrate: complex = param(2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", kind="index")
-    stroke_angle: float = param(0.0, "azimuth of the strokes from the x axis (rad)")
-    normalization: str = param(
-        "published", "Eq. 24 as printed or energy-normalized", kind="choice", choices=("published", "energy")
+    convention: str = convention_param(
+        "Eq. 24 as printed (paper) or divided by 4 pi with the refraction Jacobian (corrected)"
     )
     shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=("blinn", "none"))
-    solid_angle: str = param(
-        "published",
-        "denominator of Eq. 24 or the refraction-consistent one",
-        kind="choice",
-        choices=("published", "refracted"),
-    )
 
-    @property
-    def mirror_symmetric(self) -> bool:
-        return self.m_parallel == self.m_perpendicular or math.sin(2.0 * self.stroke_angle) == 0.0
-
-    @property
-    def slopes(self):
-        """The brushed facet slope density of Eq. 19 (:class:`models.StrokeSlopes`)."""
-        from .stroke_slopes import StrokeSlopes
-
-        return StrokeSlopes(
-            m_parallel=self.m_parallel, m_perpendicular=self.m_perpendicular, stroke_angle=self.stroke_angle
-        )
-
-    @property
-    def coating(self):
-        """The varnish is the coating the light crosses (for coating-generic analyses)."""
-        return self.varnish
-
-    def rotated(self, angle):
-        if self.m_parallel == self.m_perpendicular:
-            return self
-        return self.replace(stroke_angle=(self.stroke_angle + angle) % (2 * math.pi))
+    aliases = {
+        "varnish": "coating",
+        "m": Alias("slopes", _slopes_from_strokes),
+        "m_parallel": Alias("slopes", _slopes_from_strokes),
+        "m_perpendicular": Alias("slopes", _slopes_from_strokes),
+        "stroke_angle": Alias("slopes", _slopes_from_strokes),
+        "normalization": Alias("convention", _convention_from_old),
+        "solid_angle": Alias("convention", _convention_from_old),
+    }
 
     def _brdf_flat(self, ti, tr, pr):
         ci, cr, live = _grazing_safe(ti, tr)
-        nv = self.varnish
+        nv = self.coating
         ext = np.stack([ci, cr])
         # Eq. 20-21: internal cosines (no TIR entering from air).
         # cos' = sqrt(n_v^2 - 1 + cos^2) / n_v: exact for n_v = 1 and free of the
         # cancellation of sqrt(1 - sin^2/n_v^2) at grazing incidence.
         c_int = np.sqrt(nv * nv - 1.0 + ext * ext) * (1.0 / nv)
         index = self.substrate if self.substrate == math.inf else complex(self.substrate) / nv  # Eq. 22
-        d_fn = stroke_d(self.m_parallel, self.m_perpendicular, self.stroke_angle)
-        val = ct_kernel(c_int[0], c_int[1], np.cos(pr), np.sin(pr), d_fn, index, self.shadowing)
+        val = ct_kernel(c_int[0], c_int[1], np.cos(pr), np.sin(pr), self._d_fn(), index, self.shadowing)
         if nv != 1.0:
             t = 1.0 - fresnel_average(ext, nv)  # 1 - F_in(psi), 1 - F_out(Theta) = 1 - F(theta)
             val *= t[0] * t[1]  # Eq. 23
-        scale = _INV_4PI if self.normalization == "energy" else 1.0
-        if self.solid_angle == "published":
-            val *= scale / (ci * cr)  # Eq. 24
+        if self.convention == "paper":
+            val *= 1.0 / (ci * cr)  # Eq. 24
         else:
-            val *= scale / (nv * nv * c_int[0] * c_int[1])
+            val *= _INV_4PI / (nv * nv * c_int[0] * c_int[1])
         if live is not None:
             val[~live] = 0.0
         return val
 
     def lobe(self, theta_i):
         """Specular lobe at ``(theta_i, 0)``; width ``2 n_v m cos(Psi) / cos(psi)`` in theta_r."""
-        nv = self.varnish
+        nv = self.coating
         s = math.sin(theta_i) / nv
-        width = 2.0 * nv * max(self.m_parallel, self.m_perpendicular) * math.sqrt(1 - s * s)
+        width = 2.0 * nv * self.slopes.scale * math.sqrt(1 - s * s)
         return (theta_i, 0.0, width / max(math.cos(theta_i), 1e-6))

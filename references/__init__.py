@@ -10,12 +10,29 @@ from __future__ import annotations
 import csv
 import math
 import os
+import tomllib
 
 import numpy as np
 
-__all__ = ["data_path", "read_csv", "provenance", "table1", "scatmech_facet", "table1_scatmech"]
+__all__ = [
+    "data_path",
+    "read_csv",
+    "provenance",
+    "table1",
+    "scatmech_facet",
+    "table1_scatmech",
+    "scene_paths",
+    "scene_path",
+    "seed003_presets",
+    "iron_plate",
+    "IRON_PLATE",
+    "scatmech_seed003",
+    "scatmech_flake_measurement_path",
+]
 
-_DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_DATA = os.path.join(_HERE, "data")
+_SCENES = os.path.join(_HERE, "scenes")
 
 
 def data_path(name: str) -> str:
@@ -86,17 +103,49 @@ def table1_scatmech() -> dict:
 
 def scene_paths() -> list[str]:
     """Paths of the example scene files shipped with scatterbench (one per preset)."""
-    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenes")
-    return sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".toml"))
+    return sorted(os.path.join(_SCENES, f) for f in os.listdir(_SCENES) if f.endswith(".toml"))
 
 
-# --- issue 4 (seed 001): the iron-plate preset -------------------------------------
-from .presets_seed001 import IRON_PLATE, iron_plate_models, point_source_geometry  # noqa: E402
+def scene_path(name: str) -> str:
+    """Path of the shipped scene file ``name`` (e.g. ``"green_carc.toml"``)."""
+    return os.path.join(_SCENES, name)
 
-__all__ += ["IRON_PLATE", "iron_plate_models", "point_source_geometry"]
+
+def _presets() -> dict:
+    with open(data_path("presets.toml"), "rb") as fh:
+        return tomllib.load(fh)
 
 
-# --- issue 3 (seed 003) -------------------------------------------------------------
+def seed003_presets() -> dict:
+    """Seed 003's paper presets (Fig. 2-3), by name in sorted order: ``scene`` (the path of
+    the scene file that holds the model and its numbers; load it with
+    ``models.scene.load``), ``sample``, ``figure``, ``model`` (a label), ``printed``
+    (False: the numbers are our placeholders) and ``source`` (the quote)."""
+    out = {}
+    for name, p in sorted(_presets()["seed003"].items()):
+        out[name] = {**p, "scene": scene_path(p["scene"])}
+    return out
+
+
+def iron_plate() -> dict:
+    """Seed 001's iron plate ("Measurement Results"): ``m``, ``varnish`` (n_v),
+    ``substrate`` (complex iron index), ``wavelength_nm``, ``incidence_ranges_deg``
+    (the printed ranges of incidence over the sample, ``(lo, hi)`` pairs) and ``source``."""
+    p = _presets()["seed001"]["iron_plate"]
+    return {
+        "m": p["m"],
+        "varnish": p["varnish"],
+        "substrate": complex(*p["substrate"]),
+        "wavelength_nm": p["wavelength_nm"],
+        "incidence_ranges_deg": tuple(tuple(r) for r in p["incidence_ranges_deg"]),
+        "source": p["source"],
+    }
+
+
+#: Seed 001's iron plate (:func:`iron_plate`).
+IRON_PLATE = iron_plate()
+
+
 def scatmech_seed003(kind: str) -> dict:
     """SCATMECH Mueller BSDFs for the seed 003 models; ``kind`` is ``diffuse``,
     ``single``, ``btdf`` or ``mb`` (Maxwell-Beard specular term).  Parameter columns (floats; ``sdf`` a string) and

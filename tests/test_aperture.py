@@ -53,7 +53,7 @@ def test_matches_an_independent_field_projection_including_the_normal(tr, pr):
 
 
 def test_lambertian_reads_its_own_brdf_for_any_aperture_and_nominal_direction():
-    lam = models.DiffuseSubsurfaceBRDF(n=1.0, rho=1.0)  # 1/pi, unpolarized, everywhere
+    lam = models.DiffuseSubsurfaceBRDF(coating=1.0, rho=1.0)  # 1/pi, unpolarized, everywhere
     tr = np.radians([0.0, 30.0, 80.0, 89.9, 90.0])
     for deg in (0.7, 10.0, 90.0):
         ap = models.DetectorAperture(model=lam, aperture=math.radians(deg))

@@ -76,3 +76,81 @@ def test_models_are_frozen_and_replace_validates():
 def test_negative_zero_k_normalized():
     m = models.FacetBRDF(substrate=complex(1.5, -0.0))
     assert math.copysign(1.0, m.substrate.imag) == 1.0
+
+
+# ----------------------------------------------------------------------- one vocabulary, old names
+@pytest.mark.parametrize(
+    "old, new",
+    [
+        (lambda: models.SingleScatterBRDF(n=1.6), lambda: models.SingleScatterBRDF(coating=1.6)),
+        (
+            lambda: models.DiffuseSubsurfaceBRDF(n=1.3, rho=0.4),
+            lambda: models.DiffuseSubsurfaceBRDF(coating=1.3, rho=0.4),
+        ),
+        (
+            lambda: models.RoughDiffuseBRDF(n=1.4, pairs=20, surface_normalization="exact"),
+            lambda: models.RoughDiffuseBRDF(coating=1.4, pairs=20, convention="corrected"),
+        ),
+        (
+            lambda: models.FacetBTDF(normalization="exact"),
+            lambda: models.FacetBTDF(convention="corrected"),
+        ),
+        (
+            lambda: models.CookTorranceBRDF(m=0.2, normalization="energy"),
+            lambda: models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.2), convention="corrected"),
+        ),
+        (
+            lambda: models.VarnishedCookTorranceBRDF(
+                m_parallel=0.05,
+                m_perpendicular=0.3,
+                stroke_angle=0.4,
+                varnish=1.7,
+                normalization="energy",
+                solid_angle="refracted",
+            ),
+            lambda: models.VarnishedCookTorranceBRDF(
+                slopes=models.StrokeSlopes(0.05, 0.3, 0.4), coating=1.7, convention="corrected"
+            ),
+        ),
+        (
+            lambda: models.VarnishedCookTorranceBRDF(m_perpendicular=0.1),
+            lambda: models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.03, 0.1)),
+        ),
+    ],
+)
+def test_old_keywords_build_the_same_model(old, new):
+    assert old() == new()
+
+
+def test_replace_accepts_old_names_from_the_current_values():
+    v = models.VarnishedCookTorranceBRDF(m_parallel=0.05, m_perpendicular=0.3, stroke_angle=0.4)
+    assert v.replace(m_perpendicular=0.2).slopes == models.StrokeSlopes(0.05, 0.2, 0.4)
+    c = v.replace(convention="corrected")
+    assert c.replace(normalization="energy") == c  # completed with the current solid angle: refracted
+    with pytest.raises(ValueError, match="solid_angle='refracted'"):
+        c.replace(normalization="published")
+    assert models.SingleScatterBRDF().replace(n=2.0).coating == 2.0
+
+
+def test_old_names_are_listed_read_and_named_in_errors():
+    info = {p.name: p for p in models.VarnishedCookTorranceBRDF.parameters()}
+    assert info["coating"].aliases == ("varnish",)
+    assert info["convention"].aliases == ("normalization", "solid_angle")
+    assert info["slopes"].aliases == ("m", "m_parallel", "m_perpendicular", "stroke_angle")
+    assert "old name n" in models.SingleScatterBRDF.info()
+    assert models.SingleScatterBRDF(coating=1.7).n == 1.7  # a plain rename reads as before
+    with pytest.raises(AttributeError):
+        models.CookTorranceBRDF().m  # noqa: B018 - a converted old name has no attribute
+    with pytest.raises(ValueError, match=r"^n \(old name of coating\): coating must be"):
+        models.DiffuseSubsurfaceBRDF(n=0.5)
+    with pytest.raises(ValueError, match="give coating alone"):
+        models.DiffuseSubsurfaceBRDF(n=1.5, coating=1.5)
+    with pytest.raises(ValueError, match="surface_normalization .* must be one of 'paper', 'exact'"):
+        models.RoughDiffuseBRDF(surface_normalization="corrected")
+
+
+@pytest.mark.parametrize("cls", [models.PointSourceBRDF, models.DetectorAperture])
+def test_wrappers_require_their_model(cls):
+    with pytest.raises(ValueError, match="model is required"):
+        cls()
+    assert {p.name: p for p in cls.parameters()}["model"].required

@@ -60,7 +60,10 @@ BASE = 'name = "x"\n[illumination]\ntheta_i_deg = 30\n'
             "[substrate] index",
         ),
         (BASE + '[substrate]\nindex = 1.5\ndistribution = "gaussian"\n', "[substrate] sigma"),
-        (BASE + '[substrate]\nindex = 1.5\ndistribution = "gaussian"\nsigma = -1\n', "[substrate] gaussian"),
+        (
+            BASE + '[substrate]\nindex = 1.5\ndistribution = "gaussian"\nsigma = -1\n',
+            "[substrate] sigma: sigma",
+        ),
         (BASE + '[substrate]\nindex = 1.5\ndistribution = "cauchy"\nsigma = 1\n', "distribution"),
         (BASE + "[substrat]\nindex = 1.5\n", "substrat"),
         (BASE + "[illumination.extra]\n", "extra"),
@@ -136,7 +139,7 @@ def test_cook_torrance_scenes_and_point_source_decision():
         _ct_scene("", "m_parallel = 0.03\nm_perpendicular = 0.3\nstroke_angle_deg = 30\n"), "b.toml"
     )
     b = brushed.build()
-    assert b.m_perpendicular == 0.3 and abs(b.stroke_angle - math.radians(30)) < 1e-15
+    assert b.slopes.m_perpendicular == 0.3 and abs(b.slopes.stroke_angle - math.radians(30)) < 1e-15
 
 
 @pytest.mark.parametrize(
@@ -173,13 +176,28 @@ def test_volume_scenes_build_only_what_they_declare():
     assert mc.surface and mc.pairs == 5000 and mc.slopes.sigma == 2.0 and mc.rho == 0.05 and mc.phase.g == 0.3
 
 
-def test_red_paint_scene_is_the_preset_combination():
-    from references import presets_seed003
-
-    a = _scene("red_pigmented_paint.toml").build()
-    b = presets_seed003.build("red_paint")
-    ti, tr, pr = 1.0, np.linspace(0, 1.4, 9), 0.3
-    np.testing.assert_allclose(a.mueller(ti, tr, pr), b.mueller(ti, tr, pr), rtol=1e-13, atol=0)
+def test_preset_scenes_are_the_paper_models():
+    """The scene files of seed 003's presets hold the models (and parameters) of the paper's
+    Fig. 2-3 as the preset builder wrote them before the presets became data."""
+    white = _scene("glossy_white_paint.toml").build()
+    assert white == models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.93)
+    phase = models.HenyeyGreenstein(g=0.3, polarized=True)
+    red = _scene("red_pigmented_paint.toml").build()
+    assert red == (
+        1.0 * models.FacetBRDF(slopes=models.GaussianSlopes(sigma=0.05), substrate=1.5)
+        + 1.0 * models.SingleScatterBRDF(coating=1.5, phase=phase)
+        + 1.0 * models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.1)
+    )
+    carc = _scene("green_carc.toml").build()
+    assert carc == models.RoughDiffuseBRDF(
+        slopes=models.ExponentialSlopes(sigma=2.0),
+        coating=1.5,
+        phase=phase,
+        rho=0.05,
+        pairs=5000,
+        seed=0,
+        surface=True,
+    )
 
 
 def test_smooth_scenes_never_call_the_monte_carlo(monkeypatch):
@@ -276,3 +294,95 @@ def test_decisions_are_measured_once_and_can_be_imposed():
     m = flakes.build(decisions={"point_source": False, "aperture_resolution": 2})
     assert isinstance(m, models.DetectorAperture) and m.resolution == 2
     assert flakes.build(decisions={"point_source": False, "aperture_resolution": None}) == m.model
+
+
+# ----------------------------------------------------------------------- scenes derived from the models
+def test_values_are_validated_by_the_models_declared_parameters():
+    """The scene wraps the model's own error with the file and the key; no range of its own
+    (e.g. [volume] g is HenyeyGreenstein's open interval (-1, 1))."""
+    vol = BASE + "[coating]\nindex = 1.5\n[volume]\nrho = 0.5\n"
+    sc = scene.loads(vol + "g = 0.9999995\n", "v.toml")
+    assert sc.volume["g"] == 0.9999995 and sc.build().terms[0][1].phase.g == 0.9999995
+    for text, message in (
+        (vol + "g = 1.0\n", "v.toml: [volume] g: g must be a finite real number in (-1, 1); got 1.0"),
+        (vol + "seed = -2\n", "v.toml: [volume] seed: seed must be an integer >= 0"),
+        (vol + "polarized = 1\n", "v.toml: [volume] polarized: polarized must be one of True, False; got 1"),
+        (_MB + "tau_deg = -3\n", "v.toml: [substrate] tau_deg: tau must be a finite real number in (0, inf)"),
+    ):
+        with pytest.raises(scene.SceneError) as exc:
+            scene.loads(text, "v.toml")
+        assert str(exc.value).startswith(message), str(exc.value)
+    with pytest.raises(scene.SceneError, match=r"tau_deg = -3 deg in the file, converted to radians"):
+        scene.loads(_MB + "tau_deg = -3\n", "v.toml")
+
+
+@pytest.mark.parametrize(
+    "extra_sub, convention",
+    [
+        ("m = 0.03\n", "corrected"),  # the scene's default: energy normalization, refracted solid angle
+        ('m = 0.03\nconvention = "paper"\n', "paper"),
+        ('m = 0.03\nnormalization = "energy"\n', "corrected"),  # with the default solid angle
+        ('m = 0.03\nnormalization = "published"\nsolid_angle = "published"\n', "paper"),
+    ],
+)
+def test_cook_torrance_scene_convention(extra_sub, convention):
+    m = scene.loads(_ct_scene("", extra_sub), "c.toml").build()
+    assert isinstance(m, models.VarnishedCookTorranceBRDF) and m.convention == convention
+
+
+@pytest.mark.parametrize(
+    "extra_sub, message",
+    [
+        (
+            'm = 0.03\nnormalization = "published"\n',
+            "[substrate] normalization: normalization='published' with",
+        ),
+        ('m = 0.03\nconvention = "energy"\n', "[substrate] convention: convention must be one of"),
+        (
+            'm = 0.03\nconvention = "paper"\nsolid_angle = "published"\n',
+            "[substrate] solid_angle: solid_angle: old",
+        ),
+    ],
+)
+def test_cook_torrance_scene_convention_errors(extra_sub, message):
+    with pytest.raises(scene.SceneError) as exc:
+        scene.loads(_ct_scene("", extra_sub), "c.toml")
+    assert str(exc.value).startswith("c.toml: " + message), str(exc.value)
+
+
+def test_one_assembly_measures_once(monkeypatch):
+    from models.scene import decisions
+
+    calls = []
+    real = decisions._deviation
+    monkeypatch.setattr(decisions, "_deviation", lambda *a: calls.append(1) or real(*a))
+    flakes = _scene("aluminium_flakes_clearcoat.toml")
+    a = flakes.assemble()
+    measured = len(calls)
+    assert measured > 1 and isinstance(a, scene.Assembly)
+    assert a.decisions == {"point_source": False, "aperture_resolution": 8} and "kept" in a.aperture_reason
+    text = flakes.describe()
+    assert flakes.build() is a.model and flakes.decisions() == a.decisions
+    assert flakes.source_decision() == a.source_reason and a.aperture_reason in text
+    assert len(calls) == measured  # describe, build, decisions and the reasons reuse it
+    assert [m.name for m in a.mechanisms] == [m.name for m in flakes.mechanisms()]
+    flakes.assemble(tol=1e-2)
+    assert len(calls) > measured  # another tolerance is another measurement
+
+
+def test_distributions_table_keeps_its_form():
+    cls, keys = scene.DISTRIBUTIONS["anisotropic-gaussian"]
+    assert cls is models.AnisotropicGaussianSlopes and keys == (
+        "sigma_x",
+        "sigma_y",
+        "rotation_deg",
+        "coverage",
+    )
+    assert set(scene.DISTRIBUTIONS) == {
+        "exponential",
+        "gaussian",
+        "anisotropic-exponential",
+        "anisotropic-gaussian",
+        "gaussian-angle",
+        "exponential-angle",
+    }

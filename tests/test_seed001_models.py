@@ -24,7 +24,9 @@ def test_energy_ct_equals_facet_gaussian(m, substrate, rng):
     to 1e-9 relative wherever both are non-zero, and they vanish at the same geometries."""
     ti, tr = rng.uniform(0, 1.56, (2, 20000))
     pr = rng.uniform(-math.pi, math.pi, 20000)
-    ct = models.CookTorranceBRDF(m=m, substrate=substrate, normalization="energy", shadowing="none")
+    ct = models.CookTorranceBRDF(
+        slopes=models.GaussianSlopes(m), substrate=substrate, convention="corrected", shadowing="none"
+    )
     fa = models.FacetBRDF(slopes=models.GaussianSlopes(sigma=m), substrate=substrate)
     a, b = ct.brdf(ti, tr, pr), fa.brdf(ti, tr, pr)
     np.testing.assert_array_equal(a > 0, b > 0)
@@ -37,8 +39,12 @@ def test_published_is_exactly_4pi_energy(rng):
     ti, tr = rng.uniform(0, 1.5, (2, 5000))
     pr = rng.uniform(-math.pi, math.pi, 5000)
     for sh in ("blinn", "none"):
-        a = models.CookTorranceBRDF(m=0.2, shadowing=sh, normalization="published").brdf(ti, tr, pr)
-        b = models.CookTorranceBRDF(m=0.2, shadowing=sh, normalization="energy").brdf(ti, tr, pr)
+        a = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.2), shadowing=sh, convention="paper").brdf(
+            ti, tr, pr
+        )
+        b = models.CookTorranceBRDF(
+            slopes=models.GaussianSlopes(0.2), shadowing=sh, convention="corrected"
+        ).brdf(ti, tr, pr)
         np.testing.assert_allclose(a, 4 * math.pi * b, rtol=1e-14, atol=0)
     assert c.published_over_energy_error() < 1e-14
 
@@ -46,17 +52,17 @@ def test_published_is_exactly_4pi_energy(rng):
 def test_shadowing_only_attenuates(rng):
     ti, tr = rng.uniform(0, 1.5, (2, 5000))
     pr = rng.uniform(-math.pi, math.pi, 5000)
-    g = models.CookTorranceBRDF(m=0.5).brdf(ti, tr, pr)
-    n = models.CookTorranceBRDF(m=0.5, shadowing="none").brdf(ti, tr, pr)
+    g = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.5)).brdf(ti, tr, pr)
+    n = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.5), shadowing="none").brdf(ti, tr, pr)
     assert np.all(g <= n) and np.any(g < 0.9 * n)
     # Blinn's G = 1 near the specular peak at moderate angles
-    assert models.CookTorranceBRDF(m=0.1).brdf(0.3, 0.3, 0.0) == models.CookTorranceBRDF(
-        m=0.1, shadowing="none"
-    ).brdf(0.3, 0.3, 0.0)
+    assert models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.1)).brdf(
+        0.3, 0.3, 0.0
+    ) == models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.1), shadowing="none").brdf(0.3, 0.3, 0.0)
 
 
 def test_mueller_is_depolarizer_with_m00_brdf():
-    m = models.VarnishedCookTorranceBRDF(m_parallel=0.05, m_perpendicular=0.2, stroke_angle=0.3)
+    m = models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.05, 0.2, 0.3))
     ti = np.linspace(0, 1.2, 3)[:, None]
     tr = np.linspace(0, 1.2, 4)[None, :]
     M = m.mueller(ti, tr, 0.1)
@@ -103,8 +109,12 @@ def test_printed_fresnel_is_off():
 def test_published_albedo_exceeds_one_by_4pi():
     """The printed normalization integrates to ~7 for iron: 4 pi times the energy form."""
     for ti in (0.3, 1.0):
-        p = integrated_reflectance(models.CookTorranceBRDF(m=0.03, normalization="published"), ti, tol=1e-3)
-        e = integrated_reflectance(models.CookTorranceBRDF(m=0.03, normalization="energy"), ti, tol=1e-4)
+        p = integrated_reflectance(
+            models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="paper"), ti, tol=1e-3
+        )
+        e = integrated_reflectance(
+            models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="corrected"), ti, tol=1e-4
+        )
         assert p.value > 1.0
         assert abs(p.value - 4 * math.pi * e.value) <= p.error + 4 * math.pi * e.error
 
@@ -114,7 +124,9 @@ def test_energy_blinn_albedo_at_most_one(m):
     for sub in (IRON, math.inf):
         for deg in (0, 45, 80, 89.9):
             r = integrated_reflectance(
-                models.CookTorranceBRDF(m=m, substrate=sub, normalization="energy"),
+                models.CookTorranceBRDF(
+                    slopes=models.GaussianSlopes(m), substrate=sub, convention="corrected"
+                ),
                 math.radians(deg),
                 tol=1e-4,
             )
@@ -126,7 +138,11 @@ def test_energy_no_shadowing_integral_matches_slope_space(m):
     """The integrator with the model's lobe hint against validation.numerics.energy's slope-space form."""
     for ti in (0.2, 1.0):
         r = integrated_reflectance(
-            models.CookTorranceBRDF(m=m, normalization="energy", shadowing="none"), ti, tol=1e-5
+            models.CookTorranceBRDF(
+                slopes=models.GaussianSlopes(m), convention="corrected", shadowing="none"
+            ),
+            ti,
+            tol=1e-5,
         )
         assert abs(r.value - exposed_reflectance(models.GaussianSlopes(m), ti, IRON)) < 2e-5
 
@@ -146,10 +162,11 @@ def test_reciprocity(rng):
 def test_varnish_one_is_cook_torrance(rng):
     ti, tr = rng.uniform(0, 1.5, (2, 5000))
     pr = rng.uniform(-math.pi, math.pi, 5000)
+    # at n_v = 1 the corrected convention is the energy normalization (the Jacobian is 1)
     v = models.VarnishedCookTorranceBRDF(
-        m_parallel=0.1, m_perpendicular=0.1, varnish=1.0, normalization="energy"
+        slopes=models.StrokeSlopes(0.1, 0.1), coating=1.0, convention="corrected"
     )
-    ct = models.CookTorranceBRDF(m=0.1, normalization="energy")
+    ct = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.1), convention="corrected")
     # Equal up to rounding; in the far tails (values ~1e-227) the exponent's rounding
     # (~eps x 500) dominates, so the relative tolerance is 1e-11.
     np.testing.assert_allclose(v.brdf(ti, tr, pr), ct.brdf(ti, tr, pr), rtol=1e-11, atol=0)
@@ -191,8 +208,10 @@ def test_varnish_vs_subsurface_facet():
 
 def test_varnish_fresnel_in_out():
     """At normal incidence and specular the varnish factor is (1 - 0.04)^2 F(n/n_v)."""
-    v = models.VarnishedCookTorranceBRDF(m_parallel=0.1, m_perpendicular=0.1, shadowing="none")
-    ct = models.CookTorranceBRDF(m=0.1 * 1.0, substrate=IRON / 1.5, shadowing="none")
+    v = models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.1, 0.1), shadowing="none")
+    ct = models.CookTorranceBRDF(
+        slopes=models.GaussianSlopes(0.1 * 1.0), substrate=IRON / 1.5, shadowing="none"
+    )
     # Internal and external angles coincide at normal incidence; D(0) = 1/m^2 in both.
     np.testing.assert_allclose(v.brdf(0.0, 0.0, 0.0), 0.96**2 * ct.brdf(0.0, 0.0, 0.0), rtol=1e-12)
 
@@ -203,11 +222,9 @@ def test_anisotropic_matches_facet_with_eq19_slopes(rng):
     pr = rng.uniform(-math.pi, math.pi, 10000)
     for mp, mq, ang in ((0.05, 0.3, 0.4), (0.01, 1.0, -1.2)):
         v = models.VarnishedCookTorranceBRDF(
-            m_parallel=mp,
-            m_perpendicular=mq,
-            stroke_angle=ang,
-            varnish=1.0,
-            normalization="energy",
+            slopes=models.StrokeSlopes(mp, mq, ang),
+            coating=1.0,
+            convention="corrected",  # the Jacobian is 1 at n_v = 1
             shadowing="none",
         )
         f = models.FacetBRDF(slopes=models.StrokeSlopes(mp, mq, ang), substrate=IRON)
@@ -246,23 +263,23 @@ def test_eq19_sampling_moments():
 def test_strokes_rotated_by_90_swap_axes(rng):
     ti, tr = rng.uniform(0, 1.4, (2, 3000))
     pr = rng.uniform(-math.pi, math.pi, 3000)
-    a = models.VarnishedCookTorranceBRDF(m_parallel=0.05, m_perpendicular=0.3, stroke_angle=0.2)
-    b = models.VarnishedCookTorranceBRDF(m_parallel=0.3, m_perpendicular=0.05, stroke_angle=0.2 + math.pi / 2)
+    a = models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.05, 0.3, 0.2))
+    b = models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.3, 0.05, 0.2 + math.pi / 2))
     np.testing.assert_allclose(a.brdf(ti, tr, pr), b.brdf(ti, tr, pr), rtol=1e-12, atol=1e-300)
-    assert not a.mirror_symmetric and a.rotated(0.5).stroke_angle == pytest.approx(0.7)
+    assert not a.mirror_symmetric and a.rotated(0.5).slopes.stroke_angle == pytest.approx(0.7)
     assert models.VarnishedCookTorranceBRDF().rotated(0.5) is not None
 
 
 # ----------------------------------------------------------------------- extremes, input
 def test_extreme_values_are_sensible():
     # m -> 0: specular spike grows like 1/m^2; off-specular exactly 0
-    ct = models.CookTorranceBRDF(m=1e-6)
+    ct = models.CookTorranceBRDF(slopes=models.GaussianSlopes(1e-6))
     assert ct.brdf(0.5, 0.5, 0.0) > 1e11 and ct.brdf(0.5, 0.6, 0.0) == 0.0
     # grazing 89.99 deg in and out: finite, positive
     g = math.radians(89.99)
     for m in (
-        models.CookTorranceBRDF(m=2.0),
-        models.VarnishedCookTorranceBRDF(m_parallel=0.01, m_perpendicular=1.0),
+        models.CookTorranceBRDF(slopes=models.GaussianSlopes(2.0)),
+        models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.01, 1.0)),
     ):
         v = m.brdf(g, g, 0.0)
         assert np.isfinite(v) and v > 0
@@ -283,6 +300,12 @@ def test_extreme_values_are_sensible():
         (lambda: models.VarnishedCookTorranceBRDF(m_perpendicular=0), "m_perpendicular"),
         (lambda: models.VarnishedCookTorranceBRDF(stroke_angle=math.inf), "stroke_angle"),
         (lambda: models.VarnishedCookTorranceBRDF(solid_angle="x"), "solid_angle"),
+        (lambda: models.VarnishedCookTorranceBRDF(convention="energy"), "convention"),
+        (lambda: models.VarnishedCookTorranceBRDF(normalization="energy"), "solid_angle='published'"),
+        (lambda: models.VarnishedCookTorranceBRDF(solid_angle="refracted"), "normalization='published'"),
+        (lambda: models.CookTorranceBRDF(m=0.1, slopes=models.GaussianSlopes(0.1)), "give slopes alone"),
+        (lambda: models.CookTorranceBRDF(slopes=models.ExponentialSlopes(0.1)), "slopes"),
+        (lambda: models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.1, coverage=0.5)), "slopes"),
         (lambda: models.StrokeSlopes(m_parallel=-0.1), "m_parallel"),
     ],
 )
@@ -299,12 +322,27 @@ def test_bad_angles():
 def test_varnish_energy_form_still_creates_energy():
     """Eq. 24 with 1/(4 pi) on a perfect conductor: albedo ~2.08 at normal incidence
     although the varnish transmits 0.96 each way -- the missing refraction Jacobian.
-    With solid_angle='refracted' it is T_in T_out = 0.9216 (m -> 0 limit)."""
-    kw = dict(m_parallel=0.03, m_perpendicular=0.03, substrate=math.inf, normalization="energy")
-    pub = integrated_reflectance(models.VarnishedCookTorranceBRDF(**kw), 0.0, tol=1e-4)
+    With it (convention 'corrected') it is T_in T_out = 0.9216 (m -> 0 limit)."""
+    kw = dict(slopes=models.StrokeSlopes(0.03, 0.03), substrate=math.inf)
+    energy_printed = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF(convention="paper", **kw)
+    pub = integrated_reflectance(energy_printed, 0.0, tol=1e-4)
     ref = integrated_reflectance(
-        models.VarnishedCookTorranceBRDF(solid_angle="refracted", **kw), 0.0, tol=1e-4
+        models.VarnishedCookTorranceBRDF(convention="corrected", **kw), 0.0, tol=1e-4
     )
     assert pub.value > 2.0
     assert abs(ref.value - 0.96**2) < 2e-3  # slope spread loses a little through the varnish
     assert ref.value - ref.error <= 0.96
+
+
+def test_beckmann_m_is_the_gaussian_slope_sigma():
+    """Eq. 8's D / pi = exp(-tan^2 alpha / m^2) / (pi m^2 cos^4 alpha) is GaussianSlopes(sigma=m).p3
+    at zeta = tan(alpha) over cos^4(alpha): m is the sigma of P(z) = exp(-(z/sigma)^2)/(pi sigma^2)."""
+    m = 0.17
+    # exp(-tan^2 alpha / m^2) / m^2 for h = (hx, hy, hz)
+    d_fn = models.CookTorranceBRDF(slopes=models.GaussianSlopes(m))._d_fn()
+    alpha = np.linspace(0.0, 1.2, 50)
+    phi = np.linspace(-3.0, 3.0, 50)
+    hx, hy = np.sin(alpha) * np.cos(phi), np.sin(alpha) * np.sin(phi)
+    hz2 = np.cos(alpha) ** 2
+    p3 = models.GaussianSlopes(sigma=m).p3(hx / np.cos(alpha), hy / np.cos(alpha))
+    np.testing.assert_allclose(d_fn(hx, hy, hz2) / math.pi, p3, rtol=1e-13)

@@ -10,7 +10,8 @@ import references
 from validation.checks import seed001 as c
 from validation.numerics.reciprocity import reciprocity_error
 
-BASE = models.VarnishedCookTorranceBRDF(normalization="energy")
+# energy normalization with Eq. 24's printed solid angle: the printed model over the exact 4 pi
+BASE = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF()
 
 
 def test_infinite_distance_is_the_model(rng):
@@ -56,7 +57,7 @@ def test_shift_grid_matches_pointwise_shift():
     """Eq. 30 by FFT correlation reproduces the pointwise Eq. 29 sum up to the
     bilinear interpolation of the central BRDF, which falls as the grid is refined
     (measured 2.9e-4, 9.5e-5, 5.3e-5 of the peak for 61, 121, 241 theta nodes)."""
-    m = models.CookTorranceBRDF(m=0.3, normalization="energy")
+    m = models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.3), convention="corrected")
     ti = math.radians(30)
     errs = []
     for n in (61, 121, 241):
@@ -107,14 +108,14 @@ def test_not_reciprocal_and_by_how_much():
 
 def test_preset_ranges():
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
-        psi_c, d = references.point_source_geometry(lo, hi)
+        psi_c, d = models.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=BASE, distance=d)
         a, b = ps.incidence_range(psi_c)
         assert math.degrees(a) == pytest.approx(lo, abs=1e-9) and math.degrees(b) == pytest.approx(
             hi, abs=1e-9
         )
-    ct, vn = references.iron_plate_models()
-    assert models.CookTorranceBRDF(**ct).m == 0.03 and models.VarnishedCookTorranceBRDF(**vn).varnish == 1.5
+    assert references.IRON_PLATE["m"] == 0.03 and references.IRON_PLATE["varnish"] == 1.5
+    assert references.IRON_PLATE["substrate"] == 2.29 + 3.37j
 
 
 @pytest.mark.parametrize(

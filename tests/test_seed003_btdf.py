@@ -61,7 +61,9 @@ def test_exact_normalization_conserves_energy_with_facet_reflection():
     ray is sent below the horizon (narrow slopes, moderate angle)."""
     s = models.GaussianSlopes(0.05)
     ti = math.radians(30.0)
-    t = integrated_reflectance(models.FacetBTDF(slopes=s, substrate=1.5, normalization="exact"), ti, tol=1e-7)
+    t = integrated_reflectance(
+        models.FacetBTDF(slopes=s, substrate=1.5, convention="corrected"), ti, tol=1e-7
+    )
     r = integrated_reflectance(models.FacetBRDF(slopes=s, substrate=1.5), ti, tol=1e-7)
     N = models.facet_btdf.projected_area(s, np.array([math.cos(ti)]))[0]
     assert abs(t.value + r.value * math.cos(ti) / N - 1.0) < 1e-5
@@ -108,5 +110,5 @@ def test_angle_validation_names_theta_t():
 
 
 def test_exact_normalization_refuses_anisotropic_slopes():
-    with pytest.raises(ValueError, match="normalization 'exact' needs isotropic slopes"):
-        models.FacetBTDF(slopes=models.AnisotropicGaussianSlopes(1.6, 0.2), normalization="exact")
+    with pytest.raises(ValueError, match="convention 'corrected' needs isotropic slopes"):
+        models.FacetBTDF(slopes=models.AnisotropicGaussianSlopes(1.6, 0.2), convention="corrected")

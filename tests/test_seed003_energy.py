@@ -21,9 +21,9 @@ from validation.numerics.integrate import integrated_reflectance
 )
 def test_integrated_reflectance_at_most_one(n, g, polarized, rho, sigma, theta_i):
     for m in (
-        models.SingleScatterBRDF(n=n, phase=models.HenyeyGreenstein(g, polarized=polarized)),
-        models.DiffuseSubsurfaceBRDF(n=n, rho=rho),
-        models.FacetBTDF(slopes=models.GaussianSlopes(sigma), substrate=max(n, 1.01), normalization="exact"),
+        models.SingleScatterBRDF(coating=n, phase=models.HenyeyGreenstein(g, polarized=polarized)),
+        models.DiffuseSubsurfaceBRDF(coating=n, rho=rho),
+        models.FacetBTDF(slopes=models.GaussianSlopes(sigma), substrate=max(n, 1.01), convention="corrected"),
     ):
         r = integrated_reflectance(m, theta_i, tol=1e-4)
         assert r.value <= 1.0 + r.error
@@ -31,9 +31,7 @@ def test_integrated_reflectance_at_most_one(n, g, polarized, rho, sigma, theta_i
 
 def test_monte_carlo_energy():
     for sigma, t in ((0.5, 85.0), (2.0, 0.0)):
-        v, e = c3.mc_energy(
-            sigma, t, pairs=500, rho=1.0, single=0.0, surface=True, surface_normalization="exact"
-        )
+        v, e = c3.mc_energy(sigma, t, pairs=500, rho=1.0, single=0.0, surface=True, convention="corrected")
         assert v - 3 * e <= 1.0
     # the flat R-bar feedback under a rough interface gives more light than the rough one
     v_flat, _ = c3.mc_energy(0.5, 0.0, pairs=500, rho=1.0, single=0.0, surface=False, feedback="flat")

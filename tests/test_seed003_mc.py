@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 import models
-from references import presets_seed003
+import references
+from models import scene
 from validation.checks import seed003 as c3
 
-KW = dict(slopes=models.ExponentialSlopes(0.5), n=1.5, phase=models.HenyeyGreenstein(0.3), rho=0.3)
+KW = dict(slopes=models.ExponentialSlopes(0.5), coating=1.5, phase=models.HenyeyGreenstein(0.3), rho=0.3)
 G = c3._GEOM
 
 
@@ -93,23 +94,22 @@ def test_bad_input(kw, name):
 
 
 def test_presets():
-    for name in presets_seed003.names():
-        p = presets_seed003.PRESETS[name]
-        assert {"sample", "wavelength_nm", "source", "printed", "params"} <= set(p)
-        m = presets_seed003.build(name)
-        M = m.mueller(math.radians(60), np.radians([10, 40, 70]), 0.0)
+    presets = references.seed003_presets()
+    assert list(presets) == ["glossy_white", "green_carc", "red_paint"]
+    for p in presets.values():
+        assert {"sample", "figure", "source", "printed", "scene"} <= set(p)
+        sc = scene.load(p["scene"])
+        assert sc.wavelength_nm > 0 and sc.theta_i == math.radians(60)
+        M = sc.build().mueller(math.radians(60), np.radians([10, 40, 70]), 0.0)
         assert np.all(np.isfinite(M)) and np.all(M[..., 0, 0] > 0)
-    white = presets_seed003.build("glossy_white").polarization(
-        math.radians(60), np.radians([20, 70]), 0.0, "+45"
-    )
-    np.testing.assert_allclose(np.abs(white["eta"]), math.pi / 2)  # the paper: eta = +-90 deg
-    with pytest.raises(ValueError, match="name"):
-        presets_seed003.build("blue")
+    white = scene.load(presets["glossy_white"]["scene"]).build()
+    pol = white.polarization(math.radians(60), np.radians([20, 70]), 0.0, "+45")
+    np.testing.assert_allclose(np.abs(pol["eta"]), math.pi / 2)  # the paper: eta = +-90 deg
 
 
 def test_combination_errors():
     mc = models.RoughDiffuseBRDF(pairs=500, seed=0, **KW)
-    det = models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.5)
+    det = models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.5)
     s = 0.5 * mc + 2.0 * det
     M, E = models.mueller_with_error(s, *G)
     Mm, Em = mc.mueller_with_error(*G)

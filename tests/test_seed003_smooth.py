@@ -35,7 +35,7 @@ def test_polarized_phase_unpolarized_probability_is_hg(rng):
     At n = 1 (no interface) f = P(k1, k2) / (cos ti + cos tr), so M00 checks Eq. 13's
     internal Jones elements too (the printed signs of q_ps and q_pp would break it)."""
     ph = models.HenyeyGreenstein(0.4, polarized=True)
-    m = models.SingleScatterBRDF(n=1.0, phase=ph)
+    m = models.SingleScatterBRDF(coating=1.0, phase=ph)
     ti, tr, pr = rng.uniform(0, 1.5, 200), rng.uniform(0, 1.5, 200), rng.uniform(-3, 3, 200)
     cos_scat = np.sin(ti) * np.sin(tr) * np.cos(pr) - np.cos(ti) * np.cos(tr)
     want = ph.density(cos_scat) / (np.cos(ti) + np.cos(tr))
@@ -55,13 +55,13 @@ def test_scatmech_single_and_diffuse():
 
 def test_rbar_exact():
     for n in (1.01, 1.5, 2.5):
-        assert abs(models.DiffuseSubsurfaceBRDF(n=n).rbar - c3._rbar_composite(n)) < 1e-12
-    assert models.DiffuseSubsurfaceBRDF(n=1.0).rbar == 0.0
+        assert abs(models.DiffuseSubsurfaceBRDF(coating=n).rbar - c3._rbar_composite(n)) < 1e-12
+    assert models.DiffuseSubsurfaceBRDF(coating=1.0).rbar == 0.0
 
 
 @pytest.mark.parametrize("n", [1.0, 1.3, 1.5, 2.0, 2.5])
 def test_unit_albedo(n):
-    m = models.DiffuseSubsurfaceBRDF(n=n, rho=1.0)
+    m = models.DiffuseSubsurfaceBRDF(coating=n, rho=1.0)
     for t in (0.0, 40.0, 85.0):
         ti = math.radians(t)
         r = integrated_reflectance(m, ti, tol=1e-9)
@@ -74,9 +74,9 @@ def test_printed_eq22_breaks_unit_albedo():
 
 def test_broadcast_shapes_and_grazing_zeros():
     for m in (
-        models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3)),
-        models.SingleScatterBRDF(n=1.0, phase=models.HenyeyGreenstein(-0.99, polarized=False)),
-        models.DiffuseSubsurfaceBRDF(n=1.0, rho=1.0),
+        models.SingleScatterBRDF(coating=1.5, phase=models.HenyeyGreenstein(0.3)),
+        models.SingleScatterBRDF(coating=1.0, phase=models.HenyeyGreenstein(-0.99, polarized=False)),
+        models.DiffuseSubsurfaceBRDF(coating=1.0, rho=1.0),
     ):
         M = m.mueller(np.array([[0.1], [0.5], [1.0]]), np.array([0.2, 0.4, 0.6, 0.8]), 0.3)
         assert M.shape == (3, 4, 4, 4)
@@ -85,7 +85,7 @@ def test_broadcast_shapes_and_grazing_zeros():
 
 
 def test_depolarizing_single_structure():
-    m = models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.3, polarized=False))
+    m = models.SingleScatterBRDF(coating=1.5, phase=models.HenyeyGreenstein(0.3, polarized=False))
     M = m.mueller(0.4, 0.9, 1.0)
     assert np.all(M[2:, :] == 0) and np.all(M[:, 2:] == 0)
     assert m.depolarizing and not models.SingleScatterBRDF().depolarizing
@@ -100,8 +100,8 @@ def test_depolarizing_single_structure():
         (lambda: models.HenyeyGreenstein(g=-1.2), "g"),
         (lambda: models.HenyeyGreenstein(g=0.1, polarized="yes"), "polarized"),
         (lambda: models.DiffuseSubsurfaceBRDF(rho=1.01), "rho"),
-        (lambda: models.DiffuseSubsurfaceBRDF(n=0.9), "n"),
-        (lambda: models.SingleScatterBRDF(n=1.5 + 0.1j), "n"),
+        (lambda: models.DiffuseSubsurfaceBRDF(coating=0.9), "n"),
+        (lambda: models.SingleScatterBRDF(coating=1.5 + 0.1j), "n"),
         (lambda: models.SingleScatterBRDF(phase=0.3), "phase"),
     ],
 )

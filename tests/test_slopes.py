@@ -113,3 +113,22 @@ def test_tabulated_rejects_bad_tables():
         models.TabulatedSlopes(zeta=(0.0, 0.2, 0.1), values=(1, 1, 1))
     with pytest.raises(ValueError, match="values"):
         models.TabulatedSlopes(zeta=(0.0, 0.2), values=(1, -1))
+
+
+@pytest.mark.parametrize("a, b", [(0.05, 0.3), (0.2, 0.2), (0.4, 0.1)])
+def test_stroke_slopes_second_moments(a, b):
+    """Eq. 19's m_parallel and m_perpendicular are not the rms slopes along and across the
+    strokes: <u^2> = a^2 b / (a + b), <v^2> = b^2 a / (a + b) (declared descriptions)."""
+    s = models.StrokeSlopes(a, b, 0.0)
+    # polar quadrature: Gauss-Legendre in |zeta| up to 12 m(beta)'s worth, uniform in beta
+    beta = (np.arange(2048) + 0.5) * (2 * math.pi / 2048)
+    x, w = np.polynomial.legendre.leggauss(200)
+    rmax = 12 * max(a, b)
+    r = 0.5 * rmax * (x + 1)
+    R, B = np.meshgrid(r, beta, indexing="ij")
+    u, v = R * np.cos(B), R * np.sin(B)
+    dens = s.p3(u, v) * R * (0.5 * rmax * w)[:, None] * (2 * math.pi / 2048)
+    assert abs(dens.sum() - 1) < 1e-12
+    np.testing.assert_allclose((u * u * dens).sum(), a * a * b / (a + b), rtol=1e-10)
+    np.testing.assert_allclose((v * v * dens).sum(), b * b * a / (a + b), rtol=1e-10)
+    assert abs((u * v * dens).sum()) < 1e-15

@@ -35,6 +35,21 @@ IRON = 2.29 + 3.37j
 SUBSTRATES = (IRON, 1.37 + 7.62j, 1.5, 3.88 + 0.02j, math.inf)
 
 
+def _energy_published(model):
+    """Energy normalization with Eq. 24's printed solid angle: the printed (``paper``) varnished
+    model divided by the exact 4 pi (the model has no single convention for this pair)."""
+    return (1.0 / (4.0 * math.pi)) * model
+
+
+def _jacobian(ti, tr, nv):
+    """Refraction Jacobian ``n_v^2 cos Psi cos Theta / (cos psi cos theta)`` between Eq. 24's
+    denominator and the refraction-consistent one."""
+    ci, cr = np.cos(ti), np.cos(tr)
+    cI = np.sqrt(1 - (np.sin(ti) / nv) ** 2)
+    cR = np.sqrt(1 - (np.sin(tr) / nv) ** 2)
+    return nv * nv * cI * cR / (ci * cr)
+
+
 def _rel_where_both(a, b):
     both = (a > 0) & (b > 0)
     mismatch = int(np.sum((a > 0) != (b > 0)))
@@ -49,7 +64,9 @@ def ct_vs_facet_error(n=20000, seed=0):
     worst, mism, live = 0.0, 0, 0
     for m in (1e-3, 0.03, 0.3, 1.0, 2.0):
         for sub in SUBSTRATES:
-            ct = models.CookTorranceBRDF(m=m, substrate=sub, normalization="energy", shadowing="none")
+            ct = models.CookTorranceBRDF(
+                slopes=models.GaussianSlopes(m), substrate=sub, convention="corrected", shadowing="none"
+            )
             fa = models.FacetBRDF(slopes=models.GaussianSlopes(sigma=m), substrate=sub)
             e, k, nl = _rel_where_both(ct.brdf(ti, tr, pr), fa.brdf(ti, tr, pr))
             worst, mism, live = max(worst, e), mism + k, live + nl
@@ -57,14 +74,18 @@ def ct_vs_facet_error(n=20000, seed=0):
 
 
 def published_over_energy_error(n=20000):
+    """Max relative |paper / corrected / (4 pi) - 1|; for the varnished model the corrected
+    form also carries the refraction Jacobian, divided out here."""
     ti, tr, pr = _geoms(n, 1)
     worst = 0.0
     for cls, kw in (
-        (models.CookTorranceBRDF, {"m": 0.2}),
-        (models.VarnishedCookTorranceBRDF, {"m_parallel": 0.05, "m_perpendicular": 0.4, "stroke_angle": 0.3}),
+        (models.CookTorranceBRDF, {"slopes": models.GaussianSlopes(0.2)}),
+        (models.VarnishedCookTorranceBRDF, {"slopes": models.StrokeSlopes(0.05, 0.4, 0.3)}),
     ):
-        a = cls(normalization="published", **kw).brdf(ti, tr, pr)
-        b = cls(normalization="energy", **kw).brdf(ti, tr, pr)
+        a = cls(convention="paper", **kw).brdf(ti, tr, pr)
+        b = cls(convention="corrected", **kw).brdf(ti, tr, pr)
+        if cls is models.VarnishedCookTorranceBRDF:
+            b = b * _jacobian(ti, tr, 1.5)
         live = b > 0
         worst = max(worst, float(np.max(np.abs(a[live] / b[live] / (4 * math.pi) - 1))))
     return worst
@@ -77,11 +98,9 @@ def stroke_vs_facet_error(n=20000, seed=2):
     worst = 0.0
     for mp, mq, ang in ((0.05, 0.3, 0.4), (0.01, 1.0, -1.2), (0.2, 0.02, 2.0)):
         v = models.VarnishedCookTorranceBRDF(
-            m_parallel=mp,
-            m_perpendicular=mq,
-            stroke_angle=ang,
-            varnish=1.0,
-            normalization="energy",
+            slopes=models.StrokeSlopes(mp, mq, ang),
+            coating=1.0,
+            convention="corrected",  # at n_v = 1 the refraction Jacobian is 1: the energy normalization
             shadowing="none",
         )
         f = models.FacetBRDF(slopes=models.StrokeSlopes(mp, mq, ang), substrate=v.substrate)
@@ -106,7 +125,7 @@ def check_ct_vs_facet(ctx):
             "seed001: published / energy - 4 pi (relative)",
             published_over_energy_error(),
             1e-14,
-            "CookTorrance and varnished models",
+            "CookTorrance and varnished models (varnished: refraction Jacobian divided out)",
         ),
         judge(
             "seed001: Varnished(n_v=1, Eq. 19) = FacetBRDF(StrokeSlopes).M00",
@@ -180,7 +199,9 @@ def published_albedos(tol=1e-3):
     out = {}
     for ti in (17.0, 44.0, 63.0):
         r = integrated_reflectance(
-            models.CookTorranceBRDF(m=0.03, normalization="published"), math.radians(ti), tol
+            models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="paper"),
+            math.radians(ti),
+            tol,
         )
         out[ti] = r.value
     return out
@@ -192,7 +213,9 @@ def energy_albedos(tol=1e-4):
     for m in (0.03, 0.1, 0.3, 0.5):
         for sub in (IRON, math.inf):
             for ti in (0.0, 30.0, 60.0, 80.0, 89.9):
-                model = models.CookTorranceBRDF(m=m, substrate=sub, normalization="energy")
+                model = models.CookTorranceBRDF(
+                    slopes=models.GaussianSlopes(m), substrate=sub, convention="corrected"
+                )
                 r = integrated_reflectance(model, math.radians(ti), tol=tol)
                 out.append((m, sub, ti, r.value, r.error))
     return out
@@ -241,8 +264,12 @@ def varnish_albedos(tol=1e-4):
     for m in (0.03, 0.1, 0.5):
         for sa in ("published", "refracted"):
             model = models.VarnishedCookTorranceBRDF(
-                m_parallel=m, m_perpendicular=m, substrate=math.inf, normalization="energy", solid_angle=sa
+                slopes=models.StrokeSlopes(m, m),
+                substrate=math.inf,
+                convention="paper" if sa == "published" else "corrected",
             )
+            if sa == "published":
+                model = _energy_published(model)
             for ti in (0.0, 30.0, 60.0, 80.0, 89.0):
                 r = integrated_reflectance(model, math.radians(ti), tol=tol)
                 rs, rp = models.fresnel_reflectance(math.cos(math.radians(ti)), 1.0, 1.5)
@@ -288,15 +315,15 @@ def check_varnish_energy(ctx, rows=None):
 # ------------------------------------------------------------------ reciprocity
 def seed001_models():
     return [
-        models.CookTorranceBRDF(m=0.03),
-        models.CookTorranceBRDF(m=0.5, substrate=1.5, normalization="energy"),
+        models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03)),
+        models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.5), substrate=1.5, convention="corrected"),
         models.VarnishedCookTorranceBRDF(),
-        models.VarnishedCookTorranceBRDF(
-            m_parallel=0.05, m_perpendicular=0.4, stroke_angle=0.7, solid_angle="refracted"
+        # published normalization with the refracted solid angle: 4 pi times the corrected form
+        (4.0 * math.pi)
+        * models.VarnishedCookTorranceBRDF(
+            slopes=models.StrokeSlopes(0.05, 0.4, 0.7), convention="corrected"
         ),
-        models.VarnishedCookTorranceBRDF(
-            m_parallel=0.3, m_perpendicular=0.01, stroke_angle=-2.0, varnish=2.0
-        ),
+        models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.3, 0.01, -2.0), coating=2.0),
     ]
 
 
@@ -315,15 +342,17 @@ def check_reciprocity(ctx):
 
 # ------------------------------------------------------------------ varnish vs subsurface
 def _pair(m=0.1, nv=1.5, sub=IRON, solid_angle="published"):
+    """Energy-normalized varnished model with Eq. 24's (``published``) or the refracted
+    solid angle, and the subsurface facet model it is compared with."""
     v = models.VarnishedCookTorranceBRDF(
-        m_parallel=m,
-        m_perpendicular=m,
-        varnish=nv,
+        slopes=models.StrokeSlopes(m, m),
+        coating=nv,
         substrate=sub,
-        normalization="energy",
+        convention="paper" if solid_angle == "published" else "corrected",
         shadowing="none",
-        solid_angle=solid_angle,
     )
+    if solid_angle == "published":
+        v = _energy_published(v)
     s = models.SubsurfaceFacetBRDF(slopes=models.GaussianSlopes(sigma=m), coating=nv, substrate=sub)
     return v, s
 
@@ -493,22 +522,24 @@ def anisotropy_text(ctx):
 
 # ------------------------------------------------------------------ extremes
 def extreme_seed001_models():
-    base = models.VarnishedCookTorranceBRDF(normalization="energy")
+    base = _energy_published(models.VarnishedCookTorranceBRDF())
     out = []
     for m in (1e-6, 0.03, 2.0):
         for sub in (IRON, 1.5, 1.0 + 0j, math.inf):
-            for norm in ("published", "energy"):
+            for conv in ("paper", "corrected"):
                 for sh in ("blinn", "none"):
-                    out.append(models.CookTorranceBRDF(m=m, substrate=sub, normalization=norm, shadowing=sh))
+                    out.append(
+                        models.CookTorranceBRDF(
+                            slopes=models.GaussianSlopes(m), substrate=sub, convention=conv, shadowing=sh
+                        )
+                    )
                     out.append(
                         models.VarnishedCookTorranceBRDF(
-                            m_parallel=m, m_perpendicular=m, substrate=sub, normalization=norm, shadowing=sh
+                            slopes=models.StrokeSlopes(m, m), substrate=sub, convention=conv, shadowing=sh
                         )
                     )
     for mp, mq in ((0.01, 1.0), (1.0, 0.01), (1e-6, 1e-4), (0.02, 2.0)):
-        out.append(
-            models.VarnishedCookTorranceBRDF(m_parallel=mp, m_perpendicular=mq, stroke_angle=0.3, varnish=2.2)
-        )
+        out.append(models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(mp, mq, 0.3), coating=2.2))
     out.append(models.PointSourceBRDF(model=base, distance=math.inf, resolution=2))
     out.append(models.PointSourceBRDF(model=base, distance=1e12, resolution=2))
     out.append(models.PointSourceBRDF(model=base, distance=1.0, sample_radius=1.0, resolution=3))
@@ -539,7 +570,7 @@ def check_extremes(ctx):
 # ------------------------------------------------------------------ point source
 def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_deg=17.0, resolution=8):
     """Max |f_g - f| / max f over an in-plane section, per source distance (R = 1)."""
-    base = models.VarnishedCookTorranceBRDF(normalization="energy")
+    base = _energy_published(models.VarnishedCookTorranceBRDF())
     tr = np.radians(np.linspace(0, 60, 241))
     ti = math.radians(ti_deg)
     f = base.brdf(ti, tr, 0.0)
@@ -555,7 +586,7 @@ def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_
 def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     """``{d: max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak}`` for the
     varnished iron plate, R = 1 (the reversed path from :mod:`validation.numerics.reciprocity`)."""
-    base = models.VarnishedCookTorranceBRDF(normalization="energy")
+    base = _energy_published(models.VarnishedCookTorranceBRDF())
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.4, (2, n))
     pr = rng.uniform(-0.3, 0.3, n)
@@ -661,7 +692,7 @@ def check_cauchy(ctx, integrals=None):
 def check_preset(ctx):
     worst = 0.0
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
-        psi_c, d = references.point_source_geometry(lo, hi)
+        psi_c, d = models.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=models.CookTorranceBRDF(), distance=d, sample_radius=1.0)
         a, b = ps.incidence_range(psi_c)
         worst = max(worst, abs(math.degrees(a) - lo), abs(math.degrees(b) - hi))
@@ -670,9 +701,16 @@ def check_preset(ctx):
 
 @text_section
 def preset_text(ctx):
-    ct_kw, vn_kw = references.iron_plate_models("published")
-    ct = models.CookTorranceBRDF(**ct_kw)
-    vn = models.VarnishedCookTorranceBRDF(**vn_kw)
+    plate = references.IRON_PLATE
+    ct = models.CookTorranceBRDF(
+        slopes=models.GaussianSlopes(plate["m"]), substrate=plate["substrate"], convention="paper"
+    )
+    vn = models.VarnishedCookTorranceBRDF(
+        slopes=models.StrokeSlopes(plate["m"], plate["m"]),
+        coating=plate["varnish"],
+        substrate=plate["substrate"],
+        convention="paper",
+    )
     lines = [
         "Iron plate of seed 001 (iron 2.29+3.37i at 650 nm, m = 0.03, n_v = 1.5), published normalization.",
         "Peak of the in-plane BRDF (1/sr) and its angle; point source sized to the printed incidence range:",
@@ -681,7 +719,7 @@ def preset_text(ctx):
     ]
     tr = np.radians(np.linspace(0, 89, 1781))
     for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]:
-        psi_c, d = references.point_source_geometry(lo, hi)
+        psi_c, d = models.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=vn, distance=d, sample_radius=1.0, resolution=16)
         cells = []
         for m in (ct, vn, ps):

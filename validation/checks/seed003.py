@@ -36,10 +36,10 @@ _FLOOR = 1e-250
 # ----------------------------------------------------------------------------- SCATMECH
 def _model_for(kind, ref, i):
     if kind == "diffuse":
-        return models.DiffuseSubsurfaceBRDF(n=ref["n"][i], rho=ref["rho"][i])
+        return models.DiffuseSubsurfaceBRDF(coating=ref["n"][i], rho=ref["rho"][i])
     if kind == "single":
         return models.SingleScatterBRDF(
-            n=ref["n"][i], phase=models.HenyeyGreenstein(ref["g"][i], polarized=False)
+            coating=ref["n"][i], phase=models.HenyeyGreenstein(ref["g"][i], polarized=False)
         )
     cls = models.GaussianSlopes if ref["sdf"][i] == "Gaussian" else models.ExponentialSlopes
     if kind == "mb":
@@ -74,7 +74,7 @@ def _scatmech_rbar_offset():
         rho = ref["rho"][i]
         if rho < 0.2 or ref["mueller"][i][0, 0] <= 0:
             continue
-        m = models.DiffuseSubsurfaceBRDF(n=ref["n"][i], rho=rho)
+        m = models.DiffuseSubsurfaceBRDF(coating=ref["n"][i], rho=rho)
         mine = m.brdf(ref["theta_i"][i], ref["theta_r"][i], ref["phi_r"][i])
         ratio = mine / ref["mueller"][i][0, 0]  # = (1 - rho Rs) / (1 - rho R)
         r_sc = (1.0 - ratio * (1.0 - rho * m.rbar)) / rho
@@ -140,7 +140,7 @@ def _specular(n, ti):
 def unit_albedo_error():
     worst = 0.0
     for n in ALBEDO_N:
-        m = models.DiffuseSubsurfaceBRDF(n=n, rho=1.0)
+        m = models.DiffuseSubsurfaceBRDF(coating=n, rho=1.0)
         for t in ALBEDO_TI:
             ti = math.radians(t)
             res = integrated_reflectance(m, ti, tol=1e-9)
@@ -160,7 +160,7 @@ def check_unit_albedo(ctx):
 
 def printed_eq22_albedo(n=1.5, ti=0.0):
     """R_spec + integral of DiffuseSubsurfaceBRDF(rho = 1) with Eq. 22's printed 1/(2 pi)."""
-    m = models.DiffuseSubsurfaceBRDF(n=n, rho=1.0)
+    m = models.DiffuseSubsurfaceBRDF(coating=n, rho=1.0)
     res = integrated_reflectance(m, ti, tol=1e-9)
     return _specular(n, ti) + res.value * (1.0 - m.rbar) / (1.0 - 0.5 * m.rbar)
 
@@ -298,9 +298,15 @@ _GEOM = (
 def mc_convergence_z(sigma=0.001, pairs=2000, seed=0, polarized=True):
     """max |M_MC - (Single + Diffuse)| / SE over elements with SE > 0 (surface=False)."""
     ph = models.HenyeyGreenstein(0.3, polarized=polarized)
-    ref = models.SingleScatterBRDF(n=1.5, phase=ph) + models.DiffuseSubsurfaceBRDF(n=1.5, rho=0.3)
+    ref = models.SingleScatterBRDF(coating=1.5, phase=ph) + models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.3)
     m = models.RoughDiffuseBRDF(
-        slopes=models.GaussianSlopes(sigma), n=1.5, phase=ph, rho=0.3, pairs=pairs, seed=seed, surface=False
+        slopes=models.GaussianSlopes(sigma),
+        coating=1.5,
+        phase=ph,
+        rho=0.3,
+        pairs=pairs,
+        seed=seed,
+        surface=False,
     )
     M, E = m.mueller_with_error(*_GEOM)
     R = ref.mueller(*_GEOM)
@@ -334,7 +340,7 @@ def mc_error_scaling(seeds=8):
     """Measured RMS error of M00 (vs a 100000-pair reference) and mean reported SE, per pairs."""
     kw = dict(
         slopes=models.ExponentialSlopes(0.5),
-        n=1.5,
+        coating=1.5,
         phase=models.HenyeyGreenstein(0.3),
         rho=0.3,
         surface=False,
@@ -384,9 +390,9 @@ def deterministic_reciprocity():
         models.MaxwellBeardBRDF(
             slopes=models.ExponentialSlopes(0.3), substrate=1.5, rho_d=0.05, rho_v=0.1, polarized=True
         ),
-        models.SingleScatterBRDF(n=1.5, phase=models.HenyeyGreenstein(0.6, polarized=True)),
-        models.SingleScatterBRDF(n=2.3, phase=models.HenyeyGreenstein(-0.4, polarized=False)),
-        models.DiffuseSubsurfaceBRDF(n=1.7, rho=0.8),
+        models.SingleScatterBRDF(coating=1.5, phase=models.HenyeyGreenstein(0.6, polarized=True)),
+        models.SingleScatterBRDF(coating=2.3, phase=models.HenyeyGreenstein(-0.4, polarized=False)),
+        models.DiffuseSubsurfaceBRDF(coating=1.7, rho=0.8),
     ):
         r = reciprocity_error(m, ti, tr, pr)
         worst[repr(m)] = max(r.scalar, r.mueller, r.jones or 0.0)
@@ -406,7 +412,7 @@ def check_reciprocity_seed003(ctx):
     ]
     m = models.RoughDiffuseBRDF(
         slopes=models.ExponentialSlopes(0.5),
-        n=1.5,
+        coating=1.5,
         phase=models.HenyeyGreenstein(0.3),
         rho=0.3,
         pairs=20000,
@@ -439,13 +445,13 @@ def energy_samples(count=12, seed=7):
         g = float(rng.uniform(-0.95, 0.95))
         for m in (
             models.SingleScatterBRDF(
-                n=n, phase=models.HenyeyGreenstein(g, polarized=bool(rng.random() < 0.5))
+                coating=n, phase=models.HenyeyGreenstein(g, polarized=bool(rng.random() < 0.5))
             ),
-            models.DiffuseSubsurfaceBRDF(n=n, rho=float(rng.uniform(0, 1))),
+            models.DiffuseSubsurfaceBRDF(coating=n, rho=float(rng.uniform(0, 1))),
             models.FacetBTDF(
                 slopes=models.GaussianSlopes(float(np.exp(rng.uniform(np.log(0.02), np.log(5))))),
                 substrate=max(n, 1.01),
-                normalization="exact",
+                convention="corrected",
             ),
         ):
             r = integrated_reflectance(m, ti, tol=1e-5)
@@ -470,7 +476,7 @@ def btdf_transmittances(sigma=1.0, n=1.5, ti_deg=60.0):
     """``(printed, exact)``: FacetBTDF's integrated transmittance with Eq. 37's and Eq. 36's normalization."""
     m = models.FacetBTDF(slopes=models.GaussianSlopes(sigma), substrate=n)
     r = integrated_reflectance(m, math.radians(ti_deg), tol=1e-5)
-    e = integrated_reflectance(m.replace(normalization="exact"), math.radians(ti_deg), tol=1e-5)
+    e = integrated_reflectance(m.replace(convention="corrected"), math.radians(ti_deg), tol=1e-5)
     return r.value, e.value
 
 
@@ -497,7 +503,7 @@ def check_btdf_paper_normalization(ctx, transmittances=None):
 def mc_energy(sigma, theta_i_deg, pairs=1000, **kw):
     m = models.RoughDiffuseBRDF(
         slopes=models.ExponentialSlopes(sigma),
-        n=1.5,
+        coating=1.5,
         phase=models.HenyeyGreenstein(0.3),
         pairs=pairs,
         seed=0,
@@ -511,7 +517,7 @@ def mc_energy_samples():
     reflectance: ``exact`` (rho = 1 diffuse + exact surface term), ``paper`` (the same with
     the Eq. 37 surface term), ``single`` (single scattering + exact surface term) and
     ``single+diffuse`` (both volume terms at rho = 1)."""
-    exact = dict(surface=True, surface_normalization="exact")
+    exact = dict(surface=True, convention="corrected")
     out = {}
     for sigma in (0.5, 2.0):
         for t in (0.0, 60.0, 85.0):
@@ -587,25 +593,27 @@ def check_extremes_seed003(ctx):
     for n in (1.0, 1.5, 2.5):
         for g in (-0.99, 0.0, 0.99):
             for pol in (True, False):
-                ms.append(models.SingleScatterBRDF(n=n, phase=models.HenyeyGreenstein(g, polarized=pol)))
+                ms.append(
+                    models.SingleScatterBRDF(coating=n, phase=models.HenyeyGreenstein(g, polarized=pol))
+                )
         for rho in (0.0, 1.0):
-            ms.append(models.DiffuseSubsurfaceBRDF(n=n, rho=rho))
+            ms.append(models.DiffuseSubsurfaceBRDF(coating=n, rho=rho))
         ms.append(
             models.MaxwellBeardBRDF(slopes=models.GaussianSlopes(0.3), substrate=n, rho_d=0.1, rho_v=0.05)
         )
     for s in (1e-4, 5.0):
-        for norm in ("paper", "exact"):
-            ms.append(models.FacetBTDF(slopes=models.ExponentialSlopes(s), substrate=1.5, normalization=norm))
+        for conv in ("paper", "corrected"):
+            ms.append(models.FacetBTDF(slopes=models.ExponentialSlopes(s), substrate=1.5, convention=conv))
         ms.append(
             models.RoughDiffuseBRDF(
                 slopes=models.ExponentialSlopes(s),
-                n=1.5,
+                coating=1.5,
                 phase=models.HenyeyGreenstein(0.99),
                 rho=1.0,
                 pairs=50,
             )
         )
-    ms.append(models.RoughDiffuseBRDF(slopes=models.GaussianSlopes(0.3), n=1.0, rho=0.0, pairs=50))
+    ms.append(models.RoughDiffuseBRDF(slopes=models.GaussianSlopes(0.3), coating=1.0, rho=0.0, pairs=50))
     bad, warned, _ = count_extremes(ms, ti, tr, pr)
     return judge(
         "seed 003 extremes: non-finite, negative M00, warnings",

@@ -31,8 +31,7 @@ from scipy import integrate, interpolate
 
 from models.base import Sum
 from models.facet import _FacetModel
-from models.params import param
-from models.slopes import SlopeDistribution
+from models.slopes import UnitSlopes
 
 __all__ = [
     "UnitSlopes",
@@ -47,19 +46,6 @@ __all__ = [
     "inversion_study",
     "inversion_figure",
 ]
-
-
-@dataclass(frozen=True)
-class UnitSlopes(SlopeDistribution):
-    """``P3(zeta) = 1`` for every slope: the model's BRDF *per unit slope density*.
-
-    Not a probability distribution (it does not normalize); only for inversion.
-    """
-
-    coverage: float = param(1.0, "fixed at 1", low=1.0, high=1.0)
-
-    def _p3_unit(self, zx, zy):
-        return np.ones(np.broadcast_shapes(np.shape(zx), np.shape(zy)))
 
 
 def facet_term(model):

@@ -2,7 +2,7 @@
 
 Every number is computed by the run, from the models and the analyses that
 already exist (:mod:`validation.checks.fig1`, :mod:`validation.checks.seed001`,
-:mod:`references.presets_seed003`, :mod:`validation.fitting.fit`, :mod:`validation.fitting.recovery`).
+:func:`references.seed003_presets`, :mod:`validation.fitting.fit`, :mod:`validation.fitting.recovery`).
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ import references  # noqa: E402
 from models.combination import mueller_with_error  # noqa: E402
 from models.geometry import signed_inplane  # noqa: E402
 from models.polarization import ellipsometric, stokes  # noqa: E402
-from references import presets_seed003  # noqa: E402
 from validation.numerics.integrate import integrated_reflectance  # noqa: E402
 
 from .core import Section, figure_block, table_block, text_block  # noqa: E402
@@ -169,21 +168,26 @@ def section_seed003_presets(ctx):
     incident = "linear:45"  # Sec. 3: "using 45 deg incident polarization"
     x = np.linspace(-85.0, 85.0, 69 if ctx.quick else 171)
     tr, pr = _signed(x)
-    carc_pairs = 200 if ctx.quick else presets_seed003.PRESETS["green_carc"]["params"]["pairs"]
+    from models import scene as scene_mod
+
+    presets = references.seed003_presets()
+    scenes = {name: scene_mod.load(pre["scene"]) for name, pre in presets.items()}
+    carc_pairs = 200 if ctx.quick else scenes["green_carc"].volume["pairs"]
     fig, axes = plt.subplots(3, 3, figsize=(13, 9), sharex=True)
     prow, trow = [], []
     x_tab = np.array([-60.0, -30.0, 0.0, 30.0, 45.0, 60.0, 75.0])
-    for j, name in enumerate(presets_seed003.names()):
-        pre = presets_seed003.PRESETS[name]
-        ti = math.radians(pre["theta_i_deg"])
-        model = presets_seed003.build(name, seed=ctx.seed)
+    for j, (name, pre) in enumerate(presets.items()):
+        sc = scenes[name]
+        ti = sc.theta_i
+        model = sc.build()
         if name == "green_carc":
-            model = model.replace(pairs=carc_pairs)
+            model = model.replace(pairs=carc_pairs, seed=ctx.seed)
         M, E = mueller_with_error(model, ti, tr, pr)
         f, eta, P = _pol_from_mueller(M, incident)
         se = E[..., 0, 0]
-        slopes_cls = getattr(models, pre["params"].get("slopes", "GaussianSlopes"))
-        mb, par = _fit_maxwell_beard(x, M[..., 0, 0], ti, slopes_cls, pre["params"]["n"])
+        rough = sc.coating.get("roughness")
+        slopes_cls = type(rough) if rough is not None else models.GaussianSlopes
+        mb, par = _fit_maxwell_beard(x, M[..., 0, 0], ti, slopes_cls, sc.coating["index"])
         fm, etam, Pm = _pol_from_mueller(mb.mueller(ti, tr, pr), incident)
         ax = axes[0, j]
         ax.semilogy(x, f, "-", label=f"preset ({pre['model'].split(' (')[0]})")
@@ -192,7 +196,7 @@ def section_seed003_presets(ctx):
                 x, np.maximum(f - 2 * se, 1e-12), f + 2 * se, alpha=0.3, lw=0, label="+- 2 SE (MC)"
             )
         ax.semilogy(x, fm, "--", label="Maxwell-Beard (fitted)")
-        ax.set_title(f"{pre['sample']} ({pre['wavelength_nm']:g} nm)", fontsize=9)
+        ax.set_title(f"{pre['sample']} ({sc.wavelength_nm:g} nm)", fontsize=9)
         ax.legend(fontsize=6)
         axes[1, j].plot(x, np.degrees(eta), "-", x, np.degrees(etam), "--")
         axes[2, j].plot(x, P, "-", x, Pm, "--")
@@ -239,7 +243,7 @@ def section_seed003_presets(ctx):
         figure_block(
             fig,
             "In-plane BRDF, principal angle eta and degree of polarization P at theta_i = 60 deg for light "
-            "polarized at 45 deg (seed 003 Sec. 3), for the presets of references/presets_seed003.py (solid) and "
+            "polarized at 45 deg (seed 003 Sec. 3), for the presets of references/data/presets.toml (solid) and "
             "the polarized Maxwell-Beard model fitted to each preset's in-plane BRDF (dashed). Green CARC: "
             f"RoughDiffuseBRDF Monte Carlo with {carc_pairs} facet pairs per geometry (seed {ctx.seed}), band = "
             "+- 2 standard errors of M00.",
@@ -296,7 +300,9 @@ def section_seed001(ctx):
     rows = []
     for t, v in pub.items():
         e = integrated_reflectance(
-            models.CookTorranceBRDF(m=0.03, normalization="energy"), math.radians(t), tol=1e-3
+            models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="corrected"),
+            math.radians(t),
+            tol=1e-3,
         )
         rows.append(
             {
@@ -311,7 +317,8 @@ def section_seed001(ctx):
         text_block(
             "Eq. 7-8 as printed have no 1/pi in D and no 4 in the denominator: the published BRDF is 4 pi times "
             f"the energy-normalized one. Measured max |published / energy / (4 pi) - 1| = {ratio_err:.2e} over "
-            "20000 random geometries (CookTorranceBRDF m = 0.2 and an anisotropic varnished model). Albedos "
+            "20000 random geometries (CookTorranceBRDF m = 0.2 and an anisotropic varnished model, its refraction "
+            "Jacobian divided out). Albedos "
             "(hemispherical integral of M00 cos theta_r, tol 1e-3) of the iron plate model (m = 0.03, iron "
             "2.29+3.37i, Blinn shadowing):"
         )
@@ -383,13 +390,18 @@ def section_seed001(ctx):
         )
     )
     # --- point source vs collimated, iron plate
-    ct_kw, vn_kw = references.iron_plate_models("published")
-    vn = models.VarnishedCookTorranceBRDF(**vn_kw)
-    ranges = references.IRON_PLATE["incidence_ranges_deg"]
+    plate = references.IRON_PLATE
+    vn = models.VarnishedCookTorranceBRDF(
+        slopes=models.StrokeSlopes(plate["m"], plate["m"]),
+        coating=plate["varnish"],
+        substrate=plate["substrate"],
+        convention="paper",
+    )
+    ranges = plate["incidence_ranges_deg"]
     fig, axes = plt.subplots(1, len(ranges), figsize=(13, 3.6))
     prow = []
     for ax, (lo, hi) in zip(axes, ranges, strict=True):
-        psi_c, d = references.point_source_geometry(lo, hi)
+        psi_c, d = models.point_source_geometry(lo, hi)
         ps = models.PointSourceBRDF(model=vn, distance=d, sample_radius=1.0, resolution=16)
         a_lo, a_hi = ps.incidence_range(psi_c)
         tr = np.radians(np.linspace(max(math.degrees(psi_c) - 10.0, 0.0), math.degrees(psi_c) + 10.0, 801))

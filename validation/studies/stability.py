@@ -95,7 +95,7 @@ _BASES = {
     # negative or unphysical matrices, not for Monte Carlo precision
     "RoughDiffuseBRDF": lambda: models.RoughDiffuseBRDF(pairs=200),
     "PointSourceBRDF": lambda: models.PointSourceBRDF(
-        model=models.CookTorranceBRDF(normalization="energy"), distance=100.0, sample_radius=1.0
+        model=models.CookTorranceBRDF(convention="corrected"), distance=100.0, sample_radius=1.0
     ),
     # a narrow lobe (rms slope 0.02) under seed 000's 0.7 deg aperture: the aperture matters
     "DetectorAperture": lambda: models.DetectorAperture(

@@ -137,7 +137,7 @@ def knob_mc_pairs(quick=False):
 
     def mc(pairs, seed):
         return models.RoughDiffuseBRDF(
-            slopes=slopes, n=n, phase=phase, rho=rho, pairs=pairs, seed=seed, surface=False
+            slopes=slopes, coating=n, phase=phase, rho=rho, pairs=pairs, seed=seed, surface=False
         )
 
     ref_pairs = 20_000 if quick else 60_000
@@ -168,7 +168,9 @@ def knob_mc_pairs(quick=False):
 def knob_point_source(quick=False):
     """Exact superposition (seed 001 Eq. 28) at increasing quadrature resolution against a
     resolution-96 evaluation (converged to ~1e-12), iron plate, d/R = 10."""
-    inner = models.CookTorranceBRDF(m=0.03, substrate=2.29 + 3.37j, normalization="energy")
+    inner = models.CookTorranceBRDF(
+        slopes=models.GaussianSlopes(0.03), substrate=2.29 + 3.37j, convention="corrected"
+    )
     theta_i = math.radians(45)
     tr = np.radians(np.linspace(30, 60, 61))
     ref = models.PointSourceBRDF(model=inner, distance=10.0, sample_radius=1.0, resolution=96).brdf(

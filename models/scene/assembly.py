@@ -1,0 +1,149 @@
+"""Mechanism assembly: the models a validated scene declares, each with the reason it is there.
+
+The substrate's mechanism comes from its model's entry in :data:`models.scene.table.TABLE`
+(``facet``, ``cook-torrance``, ``maxwell-beard``); the coating's rough top surface and the
+volume scatterer (seed 003) follow.  Nothing here measures anything: that is
+:mod:`models.scene.decisions`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..base import Model
+from ..cook_torrance import CookTorranceBRDF
+from ..diffuse_subsurface import DiffuseSubsurfaceBRDF
+from ..facet import FacetBRDF
+from ..maxwell_beard import MaxwellBeardBRDF
+from ..phase import HenyeyGreenstein
+from ..rough_diffuse import RoughDiffuseBRDF
+from ..single_scatter import SingleScatterBRDF
+from ..slopes import GaussianSlopes
+from ..subsurface_facet import SubsurfaceFacetBRDF
+from ..varnished import VarnishedCookTorranceBRDF
+
+__all__ = [
+    "Mechanism",
+    "mechanisms",
+    "facet_mechanisms",
+    "cook_torrance_mechanisms",
+    "maxwell_beard_mechanisms",
+]
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """One scattering mechanism of a scene: its name, its model and why it is there."""
+
+    name: str
+    model: Model
+    why: str
+
+
+def mechanisms(substrate: dict | None, coating: dict | None, volume: dict | None) -> list[Mechanism]:
+    """The mechanisms of a scene's validated ``[substrate]``, ``[coating]`` and ``[volume]``."""
+    coat_n = coating["index"] if coating else None
+    rough_top = coating.get("roughness") if coating else None
+    out = [] if substrate is None else substrate["entry"].mechanisms(substrate, coat_n)
+    if rough_top is not None:
+        out.append(
+            Mechanism(
+                "rough coating surface",
+                FacetBRDF(slopes=rough_top, substrate=coat_n),
+                "the coating's top surface is rough: facet reflection by the exposed interface",
+            )
+        )
+    if volume is not None:
+        out = _volume_mechanisms(out, volume, coat_n, rough_top)
+    return out
+
+
+def facet_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
+    """Facets (flakes or a rough substrate), under the coating when there is one."""
+    if sub["slopes"] is None:
+        return []  # a flat substrate only reflects specularly
+    if coat_n is not None:
+        model = SubsurfaceFacetBRDF(slopes=sub["slopes"], coating=coat_n, substrate=sub["index"])
+        why = "facets (flakes or a rough substrate) under the coating: seed 000's subsurface facet model"
+        return [Mechanism("subsurface facets", model, why)]
+    model = FacetBRDF(slopes=sub["slopes"], substrate=sub["index"])
+    return [Mechanism("exposed facets", model, "a rough substrate with no coating: the exposed facet model")]
+
+
+def cook_torrance_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
+    """Seed 001: a bare isotropic metal is Cook-Torrance (Eq. 7-18); a coated or brushed
+    one is the varnish extension (Eq. 19-24; ``n_v = 1`` without a coating)."""
+    kw = sub["params"]  # slopes (StrokeSlopes), convention, shadowing
+    iso = kw["slopes"].isotropic
+    if coat_n is None and iso:
+        model = CookTorranceBRDF(
+            slopes=GaussianSlopes(sigma=kw["slopes"].m_parallel),
+            substrate=sub["index"],
+            convention=kw["convention"],
+            shadowing=kw["shadowing"],
+        )
+        return [
+            Mechanism(
+                "Cook-Torrance reflection", model, "a bare rough metal described by seed 001 (Eq. 7-18)"
+            )
+        ]
+    model = VarnishedCookTorranceBRDF(coating=1.0 if coat_n is None else coat_n, substrate=sub["index"], **kw)
+    why = "seed 001's varnish extension (Eq. 19-24)" + (
+        "" if iso else " with brushed (anisotropic) roughness"
+    )
+    return [Mechanism("varnished Cook-Torrance reflection", model, why)]
+
+
+def maxwell_beard_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
+    """The empirical Maxwell-Beard BRDF (the scene refuses a coating or volume beside it)."""
+    kw = sub["params"]
+    model = MaxwellBeardBRDF(slopes=sub["slopes"], substrate=sub["index"], **kw)
+    why = (
+        "the empirical Maxwell-Beard BRDF (shadowed specular facets + Lambertian + volumetric "
+        "terms, no interface): the model seed 003 Sec. 4 compares its combination with"
+        + ("" if kw["polarized"] else "; published scalar form, depolarizing")
+    )
+    return [Mechanism("Maxwell-Beard", model, why)]
+
+
+def _volume_mechanisms(out, v, n, rough_top):
+    """Seed 003: volume scattering in the binder (index = the coating's)."""
+    phase = HenyeyGreenstein(g=v["g"], polarized=v["polarized"])
+    if rough_top is not None and v["interface"] == "rough":
+        # The Monte Carlo model carries the direct reflection by the rough surface
+        # (surface=True), so the separate rough-surface facet term is replaced.
+        out = [m for m in out if m.name != "rough coating surface"]
+        model = RoughDiffuseBRDF(
+            slopes=rough_top,
+            coating=n,
+            phase=phase,
+            rho=v["rho"],
+            pairs=v["pairs"],
+            seed=v["seed"],
+            surface=True,
+            single=v["single_weight"] if v["single"] else 0.0,
+        )
+        why = (
+            "a volume scatterer under a rough interface: seed 003 Sec. 2.5 Monte Carlo (two facets "
+            "per path), including the direct reflection by the rough surface"
+        )
+        return out + [Mechanism("volume under a rough interface (Monte Carlo)", model, why)]
+    under = (
+        "under a smooth interface"
+        if rough_top is None
+        else "treated as under a smooth interface, as seed 003 does for the red paint (interface = 'smooth')"
+    )
+    if v["single"]:
+        single = SingleScatterBRDF(coating=n, phase=phase)
+        if v["single_weight"] != 1.0:
+            single = v["single_weight"] * single
+        why = f"single scattering by the pigment {under} (seed 003 Eq. 8-20); no Monte Carlo needed"
+        out.append(Mechanism("single volume scattering", single, why))
+    if v["rho"] > 0:
+        model = DiffuseSubsurfaceBRDF(coating=n, rho=v["rho"])
+        out.append(
+            Mechanism(
+                "totally diffuse volume", model, f"multiply scattered light {under} (seed 003 Eq. 21-28)"
+            )
+        )
+    return out
