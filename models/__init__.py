@@ -19,10 +19,12 @@ from .polarization import (
 from .slopes import (
     AnisotropicExponentialSlopes,
     AnisotropicGaussianSlopes,
+    AnisotropicGGXSlopes,
     ExponentialAngles,
     ExponentialSlopes,
     GaussianAngles,
     GaussianSlopes,
+    GGXSlopes,
     SlopeDistribution,
     TabulatedSlopes,
 )
@@ -43,6 +45,8 @@ __all__ = [
     "GaussianAngles",
     "ExponentialAngles",
     "TabulatedSlopes",
+    "GGXSlopes",
+    "AnisotropicGGXSlopes",
     "fresnel_coefficients",
     "fresnel_reflectance",
     "fresnel_transmittance",
