@@ -48,6 +48,7 @@ from .base import Model
 from .geometry import sp_basis
 from .params import param
 from .polarization import mueller16_from_jones
+from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import GaussianSlopes, SlopeDistribution
 
 __all__ = ["FacetBTDF", "facet_transmission_jones", "ray_basis", "angle_basis", "projected_area"]
@@ -170,6 +171,14 @@ class FacetBTDF(Model):
         ``"exact"``: Eq. 36 normalized exactly, by ``N = <(cos theta_i -
         k_xy . zeta)_+>`` (:func:`projected_area`): every incident ray meets
         one facet, and reflection plus transmission integrate to 1.
+    shadowing : str
+        ``"none"`` (seed 003), ``"smith"`` or ``"smith-correlated"``
+        (:mod:`models.shadowing`): the incident direction's shadowing and the
+        masking of the transmitted direction from below, ``chi+`` on each (Walter
+        et al. 2007 Eq. 21-23).  Smith's ``G1`` satisfies ``int G1(i) (i.m)+ D dm =
+        cos theta_i``, the projected-area identity that ``"paper"`` assumes, so it
+        goes with ``normalization="paper"`` only (``"exact"`` corrects the same
+        projected area without shadowing).
     """
 
     slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", kind="object")
@@ -177,6 +186,7 @@ class FacetBTDF(Model):
     normalization: str = param(
         "paper", "Eq. 37 (paper, SCATMECH) or exact Eq. 36", kind="choice", choices=("paper", "exact")
     )
+    shadowing: str = param("none", "shadowing-masking", kind="choice", choices=SHADOWING)
 
     transmission = True
     _angle_names = ("theta_i", "theta_t", "phi_t")
@@ -194,6 +204,12 @@ class FacetBTDF(Model):
             raise ValueError(
                 "normalization 'exact' needs isotropic slopes (its projected area is the isotropic "
                 f"average); got {self.slopes!r}; use normalization='paper'"
+            )
+        check_shadowing(self.shadowing, self.slopes)
+        if self.shadowing != "none" and self.normalization != "paper":
+            raise ValueError(
+                f"normalization must be 'paper' with shadowing {self.shadowing!r} (Smith's G1 already "
+                "normalizes the projected area); got 'exact'"
             )
 
     def _parts(self, ti, tt, pt):
@@ -226,6 +242,11 @@ class FacetBTDF(Model):
         S = p3 * n * c_out * inv_cc / mz_l**4 * (n * n * c_out / np.where(live, D2, 1.0))
         if self.normalization == "exact":
             S = S * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))
+        if self.shadowing != "none":
+            # towards the source (azimuth pi) and along the transmitted ray (below: cos < 0)
+            v_i = (ci, si, -1.0, 0.0)
+            v_t = (-ct, st, cp, sp)
+            S = S * smith_g(self.shadowing, self.slopes, v_i, v_t, c_in, -c_out)
         S = np.where(live, S, 0.0)
         root = np.sqrt(S)
         return tuple((j * root, 0.0) for j in jones)  # real Jones matrix
