@@ -144,3 +144,22 @@ def mitsuba_roughconductor() -> dict:
     out["x_in"] = np.stack([col(f"xin_{c}") for c in "xyz"], -1)
     out["x_out"] = np.stack([col(f"xout_{c}") for c in "xyz"], -1)
     return out
+
+
+def tmm_reference() -> list[dict]:
+    """``tmm`` thin-film coefficients (``references/scripts/make_tmm_reference.py``): one dict
+    per case with ``n0``, ``films`` (list of ``(index, thickness_nm)``), ``substrate``,
+    ``wavelength_nm``, ``theta0`` and complex ``rs, rp, ts, tp``."""
+    out = []
+    for r in read_csv("tmm_reference.csv"):
+        films = []
+        for part in r["layers"].split("|"):
+            n, k, d = (float(x) for x in part.split(";"))
+            films.append((complex(n, k), d))
+        case = {"n0": float(r["n0"]), "films": films, "wavelength_nm": float(r["wavelength_nm"])}
+        case["substrate"] = complex(float(r["substrate_n"]), float(r["substrate_k"]))
+        case["theta0"] = float(r["theta0"])
+        for c in ("rs", "rp", "ts", "tp"):
+            case[c] = complex(float(r[f"{c}_re"]), float(r[f"{c}_im"]))
+        out.append(case)
+    return out
