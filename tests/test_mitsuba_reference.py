@@ -110,19 +110,13 @@ def _rel(a, b):
 
 
 @pytest.mark.parametrize("variant", ["scalar_rgb", "scalar_spectral_polarized"])
-def test_ggx_agrees_to_float32_precision(data, variant):
-    rows = _rows(data, variant, "ggx")
+@pytest.mark.parametrize("dist, tol", [("ggx", GGX_TOL), ("beckmann", BECKMANN_TOL)])
+def test_unpolarized_agreement(data, variant, dist, tol):
+    """GGX to float32 precision, Beckmann to Mitsuba's approximation of G1."""
+    rows = _rows(data, variant, dist)
     rel = [_rel(_ours(data, j)[0, 0], data["value"][j]) for j in rows]
     assert len(rows) >= 100
-    assert max(rel) <= GGX_TOL
-
-
-@pytest.mark.parametrize("variant", ["scalar_rgb", "scalar_spectral_polarized"])
-def test_beckmann_agrees_to_mitsubas_approximation(data, variant):
-    rows = _rows(data, variant, "beckmann")
-    rel = [_rel(_ours(data, j)[0, 0], data["value"][j]) for j in rows]
-    assert len(rows) >= 100
-    assert max(rel) <= BECKMANN_TOL
+    assert max(rel) <= tol
 
 
 def test_beckmann_difference_is_mitsubas_g1_alone(data):
