@@ -97,3 +97,9 @@ __all__ += ["MaxwellBeardBRDF"]
 from .aperture import DetectorAperture  # noqa: E402
 
 __all__ += ["DetectorAperture"]
+
+# --- issue 15: Smith shadowing-masking and thin-film stacks ----------------------------
+from . import shadowing  # noqa: E402
+from .thin_film import FilmStack, TabulatedIndex  # noqa: E402
+
+__all__ += ["shadowing", "FilmStack", "TabulatedIndex"]

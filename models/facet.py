@@ -38,14 +38,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Model
-from .fresnel import coating_transmission, substrate_rs_k
+from .fresnel import coating_transmission, reflection_rs_k
 from .params import param
 from .polarization import mueller16_from_jones
 from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import ExponentialSlopes, SlopeDistribution
 from .thin_film import FilmStack
 
-__all__ = ["FacetBRDF", "facet_jones"]
+__all__ = ["FacetBRDF", "facet_jones", "substrate_rs_k"]
+
+
+def substrate_rs_k(cos_i, n, substrate):
+    """``r_s`` and ``K = (r_s + r_p) / sin^2`` (:func:`models.fresnel.reflection_rs_k`) for
+    light in the coating ``n`` meeting ``substrate``: an index (``n + ik`` or ``math.inf``)
+    or a layer stack (:class:`models.FilmStack`, whose ``reflection_rs_k(cos_i, n)`` it
+    calls).  The one place the facet models take their reflection coefficients from."""
+    if isinstance(substrate, FilmStack):
+        return substrate.reflection_rs_k(cos_i, n)
+    m = substrate if substrate == math.inf else complex(substrate) / n
+    return reflection_rs_k(cos_i, m)
 
 
 def _polar(ti, tr, n):
@@ -73,7 +84,7 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     Flat float64 arrays in.  Zero where a ray is grazing (``theta = pi/2``: no
     projected area, as in SCATMECH) or where the slope density vanishes.
     ``substrate`` is an index or a :class:`models.FilmStack`
-    (:func:`models.fresnel.substrate_rs_k`); ``shadowing`` one of
+    (:func:`substrate_rs_k`); ``shadowing`` one of
     :data:`models.shadowing.SHADOWING` (``"none"``: seed 000's model, untouched),
     applied with the internal directions (in the coating).
     """

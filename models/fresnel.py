@@ -29,7 +29,6 @@ __all__ = [
     "fresnel_reflectance",
     "fresnel_transmittance",
     "reflection_rs_k",
-    "substrate_rs_k",
     "coating_transmission",
     "critical_angle",
 ]
@@ -114,17 +113,6 @@ def reflection_rs_k(cos_i, m):
     rs = (c - w) / cw
     k = 2.0 * (1.0 - m2) / (cw * (m2 * c + w))
     return rs, k
-
-
-def substrate_rs_k(cos_i, n1, substrate):
-    """:func:`reflection_rs_k` for light in the real ``n1`` meeting ``substrate``: an index
-    (``n + ik`` or ``math.inf``) or a layer stack (:class:`models.FilmStack`, whose
-    ``reflection_rs_k(cos_i, n1)`` it calls).  The one place the facet models take
-    their reflection coefficients from."""
-    if hasattr(substrate, "reflection_rs_k"):
-        return substrate.reflection_rs_k(cos_i, n1)
-    m = substrate if substrate == math.inf else complex(substrate) / n1
-    return reflection_rs_k(cos_i, m)
 
 
 def coating_transmission(cos_theta, n):
