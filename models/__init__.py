@@ -24,6 +24,7 @@ from .maxwell_beard import MaxwellBeardBRDF
 from .aperture import DetectorAperture
 
 # isort: on
+from . import shadowing
 from .fresnel import fresnel_coefficients, fresnel_reflectance, fresnel_transmittance
 from .params import ParamInfo
 from .polarization import (
@@ -37,16 +38,22 @@ from .polarization import (
 from .slopes import (
     AnisotropicExponentialSlopes,
     AnisotropicGaussianSlopes,
+    AnisotropicGGXSlopes,
     ExponentialAngles,
     ExponentialSlopes,
     GaussianAngles,
     GaussianSlopes,
+    GGXSlopes,
     SlopeDistribution,
     TabulatedSlopes,
     UnitSlopes,
 )
+from .thin_film import FilmStack, TabulatedIndex
 
 __all__ = [
+    "shadowing",
+    "FilmStack",
+    "TabulatedIndex",
     "CHUNK",
     "Model",
     "Sum",
@@ -62,6 +69,8 @@ __all__ = [
     "ExponentialAngles",
     "TabulatedSlopes",
     "UnitSlopes",
+    "GGXSlopes",
+    "AnisotropicGGXSlopes",
     "fresnel_coefficients",
     "fresnel_reflectance",
     "fresnel_transmittance",

@@ -41,32 +41,55 @@ from .base import Model
 from .fresnel import coating_transmission, reflection_rs_k
 from .params import param
 from .polarization import mueller16_from_jones
+from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import ExponentialSlopes, SlopeDistribution
+from .thin_film import FilmStack
 
-__all__ = ["FacetBRDF", "facet_jones"]
+__all__ = ["FacetBRDF", "facet_jones", "substrate_rs_k"]
 
 
-def facet_jones(ti, tr, pr, n, substrate, slopes):
-    """Jones elements ``(ss, ps, sp, pp)`` as ``(re, im)`` pairs of flat arrays
-    (``ps`` = p in, s out), scaled so that their Mueller matrix is the BRDF.
+def substrate_rs_k(cos_i, n, substrate):
+    """``r_s`` and ``K = (r_s + r_p) / sin^2`` (:func:`models.fresnel.reflection_rs_k`) for
+    light in the coating ``n`` meeting ``substrate``: an index (``n + ik`` or ``math.inf``)
+    or a layer stack (:class:`models.FilmStack`, whose ``reflection_rs_k(cos_i, n)`` it
+    calls).  The one place the facet models take their reflection coefficients from."""
+    if isinstance(substrate, FilmStack):
+        return substrate.reflection_rs_k(cos_i, n)
+    m = substrate if substrate == math.inf else complex(substrate) / n
+    return reflection_rs_k(cos_i, m)
 
-    Flat float64 arrays in.  Zero where a ray is grazing (``theta = pi/2``: no
-    projected area, as in SCATMECH) or where the slope density vanishes.
-    """
-    # Incident and scattered polar angles are handled as one (2, n) stack: the
+
+def _polar(ti, tr, n):
+    """``(cos_ext, sin_int, cos_int)``: cosines of the external polar angles and sines and
+    cosines of the internal (refracted) ones, each a ``(2, k)`` stack (incident, scattered)."""
+    # Incident and scattered polar angles are handled as one (2, k) stack: the
     # same trigonometry, Snell refraction and coating transmission for both.
     cos_ext = np.cos(np.stack([ti, tr]))
     # sin = sqrt(1 - cos^2): exact to ~1e-16 absolute (it loses relative precision
     # only below ~1e-8 rad, where sin enters additively); cos, which divides the
     # BRDF, stays exact.
     sin_ext = np.sqrt(1.0 - cos_ext * cos_ext)  # |cos| <= 1 from np.cos
-    sp, cp = np.sin(pr), np.cos(pr)
     if n == 1.0:
-        sin_int, cos_int = sin_ext, cos_ext
-    else:
-        sin_int = sin_ext * (1.0 / n)  # Eq. 2-3
-        # cos' = sqrt(n^2 - 1 + cos^2) / n: no cancellation at grazing incidence
-        cos_int = np.sqrt(n * n - 1.0 + cos_ext * cos_ext) * (1.0 / n)
+        return cos_ext, sin_ext, cos_ext
+    sin_int = sin_ext * (1.0 / n)  # Eq. 2-3
+    # cos' = sqrt(n^2 - 1 + cos^2) / n: no cancellation at grazing incidence
+    cos_int = np.sqrt(n * n - 1.0 + cos_ext * cos_ext) * (1.0 / n)
+    return cos_ext, sin_int, cos_int
+
+
+def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
+    """Jones elements ``(ss, ps, sp, pp)`` as ``(re, im)`` pairs of flat arrays
+    (``ps`` = p in, s out), scaled so that their Mueller matrix is the BRDF.
+
+    Flat float64 arrays in.  Zero where a ray is grazing (``theta = pi/2``: no
+    projected area, as in SCATMECH) or where the slope density vanishes.
+    ``substrate`` is an index or a :class:`models.FilmStack`
+    (:func:`substrate_rs_k`); ``shadowing`` one of
+    :data:`models.shadowing.SHADOWING` (``"none"``: seed 000's model, untouched),
+    applied with the internal directions (in the coating).
+    """
+    cos_ext, sin_int, cos_int = _polar(ti, tr, n)
+    sp, cp = np.sin(pr), np.cos(pr)
     si, sr = sin_int
     ci, cr = cos_int
     # h = k_r' - k_i' bisects the internal directions: facet normal h/|h| (Eq. 5-7).
@@ -81,23 +104,30 @@ def facet_jones(ti, tr, pr, n, substrate, slopes):
     S = p3 * q * q / (4.0 * cos_ext[0] * cos_ext[1])
     if ti.max() >= 0.5 * math.pi or tr.max() >= 0.5 * math.pi:
         S[(ti >= 0.5 * math.pi) | (tr >= 0.5 * math.pi)] = 0.0
-    root = np.sqrt(S)
+    if shadowing != "none":
+        # both directions see the facet from its front (v.m = cos(alpha) > 0): no chi+ test;
+        # the incident direction (towards the source) has azimuth pi
+        S = S * smith_g(shadowing, slopes, (ci, si, -1.0, 0.0), (cr, sr, cp, sp))
     c = 0.5 * np.sqrt(g)  # cos(alpha), local incidence in the coating (|h| <= 2)
-    m = substrate if substrate == math.inf else complex(substrate) / n
-    rs, K = reflection_rs_k(c, m)
-    # q_ab = r_s D_ab + (K - 2 r_s) (e_a.h)(e_b.h)/|h|^2  (see module docstring)
+    rs, K = substrate_rs_k(c, n, substrate)
+    # s_r'.h, p_r'.h (a2, Eq. 19b), s_i'.h / |h|^2, p_i'.h / |h|^2 (a3, Eq. 19c)
+    inv_g = 1.0 / g
+    h_dots = (si * sp, cr * cp * si + sr * ci, sr * sp * inv_g, (ci * sr * cp + si * cr) * inv_g)
+    d = (cp, -sp * ci, -cr * sp, sr * si - cr * cp * ci)  # e_a . e_b for ss, ps, sp, pp
+    return _jones_elements(rs, K, np.sqrt(S), h_dots, d, cos_ext, n)
+
+
+def _jones_elements(rs, K, root, h_dots, d, cos_ext, n):
+    """``q_ab = r_s D_ab + (K - 2 r_s) (e_a.h)(e_b.h)/|h|^2`` (module docstring) as
+    ``(re, im)`` pairs scaled by ``root``, with the coating's transmission factors."""
     r_re = rs.real * root
     r_im = rs.imag * root
     k_re = K.real * root
     k_re -= 2.0 * r_re
     k_im = K.imag * root
     k_im -= 2.0 * r_im
-    inv_g = 1.0 / g
-    ho_s = si * sp  # s_r'.h
-    ho_p = cr * cp * si + sr * ci  # p_r'.h  (a2, Eq. 19b)
-    hi_s = sr * sp * inv_g  # s_i'.h / |h|^2
-    hi_p = (ci * sr * cp + si * cr) * inv_g  # p_i'.h / |h|^2  (a3, Eq. 19c)
-    d_ss, d_ps, d_sp, d_pp = cp, -sp * ci, -cr * sp, sr * si - cr * cp * ci  # e_a . e_b
+    ho_s, ho_p, hi_s, hi_p = h_dots
+    d_ss, d_ps, d_sp, d_pp = d
     if n != 1.0:
         # Eq. 14-18: t(theta_r; 1, n) on the way out, t(theta_i; 1, n) on the way in.
         (tsi, tsr), (tpi, tpr) = coating_transmission(cos_ext, n)
@@ -128,11 +158,21 @@ def facet_jones(ti, tr, pr, n, substrate, slopes):
 class _FacetModel(Model):
     """Shared evaluation of the exposed and the coated facet models."""
 
+    def __post_init__(self):
+        # A FilmStack validates itself; the declared index check applies to plain
+        # indices, so a stack stands aside (its bottom medium in its place) meanwhile.
+        stack = self.substrate if isinstance(self.substrate, FilmStack) else None
+        if stack is not None:
+            object.__setattr__(self, "substrate", stack.indices[1])
+        super().__post_init__()
+        if stack is not None:
+            object.__setattr__(self, "substrate", stack)
+
     def _coating(self) -> float:
         return 1.0
 
     def _parts(self, ti, tr, pr):
-        return facet_jones(ti, tr, pr, self._coating(), self.substrate, self.slopes)
+        return facet_jones(ti, tr, pr, self._coating(), self.substrate, self.slopes, self.shadowing)
 
     def _mueller16(self, ti, tr, pr):
         return mueller16_from_jones(*self._parts(ti, tr, pr))
@@ -154,6 +194,7 @@ class _FacetModel(Model):
             raise ValueError(
                 f"slopes must be a slope distribution (e.g. models.ExponentialSlopes); got {self.slopes!r}"
             )
+        check_shadowing(self.shadowing, self.slopes)
 
     def rotated(self, angle):
         return self._rotated_slopes(angle)
@@ -177,18 +218,25 @@ class FacetBRDF(_FacetModel):
     """Facet reflection from an exposed rough interface (seed 000 Eq. 48-49 with n = 1).
 
     Ray-optics (Kirchhoff tangent-plane, stationary-phase) limit with no
-    shadowing and no multiple scattering; the Jones matrix is the facet's
-    Fresnel reflection in the s/p bases of the two rays.  SCATMECH:
-    ``Facet_BRDF_Model`` (``type = 0``).
+    multiple scattering and, by default, no shadowing; the Jones matrix is the
+    facet's Fresnel reflection in the s/p bases of the two rays.  SCATMECH:
+    ``Facet_BRDF_Model`` (``type = 0``).  With ``shadowing="smith"`` and GGX or
+    Gaussian slopes it is Mitsuba 3's ``roughconductor`` (divided by
+    ``cos theta``), polarized.
 
     Parameters
     ----------
     slopes : SlopeDistribution
         Facet slope distribution ``P3^xy`` (e.g. :class:`ExponentialSlopes`).
-    substrate : complex or math.inf
-        Index ``n + ik`` of the material below the facets (``k >= 0``), or
-        ``math.inf`` for a perfect conductor.
+    substrate : complex, math.inf or FilmStack
+        Index ``n + ik`` of the material below the facets (``k >= 0``),
+        ``math.inf`` for a perfect conductor, or a :class:`models.FilmStack`
+        (films on the facets, e.g. an interference pigment).
+    shadowing : str
+        ``"none"`` (seed 000), ``"smith"`` (separable Smith ``G1(i) G1(o)``) or
+        ``"smith-correlated"`` (height-correlated), :mod:`models.shadowing`.
     """
 
     slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
     substrate: complex = param(1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor)", kind="index")
+    shadowing: str = param("none", "shadowing-masking", kind="choice", choices=SHADOWING)

@@ -48,6 +48,7 @@ from .base import Model
 from .geometry import sp_basis
 from .params import choice_alias, convention_param, param
 from .polarization import mueller16_from_jones
+from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import GaussianSlopes, SlopeDistribution
 
 __all__ = ["FacetBTDF", "facet_transmission_jones", "ray_basis", "angle_basis", "projected_area"]
@@ -172,6 +173,14 @@ class FacetBTDF(Model):
         plus transmission integrate to 1.  Either way the printed slips listed in the
         module docstring (Eq. 39, 41, 43) are corrected.  Old name ``normalization``
         (``"paper"``, ``"exact"``).
+    shadowing : str
+        ``"none"`` (seed 003), ``"smith"`` or ``"smith-correlated"``
+        (:mod:`models.shadowing`): the incident direction's shadowing and the
+        masking of the transmitted direction from below, ``chi+`` on each (Walter
+        et al. 2007 Eq. 21-23).  Smith's ``G1`` satisfies ``int G1(i) (i.m)+ D dm =
+        cos theta_i``, the projected-area identity that ``"paper"`` assumes, so it
+        goes with ``convention="paper"`` only (``"corrected"`` corrects the same
+        projected area without shadowing).
     """
 
     slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", kind="object")
@@ -179,6 +188,7 @@ class FacetBTDF(Model):
     convention: str = convention_param(
         "normalization of the slopes seen by the ray: Eq. 37 (paper, SCATMECH) or exact Eq. 36 (corrected)"
     )
+    shadowing: str = param("none", "shadowing-masking", kind="choice", choices=SHADOWING)
 
     aliases = {
         "normalization": choice_alias("convention", "normalization", {"paper": "paper", "exact": "corrected"})
@@ -199,6 +209,12 @@ class FacetBTDF(Model):
             raise ValueError(
                 "convention 'corrected' needs isotropic slopes (its exact projected area is the isotropic "
                 f"average); got {self.slopes!r}; use convention='paper'"
+            )
+        check_shadowing(self.shadowing, self.slopes)
+        if self.shadowing != "none" and self.convention != "paper":
+            raise ValueError(
+                f"convention must be 'paper' with shadowing {self.shadowing!r} (Smith's G1 already "
+                "normalizes the projected area); got 'corrected'"
             )
 
     def _parts(self, ti, tt, pt):
@@ -231,6 +247,11 @@ class FacetBTDF(Model):
         S = p3 * n * c_out * inv_cc / mz_l**4 * (n * n * c_out / np.where(live, D2, 1.0))
         if self.convention == "corrected":
             S = S * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))
+        if self.shadowing != "none":
+            # towards the source (azimuth pi) and along the transmitted ray (below: cos < 0)
+            v_i = (ci, si, -1.0, 0.0)
+            v_t = (-ct, st, cp, sp)
+            S = S * smith_g(self.shadowing, self.slopes, v_i, v_t, c_in, -c_out)
         S = np.where(live, S, 0.0)
         root = np.sqrt(S)
         return tuple((j * root, 0.0) for j in jones)  # real Jones matrix

@@ -40,6 +40,8 @@ __all__ = [
     "ExponentialAngles",
     "TabulatedSlopes",
     "UnitSlopes",
+    "GGXSlopes",
+    "AnisotropicGGXSlopes",
 ]
 
 _SQRT6 = math.sqrt(6.0)
@@ -445,3 +447,81 @@ class UnitSlopes(SlopeDistribution):
 
     def _p3_unit(self, zx, zy):
         return np.ones(np.broadcast_shapes(np.shape(zx), np.shape(zy)))
+
+
+@dataclass(frozen=True)
+class GGXSlopes(SlopeDistribution):
+    """GGX (Trowbridge-Reitz) slopes ``P3^xy = C alpha^2 / (pi (alpha^2 + zeta^2)^2)``.
+
+    The microfacet distribution of Walter et al. 2007 and Mitsuba's ``ggx``
+    (``D(theta_n) = P3 / cos^4 theta_n``).  Its rms slope is *infinite*: the
+    slope-magnitude density ``P4 = 2 C alpha^2 zeta / (alpha^2 + zeta^2)^2`` falls
+    only like ``zeta^-3``, so ``<zeta^2>`` diverges logarithmically and there is no
+    ``sigma``.  ``alpha`` plays the role of Beckmann's ``alpha`` (our Gaussian
+    ``sigma``): half of the slopes lie within ``|zeta| < alpha`` (``P4``'s median),
+    ``P3`` falls to half its peak at ``0.64 alpha``.  :attr:`scale` (the width that
+    lobe hints and integrators read) is ``alpha``; a consumer that truncates the
+    slope plane at ``k alpha`` loses ``1 / (1 + k^2)`` of the distribution.
+    ``<sec theta_n>`` (Eq. 36) is finite.
+
+    Parameters
+    ----------
+    alpha : float
+        Width ``alpha > 0`` (``alpha^2 = <zeta^2>`` has no meaning here).
+    coverage : float
+        Projected coverage ``C`` in (0, 1].
+    """
+
+    alpha: float = param(0.1, "GGX width alpha (rms slope is infinite)", low=0.0, low_open=True)
+    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
+
+    @property
+    def scale(self):
+        """``alpha``, the characteristic slope (the median slope magnitude)."""
+        return self.alpha
+
+    def _p3_unit(self, zx, zy):
+        a2 = self.alpha * self.alpha
+        d = a2 + zx * zx + zy * zy
+        return a2 / (math.pi * d * d)
+
+    def _sample_radius_unit(self, u):
+        # CDF of P4: zeta^2 / (alpha^2 + zeta^2), inverted exactly.
+        u = np.asarray(u, dtype=float)
+        return self.alpha * np.sqrt(u / (1.0 - u))
+
+    @property
+    def _zeta_max(self):
+        # the tail beyond zeta_max holds alpha^2 / (alpha^2 + zeta_max^2) <= 1e-10
+        return 1e5 * self.alpha
+
+
+@dataclass(frozen=True)
+class AnisotropicGGXSlopes(_Anisotropic):
+    """Anisotropic GGX slopes ``C / (pi ax ay (1 + (u/ax)^2 + (v/ay)^2)^2)``.
+
+    ``(u, v)`` are the slopes in axes rotated by ``rotation`` from x;
+    ``alpha_x = alpha_y = alpha`` is :class:`GGXSlopes`.  Like it, the rms slope
+    is infinite along every direction; :attr:`scale` is ``max(alpha_x, alpha_y)``.
+    """
+
+    alpha_x: float = param(0.1, "GGX width along the rotated x axis", low=0.0, low_open=True)
+    alpha_y: float = param(0.1, "GGX width along the rotated y axis", low=0.0, low_open=True)
+    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
+    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
+
+    # the axis widths under the names the elliptical base class reads (not rms slopes)
+    sigma_x = property(lambda self: self.alpha_x)
+    sigma_y = property(lambda self: self.alpha_y)
+
+    def _p3_unit(self, zx, zy):
+        u, v = self._local(zx, zy)
+        d = 1.0 + (u / self.alpha_x) ** 2 + (v / self.alpha_y) ** 2
+        return 1.0 / (math.pi * self.alpha_x * self.alpha_y * d * d)
+
+    def _isotropic_unit(self):
+        return GGXSlopes(alpha=1.0)
+
+    @property
+    def _zeta_max(self):
+        return 1e5 * self.scale

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from .facet import _FacetModel
 from .params import param
+from .shadowing import SHADOWING
 from .slopes import ExponentialSlopes, SlopeDistribution
 
 __all__ = ["SubsurfaceFacetBRDF"]
@@ -31,8 +32,14 @@ class SubsurfaceFacetBRDF(_FacetModel):
         Facet slope distribution ``P3^xy`` (coverage ``C`` scales the result).
     coating : float
         Real index ``n >= 1`` of the coating (1 reproduces :class:`FacetBRDF`).
-    substrate : complex or math.inf
-        Index of the flakes / substrate, ``n + ik`` with ``k >= 0``, or ``inf``.
+    substrate : complex, math.inf or FilmStack
+        Index of the flakes / substrate, ``n + ik`` with ``k >= 0``, ``inf``, or a
+        :class:`models.FilmStack` (films on the flakes, seen from the coating: e.g.
+        mica flakes with a TiO2 film).
+    shadowing : str
+        ``"none"`` (seed 000), ``"smith"`` or ``"smith-correlated"``
+        (:mod:`models.shadowing`), evaluated inside the coating with the refracted
+        directions: the facets mask the internal rays.
     """
 
     slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
@@ -40,6 +47,7 @@ class SubsurfaceFacetBRDF(_FacetModel):
     substrate: complex = param(
         1.37 + 7.62j, "flake/substrate index n + ik (inf: perfect conductor)", kind="index"
     )
+    shadowing: str = param("none", "shadowing-masking (inside the coating)", kind="choice", choices=SHADOWING)
 
     def _coating(self) -> float:
         return self.coating

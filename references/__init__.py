@@ -170,3 +170,45 @@ def scatmech_flake_measurement_path() -> str:
     seed, noise model and pySCATMECH version in its JSON sidecar).  Read it with
     ``validation.fitting.datafile.load_data``."""
     return data_path("scatmech_flake_measurement.csv")
+
+
+# --- issue 15: peer references (Mitsuba 3, tmm) -------------------------------------
+__all__ += ["mitsuba_roughconductor", "tmm_reference"]
+
+
+def mitsuba_roughconductor() -> dict:
+    """Mitsuba 3 ``roughconductor`` evaluations (``references/scripts/make_mitsuba_roughconductor.py``):
+    string columns ``variant``, ``distribution``; float columns ``alpha, eta, k, theta_i,
+    theta_r, phi_r, value``; for the polarized rows ``mueller`` ``(N, 4, 4)`` in Mitsuba's
+    frames and ``x_in``, ``x_out`` ``(N, 3)`` (NaN in the unpolarized rows)."""
+    rows = read_csv("mitsuba_roughconductor.csv")
+    out = {k: np.array([r[k] for r in rows]) for k in ("variant", "distribution")}
+
+    def col(k):
+        return np.array([float(r[k]) if r[k] else math.nan for r in rows])
+
+    for k in ("alpha", "eta", "k", "theta_i", "theta_r", "phi_r", "value"):
+        out[k] = col(k)
+    out["mueller"] = np.stack([col(f"m{i}{j}") for i in range(4) for j in range(4)], -1).reshape(-1, 4, 4)
+    out["x_in"] = np.stack([col(f"xin_{c}") for c in "xyz"], -1)
+    out["x_out"] = np.stack([col(f"xout_{c}") for c in "xyz"], -1)
+    return out
+
+
+def tmm_reference() -> list[dict]:
+    """``tmm`` thin-film coefficients (``references/scripts/make_tmm_reference.py``): one dict
+    per case with ``n0``, ``films`` (list of ``(index, thickness_nm)``), ``substrate``,
+    ``wavelength_nm``, ``theta0`` and complex ``rs, rp, ts, tp``."""
+    out = []
+    for r in read_csv("tmm_reference.csv"):
+        films = []
+        for part in r["layers"].split("|"):
+            n, k, d = (float(x) for x in part.split(";"))
+            films.append((complex(n, k), d))
+        case = {"n0": float(r["n0"]), "films": films, "wavelength_nm": float(r["wavelength_nm"])}
+        case["substrate"] = complex(float(r["substrate_n"]), float(r["substrate_k"]))
+        case["theta0"] = float(r["theta0"])
+        for c in ("rs", "rp", "ts", "tp"):
+            case[c] = complex(float(r[f"{c}_re"]), float(r[f"{c}_im"]))
+        out.append(case)
+    return out
