@@ -8,6 +8,7 @@ Angles are radians; results broadcast and have shape ``broadcast + (4, 4)``.
 # Model.registry lists the model classes in the order they are defined, which is the
 # order of these imports: seed 000, seed 001, seed 003, then the detector aperture.
 from .base import CHUNK, Model, Sum
+from .evaluation import backend
 from .facet import FacetBRDF
 from .subsurface_facet import SubsurfaceFacetBRDF
 from .cook_torrance import CookTorranceBRDF, fresnel_real
@@ -51,6 +52,7 @@ from .slopes import (
 from .thin_film import FilmStack, TabulatedIndex
 
 __all__ = [
+    "backend",
     "shadowing",
     "FilmStack",
     "TabulatedIndex",

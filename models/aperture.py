@@ -100,7 +100,7 @@ class DetectorAperture(_Wrapper):
 
     def _mueller16(self, ti, tr, pr):
         if self.aperture == 0.0:
-            return self.model._mueller16(ti, tr, pr)
+            return self.model._m16(ti, tr, pr)
         n = ti.size
         out = np.zeros((16, n))
         wsum = np.zeros(n)
@@ -121,7 +121,7 @@ class DetectorAperture(_Wrapper):
             s = np.sum(sa * p_k, axis=-1)
             zero = np.zeros_like(c)
             R = mueller16_from_jones((c, zero), (s, zero), (-s, zero), (c, zero)).reshape(4, 4, n, kb)
-            M = self.model._mueller16(np.repeat(ti, kb), th.ravel(), ph.ravel()).reshape(4, 4, n, kb)
+            M = self.model._m16(np.repeat(ti, kb), th.ravel(), ph.ravel()).reshape(4, 4, n, kb)
             out += np.einsum("ijnk,jlnk,nk->iln", R, M, wt).reshape(16, n)
             wsum += wt.sum(axis=1)
         return out / wsum

@@ -17,18 +17,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from . import evaluation, modelset
+from .evaluation import CHUNK
 from .geometry import broadcast_angles
+from .modelset import array_leaves
 from .params import Declared, check_finite_array, check_polar_angle, param
 from .polarization import ellipsometric, stokes
 
 __all__ = ["Model", "Sum", "CHUNK"]
-
-#: Geometries evaluated per chunk, chosen so a model's float64 temporaries stay in
-#: L2 cache (measured best of 1024..32768 for the facet models on this machine).
-CHUNK = 4096
 
 
 class Model(Declared):
@@ -55,12 +55,82 @@ class Model(Declared):
         if not cls.__name__.startswith("_") and cls.__module__.startswith("models"):
             Model.registry.append(cls)
 
+    #: True when ``_mueller16``/``_brdf_flat`` take array parameters (flat, one per
+    #: geometry); otherwise a model set's numpy path runs per distinct element
+    _numpy_sets = False
+
     # -- subclass hooks -----------------------------------------------------------
     def _mueller16(self, ti, tr, pr):  # pragma: no cover - abstract
         raise NotImplementedError
 
     def _jones_flat(self, ti, tr, pr):
         raise NotImplementedError(f"{type(self).__name__} is depolarizing: it has no Jones matrix")
+
+    def _kernel_spec(self):
+        """``(code, parameters, options)`` for a compiled kernel (:mod:`models.kernels`), or
+        ``None`` where no kernel covers this model and its options (then numpy)."""
+        return None
+
+    # -- model sets and dispatch ------------------------------------------------------
+    def __post_init__(self):
+        super().__post_init__()
+        if self._sets:
+            modelset.check_broadcast(self._sets)
+
+    @cached_property
+    def _sets(self) -> dict:
+        """``{path: array}``: the parameters that are arrays (:mod:`models.modelset`)."""
+        return array_leaves(self)
+
+    @property
+    def param_shape(self) -> tuple:
+        """Broadcast shape of the array parameters (``()``: a single model, not a model set)."""
+        return np.broadcast_shapes(*(a.shape for a in self._sets.values()))
+
+    def with_values(self, values: dict, *, check: bool = True):
+        """A model with parameters replaced by dotted paths (``{"slopes.sigma": array}``; tuple
+        items by index, ``"terms.0.1.coating"``).  ``check=False`` trusts the values (a caller
+        that range-checked them once, vectorized): no validation at all, so building a model
+        set costs microseconds however many elements it holds."""
+        leaves = {tuple(int(k) if k.isdigit() else k for k in p.split(".")): v for p, v in values.items()}
+        if check:
+            return modelset.rebuilt(self, leaves)
+        return modelset.with_leaves(self, leaves)
+
+    def _element(self, leaves, index):
+        """The single model at ``index`` of flat array parameters (see :func:`evaluation.each`)."""
+        return modelset.element(self, leaves, index)
+
+    @cached_property
+    def _kernel(self):
+        spec = self._kernel_spec()
+        if spec is None:
+            return None
+        from . import kernels
+
+        return kernels.Compiled(self, *spec)
+
+    def _compiled(self):
+        """The compiled kernel to use here (``None``: numpy)."""
+        return self._kernel if evaluation.current_backend() == "numba" else None
+
+    def _m16(self, ti, tr, pr):
+        """Mueller elements ``(16, n)`` of flat angles: the kernel or the numpy implementation."""
+        k = self._compiled()
+        if k is not None:
+            return k.run(ti, tr, pr, 16)
+        if self._sets and not self._numpy_sets:
+            return evaluation.each(self, ti, tr, pr, "_m16", 1)
+        return self._mueller16(ti, tr, pr)
+
+    def _m00(self, ti, tr, pr):
+        """``M00`` ``(n,)`` of flat angles: the kernel or the numpy implementation."""
+        k = self._compiled()
+        if k is not None:
+            return k.run(ti, tr, pr, 1)[0]
+        if self._sets and not self._numpy_sets:
+            return evaluation.each(self, ti, tr, pr, "_m00", 0)
+        return self._brdf_flat(ti, tr, pr)
 
     # -- validation and chunked evaluation ----------------------------------------
     def _angles(self, theta_i, theta_r, phi_r):
@@ -70,42 +140,14 @@ class Model(Declared):
         pr = check_finite_array(n3, phi_r)
         return broadcast_angles(ti, tr, pr)
 
-    def _chunks(self, theta_i, theta_r, phi_r):
-        """Validate the angles; return ``(shape, n, blocks)`` where ``blocks`` yields
-        ``(slice, ti, tr, pr)`` flat chunks of the broadcast geometries.
+    @cached_property
+    def _has_kernel(self) -> bool:
+        return self._kernel_spec() is not None
 
-        The broadcast arrays are never materialized: inputs of the full shape are
-        sliced, scalars are filled per chunk and other broadcast inputs are
-        gathered per chunk, so a (1000, 1) x (1, 10^4) scan uses chunk-sized
-        memory, not 10^7-sized inputs.
-        """
-        n1, n2, n3 = self._angle_names
-        arrays = [
-            check_polar_angle(n1, theta_i),
-            check_polar_angle(n2, theta_r),
-            check_finite_array(n3, phi_r),
-        ]
-        shape = np.broadcast_shapes(*(a.shape for a in arrays))
-        n = math.prod(shape)
-        flat = [a.reshape(-1) if a.shape == shape else None for a in arrays]
-
-        def blocks():
-            for start in range(0, n, CHUNK):
-                stop = min(start + CHUNK, n)
-                idx = None
-                parts = []
-                for a, f in zip(arrays, flat, strict=True):
-                    if f is not None:
-                        parts.append(f[start:stop])
-                    elif a.size == 1:
-                        parts.append(np.full(stop - start, a.reshape(-1)[0]))
-                    else:
-                        if idx is None:
-                            idx = np.unravel_index(np.arange(start, stop), shape)
-                        parts.append(np.broadcast_to(a, shape)[idx])
-                yield (slice(start, stop), *parts)
-
-        return shape, n, blocks()
+    def _plan(self, theta_i, theta_r, phi_r):
+        kernel = self._has_kernel and evaluation.current_backend() == "numba"
+        chunk = evaluation.KERNEL_CHUNK if kernel else evaluation.CHUNK
+        return evaluation.Plan(self, theta_i, theta_r, phi_r, chunk)
 
     def iter_mueller(self, theta_i, theta_r, phi_r=0.0):
         """Stream the Mueller BRDF: yields ``(flat_slice, block)`` with ``block`` of shape
@@ -114,34 +156,59 @@ class Model(Declared):
         Memory stays bounded by the chunk size however many geometries there are
         (10^7 and beyond): reduce or store each block as it comes.
         """
-        _, _, blocks = self._chunks(theta_i, theta_r, phi_r)
-        for sl, ti, tr, pr in blocks:
-            yield sl, self._mueller16(ti, tr, pr).T.reshape(-1, 4, 4)
+        for sl, ti, tr, pr, m in self._plan(theta_i, theta_r, phi_r).blocks():
+            yield sl, m._m16(ti, tr, pr).T.reshape(-1, 4, 4)
 
-    def mueller(self, theta_i, theta_r, phi_r=0.0, out=None):
+    def mueller(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
         """Mueller-matrix BRDF ``(..., 4, 4)`` in 1/sr, s/p bases (SCATMECH ``psps``).
 
-        ``out``, optional: a ``(16, N)`` float64 array (e.g. a ``numpy.memmap``)
-        to write into, element-major, for very large evaluations.
+        The angles broadcast against each other and against the parameter shape of a model
+        set (:attr:`param_shape`).  ``out``, optional: a ``(16, N)`` array of the
+        precision's dtype (e.g. a ``numpy.memmap``) to write into, element-major, for very
+        large evaluations.  ``precision``: ``"float64"`` or ``"float32"`` (the float32
+        kernels, :mod:`models.kernels`; a model without one is evaluated in float64 and
+        rounded).
         """
-        shape, n, blocks = self._chunks(theta_i, theta_r, phi_r)
+        if out is None and precision == "float64":
+            fast = self._fast(theta_i, theta_r, phi_r, 16)
+            if fast is not None:
+                return fast
+        plan = self._plan(theta_i, theta_r, phi_r)
+        dtype = np.dtype(evaluation.check_precision(precision))
+        shape, n = plan.shape, plan.n
         # Element-major storage: each chunk's (16, k) block is copied without a
         # transpose; the (..., 4, 4) result is a strided view of it.
         if out is None:
-            out = np.empty((16, n))
-        elif out.shape != (16, n):
-            raise ValueError(f"out must have shape (16, {n}); got {out.shape}")
-        for sl, ti, tr, pr in blocks:
-            out[:, sl] = self._mueller16(ti, tr, pr)
+            out = np.empty((16, n), dtype=dtype)
+        elif out.shape != (16, n) or out.dtype != dtype:
+            raise ValueError(f"out must have shape (16, {n}) and dtype {dtype}; got {out.shape} {out.dtype}")
+        self._fill(plan, out, 16, precision)
         return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
 
-    def brdf(self, theta_i, theta_r, phi_r=0.0):
-        """Unpolarized-in, total-out BRDF ``M00`` (1/sr)."""
-        shape, n, blocks = self._chunks(theta_i, theta_r, phi_r)
-        out = np.empty(n)
-        for sl, ti, tr, pr in blocks:
-            out[sl] = self._brdf_flat(ti, tr, pr)
-        return out.reshape(shape)
+    def brdf(self, theta_i, theta_r, phi_r=0.0, precision="float64"):
+        """Unpolarized-in, total-out BRDF ``M00`` (1/sr); ``precision`` as for :meth:`mueller`."""
+        if precision == "float64":
+            fast = self._fast(theta_i, theta_r, phi_r, 1)
+            if fast is not None:
+                return fast
+        plan = self._plan(theta_i, theta_r, phi_r)
+        out = np.empty((1, plan.n), dtype=np.dtype(evaluation.check_precision(precision)))
+        self._fill(plan, out, 1, precision)
+        return out.reshape(plan.shape)
+
+    def _fill(self, plan, out, rows, precision):
+        kernel = None if plan.leaves else self._compiled()
+        if kernel is not None and plan.n > 0:
+            kernel.fill(plan, out, rows, precision)  # the kernel loops over the chunks itself
+            return
+        for sl, ti, tr, pr, m in plan.blocks():
+            out[:, sl] = m._m16(ti, tr, pr) if rows == 16 else m._m00(ti, tr, pr)
+
+    def _fast(self, theta_i, theta_r, phi_r, rows):
+        """A small call (floats, or float64 arrays of one shape) straight into the kernel,
+        or ``None`` for the general path (which also raises the errors)."""
+        kernel = None if self._sets else self._compiled()
+        return None if kernel is None else kernel.fast(theta_i, theta_r, phi_r, rows)
 
     def _brdf_flat(self, ti, tr, pr):
         return self._mueller16(ti, tr, pr)[0]
@@ -152,11 +219,16 @@ class Model(Declared):
         non-depolarizing models; the overall phase is arbitrary."""
         if self.depolarizing:
             raise NotImplementedError(f"{type(self).__name__} is depolarizing: it has no Jones matrix")
-        shape, n, blocks = self._chunks(theta_i, theta_r, phi_r)
-        out = np.empty((n, 2, 2), dtype=complex)
-        for sl, ti, tr, pr in blocks:
-            out[sl] = self._jones_flat(ti, tr, pr)
-        return out.reshape(shape + (2, 2))
+        plan = evaluation.Plan(self, theta_i, theta_r, phi_r, evaluation.CHUNK)
+        out = np.empty((plan.n, 2, 2), dtype=complex)
+        for sl, ti, tr, pr, m in plan.blocks():
+            out[sl] = m._jones_each(ti, tr, pr)
+        return out.reshape(plan.shape + (2, 2))
+
+    def _jones_each(self, ti, tr, pr):
+        if self._sets and not self._numpy_sets:
+            return evaluation.each(self, ti, tr, pr, "_jones_each", 0)
+        return self._jones_flat(ti, tr, pr)
 
     def scattered_stokes(self, theta_i, theta_r, phi_r=0.0, incident="unpolarized"):
         """Scattered Stokes vector BRDF ``(..., 4)`` for an incident state (name or vector)."""
@@ -259,10 +331,12 @@ class Sum(Model):
     def mirror_symmetric(self):  # type: ignore[override]
         return all(m.mirror_symmetric for _, m in self.terms)
 
+    _numpy_sets = True  # its terms evaluate their own parameters
+
     def _mueller16(self, ti, tr, pr):
         total = None
         for w, m in self.terms:
-            block = w * m._mueller16(ti, tr, pr)
+            block = w * m._m16(ti, tr, pr)
             total = block if total is None else total + block
         return total
 

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kernel_specs
 from .base import Model
 from .fresnel import fresnel_reflectance
 from .params import Alias, check_real, choice_alias, convention_param, param
@@ -204,6 +205,16 @@ class _CookTorranceBase(Model):
             return stroke_d(s.sigma, s.sigma, 0.0)
         return stroke_d(s.m_parallel, s.m_perpendicular, s.stroke_angle)
 
+    def _cook_spec(self, variant, coating):
+        s = self.slopes
+        m = (
+            [s.sigma, s.sigma, 0.0]
+            if isinstance(s, GaussianSlopes)
+            else [s.m_parallel, s.m_perpendicular, s.stroke_angle]
+        )
+        rows = [coating, *kernel_specs.index_rows(self.substrate), *m]
+        return "cook", rows, (variant, int(self.convention == "corrected"), int(self.shadowing == "blinn"))
+
     @property
     def mirror_symmetric(self) -> bool:
         s = self.slopes
@@ -268,6 +279,9 @@ class CookTorranceBRDF(_CookTorranceBase):
             "convention", "normalization", {"published": "paper", "energy": "corrected"}
         ),
     }
+
+    def _kernel_spec(self):
+        return self._cook_spec(0, 1.0)
 
     def _brdf_flat(self, ti, tr, pr):
         ci, cr, live = _grazing_safe(ti, tr)

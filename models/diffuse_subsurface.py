@@ -67,6 +67,17 @@ class DiffuseSubsurfaceBRDF(Model):
     def _scale(self) -> float:
         return (self.rho / math.pi) / (1.0 - self.rho * self.rbar)
 
+    def _kernel_spec(self):
+        n = self.coating
+        if isinstance(n, np.ndarray):  # R-bar is a quadrature: once per distinct index
+            values, inverse = np.unique(n, return_inverse=True)
+            rbar = np.array([internal_hemispherical_reflectance(float(v)) for v in values])[
+                inverse.reshape(n.shape)
+            ]
+        else:
+            rbar = self.rbar
+        return "diffuse", [n, (self.rho / math.pi) / (1.0 - self.rho * rbar)], (0, 0, 0)
+
     def _amps(self, ti, tr):
         """Interface amplitudes ``(a_s, a_p)``, rows incidence then scattering."""
         _, _, a_s, a_p = interface_amplitudes(np.cos(np.stack([ti, tr])), self.coating)

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kernel_specs
 from .base import Model
 from .fresnel import coating_transmission, reflection_rs_k
 from .params import param
@@ -176,6 +177,18 @@ class _FacetModel(Model):
 
     def _mueller16(self, ti, tr, pr):
         return mueller16_from_jones(*self._parts(ti, tr, pr))
+
+    def _kernel_spec(self):
+        """The facet kernel; numpy for film stacks and slopes or shadowing it does not cover
+        (:mod:`models.kernel_specs`)."""
+        slopes = kernel_specs.slope_rows(self.slopes)
+        if slopes is None or isinstance(self.substrate, FilmStack):
+            return None
+        shadowing = kernel_specs.shadowing_kind(self.shadowing, slopes[0])
+        if shadowing is None:
+            return None
+        rows = [self._coating(), *kernel_specs.index_rows(self.substrate), *slopes[1]]
+        return "facet", rows, (slopes[0], shadowing, 0)
 
     def _jones_flat(self, ti, tr, pr):
         J = np.empty(ti.shape + (4,), dtype=complex)

@@ -44,6 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kernel_specs
 from .base import Model
 from .geometry import sp_basis
 from .params import choice_alias, convention_param, param
@@ -258,6 +259,17 @@ class FacetBTDF(Model):
 
     def _mueller16(self, ti, tr, pr):
         return mueller16_from_jones(*self._parts(ti, tr, pr))
+
+    def _kernel_spec(self):
+        """The facet transmission kernel for ``convention="paper"``; numpy for the corrected
+        convention (its projected area is a quantile average) and uncovered slopes."""
+        slopes = kernel_specs.slope_rows(self.slopes)
+        if slopes is None or self.convention != "paper":
+            return None
+        shadowing = kernel_specs.shadowing_kind(self.shadowing, slopes[0])
+        if shadowing is None:
+            return None
+        return "btdf", [self.substrate, *slopes[1]], (slopes[0], shadowing, 0)
 
     def _jones_flat(self, ti, tr, pr):
         J = np.empty(ti.shape + (4,), dtype=complex)

@@ -32,6 +32,7 @@ from functools import cached_property
 
 import numpy as np
 
+from . import kernel_specs
 from .base import Model
 from .facet import FacetBRDF
 from .params import param
@@ -94,13 +95,28 @@ class MaxwellBeardBRDF(Model):
     def _facet(self):
         return FacetBRDF(slopes=self.slopes, substrate=self.substrate)
 
+    def _kernel_spec(self):
+        slopes = kernel_specs.slope_rows(self.slopes)
+        if slopes is None:
+            return None
+        rows = [
+            1.0,
+            *kernel_specs.index_rows(self.substrate),
+            *slopes[1],
+            self.rho_d,
+            self.rho_v,
+            self.tau,
+            self.omega,
+        ]
+        return "maxwell", rows, (slopes[0], 0, int(self.polarized))
+
     def _mueller16(self, ti, tr, pr):
         so = maxwell_beard_shadow(ti, tr, pr, self.tau, self.omega)
         if self.polarized:
-            out = self._facet._mueller16(ti, tr, pr) * so
+            out = self._facet._m16(ti, tr, pr) * so
         else:
             out = np.zeros((16, ti.size))
-            out[0] = self._facet._brdf_flat(ti, tr, pr) * so
+            out[0] = self._facet._m00(ti, tr, pr) * so
         ci, cr = np.cos(ti), np.cos(tr)
         den = ci + cr
         vol = 2.0 * self.rho_v / np.where(den > 0, den, 1.0)

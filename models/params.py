@@ -106,13 +106,40 @@ def param(
     return field(default=default, metadata={"scatterbench": info})
 
 
-def check_real(name, value, low=None, high=None, low_open=False, high_open=False) -> float:
-    """Return ``value`` as a float or raise ``ValueError`` naming ``name`` and the range."""
+def _range_text(low, high, low_open, high_open) -> str:
     lo = "-inf" if low is None else f"{low:g}"
     hi = "inf" if high is None else f"{high:g}"
     lb = "(" if (low_open or low is None) else "["
     hb = ")" if (high_open or high is None) else "]"
-    rng = f"a finite real number in {lb}{lo}, {hi}{hb}"
+    return f"a finite real number in {lb}{lo}, {hi}{hb}"
+
+
+def _is_array(value) -> bool:
+    """A numpy array of at least one dimension: a model set's parameter (0-d arrays are scalars)."""
+    return isinstance(value, np.ndarray) and value.ndim > 0
+
+
+def _first_bad(name, rng, a, bad):
+    """Raise the ``ValueError`` naming ``name``, the range and the first element where ``bad``."""
+    k = int(np.argmax(bad.reshape(-1)))
+    where = tuple(int(i) for i in np.unravel_index(k, a.shape))
+    raise ValueError(f"{name} must be {rng}; got {a.reshape(-1)[k].item()!r} at index {where}")
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    """A read-only copy: a model set's parameters cannot change under the model."""
+    a = np.array(a, copy=True)
+    a.flags.writeable = False
+    return a
+
+
+def check_real(name, value, low=None, high=None, low_open=False, high_open=False):
+    """Return ``value`` as a float, or a numpy array as a read-only float64 array (a model set,
+    every element checked once), or raise ``ValueError`` naming ``name``, the range and the
+    (first) offending value."""
+    rng = _range_text(low, high, low_open, high_open)
+    if _is_array(value):
+        return _check_real_array(name, value, rng, low, high, low_open, high_open)
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         if isinstance(value, numbers.Complex) and complex(value).imag == 0:
             value = complex(value).real
@@ -129,15 +156,46 @@ def check_real(name, value, low=None, high=None, low_open=False, high_open=False
     return v
 
 
-def check_index(name, value) -> complex | float:
+def _check_real_array(name, value, rng, low, high, low_open, high_open) -> np.ndarray:
+    if value.dtype.kind == "c":
+        if np.any(value.imag != 0):
+            _first_bad(name, rng, value, value.imag != 0)
+        value = value.real
+    if value.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be {rng} (an array of them); got an array of {value.dtype}")
+    a = value.astype(np.float64, copy=False)
+    bad = ~np.isfinite(a)
+    with np.errstate(invalid="ignore"):
+        if low is not None:
+            bad |= (a <= low) if low_open else (a < low)
+        if high is not None:
+            bad |= (a >= high) if high_open else (a > high)
+    if bad.any():
+        _first_bad(name, rng, a, bad)
+    return _frozen(a)
+
+
+def check_index(name, value):
     """Validate a refractive index ``n + ik`` (``k >= 0``) or ``math.inf``.
 
     Returns ``math.inf`` for a perfect conductor, otherwise a ``complex`` whose
     imaginary part is a non-negative float (``-0.0`` is normalised to ``+0.0`` so
     that the principal square roots used for total internal reflection pick the
-    evanescent, decaying branch).
+    evanescent, decaying branch).  A numpy array (a model set) is checked element by
+    element and returned as a read-only complex128 array (``inf + 0j``: a perfect
+    conductor).
     """
     rng = "n + ik with n > 0 and k >= 0 (both finite), or math.inf for a perfect conductor"
+    if _is_array(value):
+        if value.dtype.kind not in "iufc":
+            raise ValueError(f"{name} must be {rng} (an array of them); got an array of {value.dtype}")
+        z = value.astype(np.complex128, copy=False)
+        pec = (z.real == math.inf) & (z.imag == 0)
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(z.real) & np.isfinite(z.imag) & (z.real > 0) & (z.imag >= 0)
+        if not np.all(ok | pec):
+            _first_bad(name, rng, z, ~(ok | pec))
+        return _frozen(z.real + 1j * np.abs(z.imag))
     if isinstance(value, bool) or not isinstance(value, numbers.Complex):
         raise ValueError(f"{name} must be {rng}; got {value!r}")
     z = complex(value)
@@ -368,6 +426,8 @@ def _checked(name, value, info):
         return check_index(name, value)
     if kind == "real_index":
         z = value
+        if _is_array(z):
+            return check_real(name, z, info["low"], None)
         if isinstance(z, numbers.Complex) and not isinstance(z, numbers.Real):
             if complex(z).imag != 0:
                 raise ValueError(

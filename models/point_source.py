@@ -155,7 +155,7 @@ class PointSourceBRDF(_Wrapper):
     # -- evaluation -----------------------------------------------------------------------
     def _mueller16(self, ti, tr, pr):
         if self.distance == math.inf:
-            return self.model._mueller16(ti, tr, pr)
+            return self.model._m16(ti, tr, pr)
         out = np.zeros((16, ti.size))
         live = ti < 0.5 * math.pi
         if not live.all():
@@ -185,7 +185,7 @@ class PointSourceBRDF(_Wrapper):
             j0 = rows[0]
             for k in range(psi.shape[1]):
                 m = self.model.rotated(-float(Phi[j0, k]))
-                M = m._mueller16(np.full(rows.size, psi[j0, k]), tr[rows], pr[rows] - Phi[j0, k])
+                M = m._m16(np.full(rows.size, psi[j0, k]), tr[rows], pr[rows] - Phi[j0, k])
                 out[:, rows] += w[j0, k] * M
         return out
 
@@ -202,7 +202,7 @@ class PointSourceBRDF(_Wrapper):
         for k0 in range(0, K, step):
             sl = slice(k0, min(K, k0 + step))
             kb = sl.stop - sl.start
-            M = model._mueller16(a[:, sl].ravel(), b[:, sl].ravel(), c[:, sl].ravel())
+            M = model._m16(a[:, sl].ravel(), b[:, sl].ravel(), c[:, sl].ravel())
             out += np.einsum("eik,ik->ei", M.reshape(16, n, kb), w[:, sl])
 
     def brdf_grid(self, theta_i, theta_r, phi_r):

@@ -58,6 +58,7 @@ from functools import cached_property
 
 import numpy as np
 
+from . import modelset
 from .base import Model
 from .facet import FacetBRDF
 from .facet_btdf import _dot, angle_basis, facet_transmission_jones, projected_area, ray_basis
@@ -228,6 +229,10 @@ class RoughDiffuseBRDF(Model):
         object.__setattr__(self, "_z1", np.stack(z1))
         object.__setattr__(self, "_z2", np.stack(z2))
 
+    def _element(self, leaves, index):
+        # validated: the facet pairs are drawn from the element's own slopes and seed
+        return modelset.rebuilt(self, {p: modelset.scalar_value(a[index]) for p, a in leaves.items()})
+
     @cached_property
     def _rbar(self):
         if self.feedback == "flat" or self.rho == 0.0:
@@ -372,7 +377,7 @@ class RoughDiffuseBRDF(Model):
         return mean, err
 
     def _surface16(self, ti, tr, pr):
-        out = self._surface_model._mueller16(ti, tr, pr)
+        out = self._surface_model._m16(ti, tr, pr)
         if self.convention == "corrected":
             ci = np.cos(ti)
             out = out * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))

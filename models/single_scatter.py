@@ -103,7 +103,14 @@ class SingleScatterBRDF(Model):
         _, _, _, _, _, _, _, asi, asr, api, apr, K = self._parts(ti, tr, pr)
         return depolarized_between(asi, api, asr, apr, K)  # a depolarizing phase between the crossings
 
+    def _kernel_spec(self):
+        return "single", [self.coating, self.phase.g], (int(self.phase.polarized), 0, 0)
+
     def _brdf_flat(self, ti, tr, pr):
+        if self.phase.polarized:
+            # M00 of the Jones matrix: the product form below holds for the depolarizing phase
+            # only (with s and p transmitted differently the polarized phase weighs them apart)
+            return 0.5 * sum(re * re for re, _ in self._jones_parts(ti, tr, pr))
         _, _, _, _, _, _, _, asi, asr, api, apr, K = self._parts(ti, tr, pr)
         return 0.25 * K * (asr * asr + apr * apr) * (asi * asi + api * api)
 

@@ -147,6 +147,9 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
         "solid_angle": Alias("convention", _convention_from_old),
     }
 
+    def _kernel_spec(self):
+        return self._cook_spec(1, self.coating)
+
     def _brdf_flat(self, ti, tr, pr):
         ci, cr, live = _grazing_safe(ti, tr)
         nv = self.coating

@@ -198,9 +198,12 @@ def test_facet_with_zero_thickness_film_is_the_bare_substrate(coating):
 
 
 def test_facet_with_empty_stack_is_bit_identical():
+    """On the numpy path (a film stack has no compiled kernel; the bare interface's kernel is
+    held to the numpy path at 1e-12 in test_kernels)."""
     ti, tr, pr = _angles()
     for sub in (1.5, math.inf):
-        a = models.FacetBRDF(substrate=sub).mueller(ti, tr, pr)
+        with models.backend("numpy"):
+            a = models.FacetBRDF(substrate=sub).mueller(ti, tr, pr)
         b = models.FacetBRDF(substrate=FilmStack(layers=(), substrate=sub)).mueller(ti, tr, pr)
         assert np.array_equal(a, b)
 

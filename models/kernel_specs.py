@@ -1,0 +1,68 @@
+"""What the compiled kernels cover, without importing them: the codes of slope
+distributions and shadowing, and a model's parameters laid out as kernel rows.
+
+A model's ``_kernel_spec`` (see :class:`models.Model`) returns ``(code, rows, options)``
+built with these helpers, or ``None`` where the kernels do not cover it; then the numpy
+implementation runs.  Not covered (numpy): tabulated slopes and the angle distributions
+(their normalizations are quadratures), Smith shadowing of distributions without a
+closed-form ``Lambda`` (the exponential families use a tabulated one), film-stack
+substrates, ``FacetBTDF(convention="corrected")`` (its projected area is an average over
+quantiles), and the Monte Carlo and wrapper models (whose inner models use the kernels).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["SLOPE_KINDS", "SHADOWING_KINDS", "slope_rows", "index_rows", "shadowing_kind"]
+
+# the kinds the kernels know (models.kernels.common uses the same numbers)
+EXPONENTIAL, GAUSSIAN, GGX, ANISO_EXPONENTIAL, ANISO_GAUSSIAN, ANISO_GGX, STROKE, UNIT = range(8)
+SLOPE_KINDS = {
+    "ExponentialSlopes": EXPONENTIAL,
+    "GaussianSlopes": GAUSSIAN,
+    "GGXSlopes": GGX,
+    "AnisotropicExponentialSlopes": ANISO_EXPONENTIAL,
+    "AnisotropicGaussianSlopes": ANISO_GAUSSIAN,
+    "AnisotropicGGXSlopes": ANISO_GGX,
+    "StrokeSlopes": STROKE,
+    "UnitSlopes": UNIT,
+}
+#: slope kinds whose Smith Lambda has a closed form in the kernels
+SMITH_KINDS = (GAUSSIAN, GGX, ANISO_GAUSSIAN, ANISO_GGX)
+SHADOWING_KINDS = {"none": 0, "smith": 1, "smith-correlated": 2}
+
+
+def slope_rows(slopes):
+    """``(kind, [sx, sy, rotation, coverage])`` of a slope distribution, or ``None``."""
+    kind = SLOPE_KINDS.get(type(slopes).__name__)
+    if kind is None:
+        return None
+    if kind in (EXPONENTIAL, GAUSSIAN):
+        return kind, [slopes.sigma, slopes.sigma, 0.0, slopes.coverage]
+    if kind == GGX:
+        return kind, [slopes.alpha, slopes.alpha, 0.0, slopes.coverage]
+    if kind == STROKE:
+        return kind, [slopes.m_parallel, slopes.m_perpendicular, slopes.stroke_angle, slopes.coverage]
+    if kind == UNIT:
+        return kind, [1.0, 1.0, 0.0, 1.0]
+    return kind, [slopes.sigma_x, slopes.sigma_y, slopes.rotation, slopes.coverage]
+
+
+def shadowing_kind(shadowing, kind):
+    """The kernels' code of ``shadowing`` for slopes of ``kind``, or ``None`` (numpy)."""
+    if shadowing != "none" and kind not in SMITH_KINDS:
+        return None
+    return SHADOWING_KINDS[shadowing]
+
+
+def index_rows(index):
+    """``[re, im]`` of a refractive index (``math.inf``: ``[inf, 0]``; arrays element-wise)."""
+    if isinstance(index, np.ndarray):
+        return [index.real, index.imag]
+    if index == math.inf:
+        return [math.inf, 0.0]
+    z = complex(index)
+    return [z.real, z.imag]

@@ -1,0 +1,195 @@
+"""Compiled kernels: fused float64 (and float32) loops for the closed-form models (numba).
+
+One function per model evaluates one geometry in real arithmetic, with no temporaries
+(:mod:`~models.kernels.facet`, :mod:`~models.kernels.volume`, :mod:`~models.kernels.cook`,
+:mod:`~models.kernels.maxwell`, sharing :mod:`~models.kernels.common`);
+:mod:`~models.kernels.drive` loops it over flat arrays, serially for small calls and over
+the cores (``prange``) from :data:`PARALLEL_MIN` geometries on, writing the element-major
+``(16, N)`` result directly.  Parameters are per element (a model set) or shared, so a
+likelihood evaluates all walkers of an emcee step in one call.
+
+The numpy implementation of every model stays the reference (``with models.backend("numpy")``);
+the tests hold the kernels to it within 1e-12 relative to ``M00``.  A model's
+``_kernel_spec`` says which kernel covers it and which options fall back to numpy.
+
+Compilation happens once per machine: numba's on-disk cache (``cache=True``) lives in
+``$NUMBA_CACHE_DIR/scatterbench-<hash>`` or, without that variable, in the user's cache
+directory (``$XDG_CACHE_HOME`` or ``~/.cache``, then the temporary directory), never next
+to an installed, read-only package.  ``<hash>`` covers every kernel source file, so an
+edit to a shared helper recompiles the kernels that inline it (numba alone only notices
+changes to the file of the function itself).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import math
+import os
+import tempfile
+
+import numpy as np
+
+__all__ = ["Compiled", "PARALLEL_MIN", "cache_dir", "warm_up"]
+
+#: geometries from which the kernels run on every core (below: the serial loop, which has
+#: no thread start-up cost)
+PARALLEL_MIN = 8192
+_HALF_PI = 0.5 * math.pi
+_HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _source_hash() -> str:
+    h = hashlib.sha256()
+    for name in sorted(os.listdir(_HERE)):
+        if name.endswith(".py"):
+            with open(os.path.join(_HERE, name), "rb") as fh:
+                h.update(name.encode() + fh.read())
+    return h.hexdigest()[:16]
+
+
+def _writable(path) -> bool:
+    try:
+        os.makedirs(path, exist_ok=True)
+    except OSError:
+        return False
+    return os.access(path, os.W_OK)
+
+
+def cache_dir() -> str:
+    """Where the compiled kernels are cached (see the module docstring)."""
+    sub = f"scatterbench-{_source_hash()}"
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    bases = [env] if env else []
+    bases.append(os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "numba"))
+    bases.append(
+        os.path.join(tempfile.gettempdir(), f"numba-cache-{os.getuid() if hasattr(os, 'getuid') else 0}")
+    )
+    for base in bases:
+        if _writable(os.path.join(base, sub)):
+            return os.path.join(base, sub)
+    return ""  # nowhere writable: compile in every process
+
+
+@contextlib.contextmanager
+def _caching_in(path):
+    """numba's cache locator reads ``config.CACHE_DIR`` when a function is decorated."""
+    from numba.core import config
+
+    old = config.CACHE_DIR
+    config.CACHE_DIR = path
+    try:
+        yield
+    finally:
+        config.CACHE_DIR = old
+
+
+with _caching_in(cache_dir()):
+    from . import drive  # noqa: E402  (decorated here, cached there)
+
+
+class Compiled:
+    """A model's kernel: its code, parameter rows and options, and the calls into it.
+
+    Parameters
+    ----------
+    model : Model
+        The model (a single model, or a chunk of a model set whose array parameters are
+        flat, one element per geometry).
+    code : str
+        The kernel (:data:`models.kernels.drive.CODES`).
+    rows : sequence
+        The kernel's parameter rows in order: floats, or flat arrays of one length.
+    options : sequence of int
+        The kernel's options (slope kind, shadowing, conventions).
+    """
+
+    def __init__(self, model, code, rows, options):
+        self.code = drive.CODES[code]
+        length = max((np.size(r) for r in rows), default=1)
+        prm = np.empty((len(rows), length))
+        for k, r in enumerate(rows):
+            prm[k] = r
+        self.prm = {"float64": prm}
+        self.iopt = np.asarray(options, dtype=np.int64)
+
+    def params(self, precision):
+        p = self.prm.get(precision)
+        if p is None:
+            p = self.prm[precision] = self.prm["float64"].astype(precision)
+        return p
+
+    def call(self, ti, tr, pr, out, start, precision="float64"):
+        """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
+        fn = drive.run_parallel if n >= PARALLEL_MIN else drive.run
+        # contiguous inputs: one compiled specialization (and no view of a broadcast array)
+        ti, tr, pr = (np.ascontiguousarray(x) for x in (ti, tr, pr))
+        fn(self.code, ti, tr, pr, self.params(precision), self.iopt, out, start)
+
+    def run(self, ti, tr, pr, rows):
+        """``(rows, n)`` float64 of flat float64 angles (the model's dispatch, ``Model._m16``)."""
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
+        out = np.empty((rows, n))
+        self.call(ti, tr, pr, out, 0)
+        return out
+
+    def fill(self, plan, out, rows, precision):
+        """The whole evaluation of ``plan`` (a single model) into ``out``, chunk by chunk."""
+        dtype = np.dtype(precision)
+        direct = type(out) is np.ndarray and out.flags.c_contiguous
+        for sl, ti, tr, pr, _ in plan.blocks(fill=False):
+            a, b, c = (x.astype(dtype, copy=False) for x in (ti, tr, pr))
+            if direct:
+                self.call(a, b, c, out, sl.start, precision)
+            else:  # e.g. a memmap: through a chunk-sized buffer
+                buf = np.empty((rows, sl.stop - sl.start), dtype=dtype)
+                self.call(a, b, c, buf, 0, precision)
+                out[:, sl] = buf
+
+    def fast(self, theta_i, theta_r, phi_r, rows):
+        """The small-call path: floats, or C-contiguous float64 arrays of one shape (or
+        floats among them); ``None`` for anything else or a bad angle (the general path
+        then raises the error naming it)."""
+        if type(theta_i) is float and type(theta_r) is float and type(phi_r) in (float, int):
+            if not (0.0 <= theta_i <= _HALF_PI and 0.0 <= theta_r <= _HALF_PI and math.isfinite(phi_r)):
+                return None
+            out = np.empty((rows, 1))
+            drive.run_one(self.code, theta_i, theta_r, float(phi_r), self.prm["float64"], self.iopt, out)
+            return out.reshape(4, 4) if rows == 16 else out.reshape(())
+        shape = None
+        flat = []
+        for x in (theta_i, theta_r, phi_r):
+            if type(x) is float:
+                flat.append(np.full(1, x))
+            elif type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous and x.ndim:
+                if shape is not None and x.shape != shape:
+                    return None
+                shape = x.shape
+                flat.append(x.reshape(-1))
+            else:
+                return None
+        if shape is None or not drive.angles_ok(*flat):
+            return None
+        n = flat[0].size if flat[0].size > 1 else max(f.size for f in flat)
+        out = np.empty((rows, n))
+        self.call(flat[0], flat[1], flat[2], out, 0)
+        if rows == 1:
+            return out.reshape(shape)
+        return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
+
+
+def warm_up() -> None:
+    """Compile (or load from the cache) every kernel specialization the models use."""
+    prm = np.ones((11, 1))
+    for dtype in ("float64", "float32"):
+        a = np.full(1, 0.5, dtype=dtype)
+        p = prm.astype(dtype)
+        iopt = np.zeros(3, dtype=np.int64)
+        for rows in (16, 1):
+            out = np.empty((rows, 1), dtype=dtype)
+            for code in drive.CODES.values():
+                drive.run(code, a, a, a, p, iopt, out, 0)
+                drive.run_parallel(code, a, a, a, p, iopt, out, 0)
+    drive.run_one(0, 0.5, 0.5, 0.5, prm, np.zeros(3, dtype=np.int64), np.empty((16, 1)))
+    drive.angles_ok(np.zeros(1), np.zeros(1), np.zeros(1))

@@ -1,0 +1,237 @@
+"""Scalar building blocks of the compiled kernels (numba, ``cache=True``).
+
+Every function here works on one geometry's scalars in real arithmetic, in the precision
+of its arguments: constants are written ``T(c)`` with ``T = type(x)`` so that the float32
+kernels compute in float32 and the float64 ones exactly as written.  Complex numbers are
+``(re, im)`` pairs.  The formulas mirror the numpy implementation they are tested against
+(:mod:`models.fresnel`, :mod:`models.slopes`, :mod:`models.shadowing`,
+:func:`models.polarization.mueller16_from_jones`); comments say where they differ.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ..kernel_specs import (
+    ANISO_EXPONENTIAL,
+    ANISO_GAUSSIAN,
+    ANISO_GGX,
+    EXPONENTIAL,
+    GAUSSIAN,
+    GGX,
+    SHADOWING_KINDS,
+    UNIT,
+)
+
+NO_SHADOWING, SMITH = SHADOWING_KINDS["none"], SHADOWING_KINDS["smith"]
+
+_SQRT6 = math.sqrt(6.0)
+_INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
+
+
+@njit(cache=True)
+def exp_neg(x):
+    """``exp(-x)`` for ``x >= 0``, exactly zero from 700 on (as :func:`models.slopes._exp_neg`)."""
+    T = type(x)
+    if x < T(700.0):
+        return math.exp(-x)
+    return T(0.0)
+
+
+@njit(cache=True)
+def csqrt(a, b):
+    """Principal square root of ``a + ib`` (a ``+0`` imaginary part: the ``+i`` branch, TIR)."""
+    T = type(a)
+    if a == T(0.0) and b == T(0.0):
+        return T(0.0), T(0.0)
+    r = math.hypot(a, b)
+    if a >= T(0.0):
+        t = math.sqrt((a + r) * T(0.5))
+        return t, b / (T(2.0) * t)
+    t = math.sqrt((r - a) * T(0.5))
+    return abs(b) / (T(2.0) * t), math.copysign(t, b)
+
+
+@njit(cache=True)
+def cdiv(a, b, c, d):
+    """``(a + ib) / (c + id)`` (Smith's algorithm, as numpy)."""
+    if abs(c) >= abs(d):
+        r = d / c
+        den = c + d * r
+        return (a + b * r) / den, (b - a * r) / den
+    r = c / d
+    den = c * r + d
+    return (a * r + b) / den, (b * r - a) / den
+
+
+@njit(cache=True)
+def rs_k(c, mr, mi, pec):
+    """``r_s`` and ``K = (r_s + r_p) / sin^2`` at cosine ``c`` for relative index ``m = mr + i mi``
+    (:func:`models.fresnel.reflection_rs_k`); ``pec``: a perfect conductor."""
+    T = type(c)
+    if pec:
+        return T(-1.0), T(0.0), T(0.0), T(0.0)
+    if mr == T(1.0) and mi == T(0.0):
+        return T(0.0), T(0.0), T(0.0), T(0.0)
+    m2r = mr * mr - mi * mi
+    m2i = mr * mi + mi * mr
+    wr, wi = csqrt(m2r - T(1.0) + c * c, m2i)
+    cwr, cwi = c + wr, wi
+    rsr, rsi = cdiv(c - wr, -wi, cwr, cwi)
+    # (m^2 c + w) (c + w)
+    pr_, pi_ = m2r * c + wr, m2i * c + wi
+    dr = cwr * pr_ - cwi * pi_
+    di = cwr * pi_ + cwi * pr_
+    kr, ki = cdiv(T(2.0) * (T(1.0) - m2r), -T(2.0) * m2i, dr, di)
+    return rsr, rsi, kr, ki
+
+
+@njit(cache=True)
+def coating_t(c, n):
+    """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`models.fresnel.coating_transmission`)."""
+    T = type(c)
+    w = math.sqrt(n * n - T(1.0) + c * c)
+    return T(2.0) * c / (c + w), T(2.0) * n * c / (n * n * c + w)
+
+
+@njit(cache=True)
+def p3(kind, zx, zy, sx, sy, rot, cov):
+    """Slope density ``P3^xy`` of ``kind`` at ``(zx, zy)``; ``sx``, ``sy`` the widths (sigma,
+    alpha; ``m_parallel``, ``m_perpendicular`` for strokes), ``rot`` the axes' rotation."""
+    T = type(zx)
+    pi = T(math.pi)
+    if kind == UNIT:
+        return T(1.0)
+    if kind == EXPONENTIAL:
+        z = math.sqrt(zx * zx + zy * zy)
+        return cov * ((T(3.0) / (pi * sx * sx)) * exp_neg(T(_SQRT6) * z / sx))
+    if kind == GAUSSIAN:
+        return cov * (exp_neg((zx * zx + zy * zy) / (sx * sx)) / (pi * sx * sx))
+    if kind == GGX:
+        a2 = sx * sx
+        d = a2 + zx * zx + zy * zy
+        return cov * (a2 / (pi * d * d))
+    c, s = math.cos(rot), math.sin(rot)
+    u = c * zx + s * zy
+    v = -s * zx + c * zy
+    if kind == ANISO_EXPONENTIAL:
+        r = math.sqrt((u / sx) ** 2 + (v / sy) ** 2)
+        return cov * (T(3.0) / (pi * sx * sy) * exp_neg(T(_SQRT6) * r))
+    if kind == ANISO_GAUSSIAN:
+        return cov * (exp_neg((u / sx) ** 2 + (v / sy) ** 2) / (pi * sx * sy))
+    if kind == ANISO_GGX:
+        d = T(1.0) + (u / sx) ** 2 + (v / sy) ** 2
+        return cov * (T(1.0) / (pi * sx * sy * d * d))
+    return cov * (stroke_d(zx, zy, T(1.0), sx, sy, c, s) / pi)
+
+
+@njit(cache=True)
+def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
+    """``exp(-tan^2 alpha / m(beta)^2) / m(beta)^2`` for a bisector ``h`` (seed 001 Eq. 8, 19;
+    :func:`models.stroke_slopes.stroke_d`); ``c``, ``s``: cosine and sine of the strokes' azimuth."""
+    T = type(hx)
+    a2 = T(1.0) / (m_par * m_par)
+    if m_par == m_perp:
+        return exp_neg((hx * hx + hy * hy) * a2 / hz2) * a2
+    b2 = T(1.0) / (m_perp * m_perp)
+    u = c * hx + s * hy
+    v = c * hy - s * hx
+    u2, v2 = u * u, v * v
+    q = u2 * a2 + v2 * b2
+    r2 = u2 + v2
+    inv_m2 = q / r2 if r2 > T(0.0) else T(0.5) * (a2 + b2)
+    return exp_neg(q / hz2) * inv_m2
+
+
+@njit(cache=True)
+def lam_unit(kind, mu):
+    """Smith ``Lambda`` of the unit-width Gaussian or GGX family at ``mu = |cot theta|``."""
+    T = type(mu)
+    if kind == GAUSSIAN or kind == ANISO_GAUSSIAN:
+        if mu == T(0.0):
+            return T(math.inf)
+        tail = math.exp(-mu * mu) * T(_INV_SQRT_PI) / (T(2.0) * mu)
+        return tail - T(0.5) * math.erfc(mu)
+    if mu == T(0.0):
+        return T(math.inf)
+    x = T(1.0) / mu
+    return T(0.5) * x * x / (T(1.0) + math.sqrt(T(1.0) + x * x))
+
+
+@njit(cache=True)
+def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
+    """Smith ``Lambda`` (:func:`models.shadowing.smith_lambda`) of the Gaussian and GGX
+    families, isotropic or elliptical, for a direction (cosine, sine, azimuth)."""
+    T = type(c)
+    mu = abs(c) / s if s > T(0.0) else T(math.inf)
+    if kind == GAUSSIAN or kind == GGX:
+        alpha = sx
+    else:
+        cr, sr = math.cos(rot), math.sin(rot)
+        cl = cphi * cr + sphi * sr
+        sl = sphi * cr - cphi * sr
+        alpha = math.sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
+    return lam_unit(kind, mu / alpha)
+
+
+@njit(cache=True)
+def smith_g(shadowing, kind, di, dio, sx, sy, rot):
+    """Shadowing-masking ``G`` for directions ``di``, ``dio`` = ``(cos, sin, cos phi, sin phi)``
+    (no back-facing test: both see the facet from its front)."""
+    T = type(sx)
+    li = smith_lambda(kind, di[0], di[1], di[2], di[3], sx, sy, rot)
+    lo = smith_lambda(kind, dio[0], dio[1], dio[2], dio[3], sx, sy, rot)
+    if shadowing == SMITH:
+        return (T(1.0) / (T(1.0) + li)) * (T(1.0) / (T(1.0) + lo))
+    return T(1.0) / (T(1.0) + (li + lo))
+
+
+@njit(cache=True)
+def write_mueller(out, i, ssr, ssi, psr, psi, spr, spi, ppr, ppi):
+    """Mueller elements of a Jones matrix into ``out[:, i]`` (Bohren & Huffman, as
+    :func:`models.polarization.mueller16_from_jones`); only ``M00`` when ``out`` has one row."""
+    T = type(ssr)
+    half = T(0.5)
+    nss = ssr * ssr + ssi * ssi
+    npp = ppr * ppr + ppi * ppi
+    nps = psr * psr + psi * psi
+    nsp = spr * spr + spi * spi
+    a = nss + npp
+    c = nps + nsp
+    out[0, i] = (a + c) * half
+    if out.shape[0] == 1:
+        return
+    b = nss - npp
+    d = nsp - nps
+    out[1, i] = (b + d) * half
+    out[4, i] = (b - d) * half
+    out[5, i] = (a - c) * half
+    x1r, x1i = ssr * psr + ssi * psi, ssi * psr - ssr * psi
+    x2r, x2i = ppr * spr + ppi * spi, ppi * spr - ppr * spi
+    x3r, x3i = ssr * spr + ssi * spi, ssi * spr - ssr * spi
+    x4r, x4i = ppr * psr + ppi * psi, ppi * psr - ppr * psi
+    x5r, x5i = ppr * ssr + ppi * ssi, ppi * ssr - ppr * ssi
+    x6r, x6i = psr * spr + psi * spi, psi * spr - psr * spi
+    out[2, i] = x1r + x2r
+    out[3, i] = x1i - x2i
+    out[6, i] = x1r - x2r
+    out[7, i] = x1i + x2i
+    out[8, i] = x3r + x4r
+    out[9, i] = x3r - x4r
+    out[10, i] = x5r + x6r
+    out[11, i] = -(x5i + x6i)
+    out[12, i] = x4i - x3i
+    out[13, i] = -(x3i + x4i)
+    out[14, i] = x5i - x6i
+    out[15, i] = x5r - x6r
+
+
+@njit(cache=True)
+def write_diag(out, i, m00):
+    """A depolarizer ``diag(m00, 0, 0, 0)`` into ``out[:, i]`` (the scalar models)."""
+    T = type(m00)
+    out[0, i] = m00
+    for e in range(1, out.shape[0]):
+        out[e, i] = T(0.0)

@@ -1,0 +1,85 @@
+"""Cook-Torrance kernels (seed 001 Eq. 7-24): :class:`models.CookTorranceBRDF` and
+:class:`models.VarnishedCookTorranceBRDF`, one geometry per call, as
+:mod:`models.cook_torrance` and :mod:`models.varnished` compute them."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .common import cdiv, csqrt, stroke_d, write_diag
+
+#: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
+COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
+
+
+@njit(cache=True)
+def fresnel_average(c, mr, mi, pec):
+    """Natural-light reflectance ``(|r_s|^2 + |r_p|^2) / 2`` at cosine ``c`` for relative index
+    ``mr + i mi`` (:func:`models.cook_torrance.fresnel_average`)."""
+    T = type(c)
+    if pec:
+        return T(1.0)
+    if mr == T(1.0) and mi == T(0.0):
+        return T(0.0)
+    m2r = mr * mr - mi * mi
+    m2i = mr * mi + mi * mr
+    wr, wi = csqrt(m2r - T(1.0) + c * c, m2i)
+    rsr, rsi = cdiv(c - wr, -wi, c + wr, wi)
+    ar, ai = m2r * c, m2i * c
+    rpr, rpi = cdiv(ar - wr, ai - wi, ar + wr, ai + wi)
+    return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
+
+
+@njit(cache=True)
+def ct_value(ci, cr, cp, sp, prm, j, mr, mi, blinn):
+    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``."""
+    T = type(ci)
+    si = math.sqrt(T(1.0) - ci * ci)
+    sr = math.sqrt(T(1.0) - cr * cr)
+    hx = sr * cp - si
+    hy = sr * sp
+    hz = ci + cr
+    hz2 = hz * hz
+    g = hx * hx + hy * hy + hz2
+    q = g / hz2
+    a = prm[5, j]
+    val = stroke_d(hx, hy, hz2, prm[3, j], prm[4, j], math.cos(a), math.sin(a)) * (q * q)
+    val *= fresnel_average(T(0.5) * math.sqrt(g), mr, mi, mr == T(math.inf))
+    if blinn:
+        t = (T(4.0) / g) * hz
+        val *= min(T(1.0), t * min(ci, cr))
+    return val
+
+
+@njit(cache=True)
+def cook(ti, tr, pr, prm, j, iopt, out, i):
+    """Cook-Torrance (``iopt[0] = 0``) or its varnished form (1); ``iopt[1]``: corrected
+    convention, ``iopt[2]``: Blinn's G."""
+    T = type(ti)
+    half_pi = T(0.5 * math.pi)
+    if ti >= half_pi or tr >= half_pi:
+        write_diag(out, i, T(0.0))
+        return
+    ci, cr = math.cos(ti), math.cos(tr)
+    cp, sp = math.cos(pr), math.sin(pr)
+    nv, sub_r, sub_i = prm[0, j], prm[1, j], prm[2, j]
+    if iopt[0] == 0:
+        val = ct_value(ci, cr, cp, sp, prm, j, sub_r, sub_i, iopt[2] == 1)
+        scale = T(1.0 / (4.0 * math.pi)) if iopt[1] == 1 else T(1.0)
+        write_diag(out, i, val * (scale / (ci * cr)))
+        return
+    inv_nv = T(1.0) / nv
+    cii = math.sqrt(nv * nv - T(1.0) + ci * ci) * inv_nv
+    cri = math.sqrt(nv * nv - T(1.0) + cr * cr) * inv_nv
+    val = ct_value(cii, cri, cp, sp, prm, j, sub_r / nv, sub_i / nv, iopt[2] == 1)
+    if nv != T(1.0):
+        ti_ = T(1.0) - fresnel_average(ci, nv, T(0.0), False)
+        tr_ = T(1.0) - fresnel_average(cr, nv, T(0.0), False)
+        val *= ti_ * tr_
+    if iopt[1] == 0:
+        val *= T(1.0) / (ci * cr)
+    else:
+        val *= T(1.0 / (4.0 * math.pi)) / (nv * nv * cii * cri)
+    write_diag(out, i, val)

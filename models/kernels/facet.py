@@ -1,0 +1,182 @@
+"""Facet kernels: reflection by facets under a smooth coating (seed 000; :class:`models.FacetBRDF`,
+:class:`models.SubsurfaceFacetBRDF`) and transmission into a rough dielectric (seed 003
+Sec. 2.4; :class:`models.FacetBTDF`), one geometry per call, as :mod:`models.facet` and
+:mod:`models.facet_btdf` compute them."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .common import NO_SHADOWING, coating_t, p3, rs_k, smith_g, write_mueller
+
+#: parameter rows of the facet reflection kernel
+FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
+
+
+@njit(cache=True)
+def facet_jones(ti, tr, pr, prm, j, iopt):
+    """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
+    Mueller matrix is the BRDF (:func:`models.facet.facet_jones`)."""
+    T = type(ti)
+    n, sub_r, sub_i = prm[0, j], prm[1, j], prm[2, j]
+    ci_e, cr_e = math.cos(ti), math.cos(tr)
+    si_e = math.sqrt(T(1.0) - ci_e * ci_e)
+    sr_e = math.sqrt(T(1.0) - cr_e * cr_e)
+    if n == T(1.0):
+        si, sr, ci, cr = si_e, sr_e, ci_e, cr_e
+    else:
+        inv_n = T(1.0) / n
+        si, sr = si_e * inv_n, sr_e * inv_n
+        ci = math.sqrt(n * n - T(1.0) + ci_e * ci_e) * inv_n
+        cr = math.sqrt(n * n - T(1.0) + cr_e * cr_e) * inv_n
+    sp, cp = math.sin(pr), math.cos(pr)
+    hx = sr * cp - si
+    hy = sr * sp
+    hz = cr + ci
+    g = hx * hx + hy * hy + hz * hz
+    inv_hz = T(1.0) / hz
+    dens = p3(iopt[0], hx * inv_hz, hy * inv_hz, prm[3, j], prm[4, j], prm[5, j], prm[6, j])
+    q = g * inv_hz * inv_hz
+    S = dens * q * q / (T(4.0) * ci_e * cr_e)
+    half_pi = T(0.5 * math.pi)
+    if ti >= half_pi or tr >= half_pi:
+        S = T(0.0)
+    if iopt[1] != NO_SHADOWING:
+        S = S * smith_g(
+            iopt[1], iopt[0], (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), prm[3, j], prm[4, j], prm[5, j]
+        )
+    c = T(0.5) * math.sqrt(g)
+    rsr, rsi, kr, ki = rs_k(c, sub_r / n, sub_i / n, sub_r == T(math.inf))
+    inv_g = T(1.0) / g
+    ho_s, ho_p = si * sp, cr * cp * si + sr * ci
+    hi_s, hi_p = sr * sp * inv_g, (ci * sr * cp + si * cr) * inv_g
+    d_ss, d_ps, d_sp, d_pp = cp, -sp * ci, -cr * sp, sr * si - cr * cp * ci
+    if n != T(1.0):
+        tsi, tpi = coating_t(ci_e, n)
+        tsr, tpr = coating_t(cr_e, n)
+        ho_s, ho_p, hi_s, hi_p = ho_s * tsr, ho_p * tpr, hi_s * tsi, hi_p * tpi
+        d_ss, d_ps = d_ss * (tsr * tsi), d_ps * (tsr * tpi)
+        d_sp, d_pp = d_sp * (tpr * tsi), d_pp * (tpr * tpi)
+    root = math.sqrt(S)
+    r_re, r_im = rsr * root, rsi * root
+    k_re = kr * root - T(2.0) * r_re
+    k_im = ki * root - T(2.0) * r_im
+    b_ss, b_ps, b_sp, b_pp = ho_s * hi_s, ho_s * hi_p, ho_p * hi_s, ho_p * hi_p
+    return (
+        r_re * d_ss + k_re * b_ss,
+        r_im * d_ss + k_im * b_ss,
+        r_re * d_ps + k_re * b_ps,
+        r_im * d_ps + k_im * b_ps,
+        r_re * d_sp + k_re * b_sp,
+        r_im * d_sp + k_im * b_sp,
+        r_re * d_pp + k_re * b_pp,
+        r_im * d_pp + k_im * b_pp,
+    )
+
+
+@njit(cache=True)
+def facet(ti, tr, pr, prm, j, iopt, out, i):
+    """:class:`models.FacetBRDF` and :class:`models.SubsurfaceFacetBRDF` at one geometry."""
+    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, prm, j, iopt)
+    write_mueller(out, i, a, b, c, d, e, f, g, h)
+
+
+#: parameter rows of the facet transmission kernel
+BTDF_ROWS = ("substrate", "sx", "sy", "rotation", "coverage")
+
+
+@njit(cache=True)
+def dot3(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def cross3(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(cache=True)
+def transmission_factors(c, mr):
+    """``t_s`` and ``(t_p - t_s) / sin^2`` of refraction at local cosine ``c`` into relative
+    index ``mr`` (zero beyond the critical angle), as :func:`models.facet_btdf.facet_transmission_jones`."""
+    T = type(c)
+    arg = mr * mr - T(1.0) + c * c
+    if not arg > T(0.0):
+        return T(0.0), T(0.0)
+    w = math.sqrt(arg)
+    den_s = c + w
+    if not den_s > T(0.0):
+        return T(0.0), T(0.0)
+    inv_s = T(1.0) / den_s
+    inv_p = T(1.0) / (mr * mr * c + w)
+    ts = T(2.0) * c * inv_s
+    delta = T(2.0) * c * (mr - T(1.0)) * (mr * mr - T(1.0)) * inv_s * inv_p
+    return ts, delta * (T(1.0) / (w + mr * c))
+
+
+@njit(cache=True)
+def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
+    """Real Jones elements ``(ss, ps, sp, pp)`` of refraction through facet ``m`` and the local
+    cosines ``(cos iota_in, cos iota_out)`` (the dyadic of seed 003 Eq. 40, Rodrigues' rotation)."""
+    T = type(mr)
+    c = min(max(-dot3(k_in, m), T(0.0)), T(1.0))
+    ts, delta = transmission_factors(c, mr)
+    u = cross3(k_in, m)
+    a_out = cross3(k_out, u)
+    a_in = cross3(k_in, u)
+    v = cross3(k_in, k_out)
+    cg = dot3(k_in, k_out)
+    one_cg = T(1.0) + cg
+    inv1 = T(1.0) / one_cg if one_cg > T(1e-300) else T(0.0)
+    res = [T(0.0)] * 4
+    for a in range(2):
+        ea = e_out[a]
+        eav = dot3(ea, v)
+        eaa = dot3(ea, a_out)
+        for b in range(2):
+            eb = e_in[b]
+            rot = cg * dot3(ea, eb) + dot3(ea, cross3(v, eb)) + eav * dot3(v, eb) * inv1
+            res[2 * a + b] = ts * rot + delta * eaa * dot3(a_in, eb)
+    c_out = min(max(-dot3(k_out, m), T(0.0)), T(1.0))
+    return res[0], res[1], res[2], res[3], c, c_out
+
+
+@njit(cache=True)
+def btdf(ti, tt, pt, prm, j, iopt, out, i):
+    """:class:`models.FacetBTDF` (``convention="paper"``) at one geometry."""
+    T = type(ti)
+    n = prm[0, j]
+    si, ci = math.sin(ti), math.cos(ti)
+    st, ct = math.sin(tt), math.cos(tt)
+    cp, sp = math.cos(pt), math.sin(pt)
+    k_in = (si, T(0.0), -ci)
+    k_out = (st * cp, st * sp, -ct)
+    h = (k_in[0] - n * k_out[0], k_in[1] - n * k_out[1], k_in[2] - n * k_out[2])
+    D2 = dot3(h, h)
+    D = math.sqrt(D2)
+    mz = h[2] / D
+    half_pi = T(0.5 * math.pi)
+    if not (mz > T(0.0) and n * dot3(k_in, k_out) - T(1.0) > T(0.0) and ti < half_pi and tt < half_pi):
+        write_mueller(out, i, T(0.0), T(0.0), T(0.0), T(0.0), T(0.0), T(0.0), T(0.0), T(0.0))
+        return
+    m = (h[0] / D, h[1] / D, mz)
+    z = (T(0.0), T(0.0), T(0.0))
+    s_in = (T(0.0), T(1.0), T(0.0))
+    s_out = (-sp, cp, T(0.0))
+    e_in = (s_in, cross3(k_in, s_in))
+    e_out = (s_out, cross3(k_out, s_out))
+    ss, ps, sp_, pp, c_in, c_out = btdf_jones(k_in, k_out, m, n, e_in, e_out)
+    dens = p3(iopt[0], h[0] / h[2], h[1] / h[2], prm[1, j], prm[2, j], prm[3, j], prm[4, j])
+    mz2 = mz * mz
+    S = dens * n * c_out * (T(1.0) / (ci * ct)) / (mz2 * mz2) * (n * n * c_out / D2)
+    if iopt[1] != NO_SHADOWING:
+        g = smith_g(
+            iopt[1], iopt[0], (ci, si, -T(1.0), T(0.0)), (-ct, st, cp, sp), prm[1, j], prm[2, j], prm[3, j]
+        )
+        # back-facing (chi+) tests of Walter et al. Eq. 21-23: both local cosines positive here
+        S = S * (g if (c_in * ci > T(0.0) and c_out * ct > T(0.0)) else T(0.0))
+    root = math.sqrt(S)
+    zr = z[0]
+    write_mueller(out, i, ss * root, zr, ps * root, zr, sp_ * root, zr, pp * root, zr)

@@ -1,0 +1,53 @@
+"""The Maxwell-Beard kernel (:class:`models.MaxwellBeardBRDF`): the facet term of
+:mod:`models.kernels.facet` times the shadowing/obscuration function, plus the Lambertian
+and volumetric terms, one geometry per call, as :mod:`models.maxwell_beard` computes them."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .common import write_diag, write_mueller
+from .facet import FACET_ROWS, facet_jones
+
+#: parameter rows: the facet kernel's, then rho_d, rho_v, tau, omega
+MAXWELL_ROWS = FACET_ROWS + ("rho_d", "rho_v", "tau", "omega")
+
+
+@njit(cache=True)
+def shadow(ti, tr, pr, tau, omega):
+    """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`models.maxwell_beard.maxwell_beard_shadow`)."""
+    T = type(ti)
+    si, ci, sr, cr = math.sin(ti), math.cos(ti), math.sin(tr), math.cos(tr)
+    cp = math.cos(pr)
+    t = si * si - T(2.0) * si * sr * cp + sr * sr
+    den = ci + cr
+    slope = math.sqrt(max(t, T(0.0))) / (den if den > T(0.0) else T(1.0))
+    theta_n = math.atan(slope)
+    cos_beta = math.sqrt(min(max(T(0.5) * (T(1.0) - si * sr * cp + ci * cr), T(0.0)), T(1.0)))
+    beta = math.acos(min(cos_beta, T(1.0)))
+    x = theta_n / omega
+    return (T(1.0) + x * math.exp(-T(2.0) * beta / tau)) / (T(1.0) + x)
+
+
+@njit(cache=True)
+def maxwell(ti, tr, pr, prm, j, iopt, out, i):
+    """Maxwell-Beard at one geometry; ``iopt[2]``: the facet Mueller matrix on the specular term."""
+    T = type(ti)
+    so = shadow(ti, tr, pr, prm[9, j], prm[10, j])
+    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, prm, j, iopt)
+    if iopt[2] == 1:
+        write_mueller(out, i, a, b, c, d, e, f, g, h)
+        for k in range(out.shape[0]):
+            out[k, i] *= so
+    else:
+        write_diag(
+            out, i, T(0.5) * ((a * a + b * b) + (c * c + d * d) + (e * e + f * f) + (g * g + h * h)) * so
+        )
+    ci, cr = math.cos(ti), math.cos(tr)
+    den = ci + cr
+    vol = T(2.0) * prm[8, j] / (den if den > T(0.0) else T(1.0))
+    half_pi = T(0.5 * math.pi)
+    if not (ti >= half_pi or tr >= half_pi):
+        out[0, i] += prm[7, j] + vol

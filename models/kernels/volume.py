@@ -1,0 +1,81 @@
+"""Volume-scattering kernels under a smooth interface (seed 003 Sec. 2.2-2.3):
+:class:`models.SingleScatterBRDF` and :class:`models.DiffuseSubsurfaceBRDF`, one geometry per
+call, as :mod:`models.single_scatter` and :mod:`models.diffuse_subsurface` compute them."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .common import write_mueller
+
+#: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
+SINGLE_ROWS = ("coating", "g")
+DIFFUSE_ROWS = ("coating", "scale")
+
+
+@njit(cache=True)
+def amplitudes(c, n):
+    """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`."""
+    T = type(c)
+    if c < T(1e-15):
+        c = T(0.0)
+    s_int = math.sqrt(T(1.0) - c * c) * (T(1.0) / n)
+    c_int = math.sqrt(T(1.0) - s_int * s_int)
+    root = T(2.0) * math.sqrt(c * c_int)
+    tiny = T(1e-300) if T(1e-300) > T(0.0) else T(1e-38)
+    return s_int, c_int, root / max(c + n * c_int, tiny), root / max(n * c + c_int, tiny)
+
+
+@njit(cache=True)
+def write_depolarized(out, i, asi, api, asr, apr, scale):
+    """:func:`models.smooth_interface.depolarized_between` into ``out[:, i]``."""
+    T = type(asi)
+    half = T(0.5)
+    a, b = asr * asr, apr * apr
+    c, d = asi * asi, api * api
+    s_out, d_out = half * (a + b) * scale, half * (a - b) * scale
+    s_in, d_in = half * (c + d), half * (c - d)
+    out[0, i] = s_out * s_in
+    if out.shape[0] == 1:
+        return
+    for e in range(2, 16):
+        out[e, i] = T(0.0)
+    out[1, i] = s_out * d_in
+    out[4, i] = d_out * s_in
+    out[5, i] = d_out * d_in
+
+
+@njit(cache=True)
+def single(ti, tr, pr, prm, j, iopt, out, i):
+    """Single scattering under a smooth interface (seed 003 Eq. 20); ``iopt[0]``: polarized phase."""
+    T = type(ti)
+    n, g = prm[0, j], prm[1, j]
+    si, ci, asi, api = amplitudes(math.cos(ti), n)
+    sr, cr, asr, apr = amplitudes(math.cos(tr), n)
+    cp, sp = math.cos(pr), math.sin(pr)
+    cos_scat = si * sr * cp - ci * cr
+    base = T(1.0) + g * g - T(2.0) * g * cos_scat
+    dens = (T(1.0) - g * g) / (T(4.0 * math.pi) * base * math.sqrt(base))
+    tiny = T(1e-300) if T(1e-300) > T(0.0) else T(1e-38)
+    K = dens / max(ci + cr, tiny)
+    if iopt[0] == 0:
+        write_depolarized(out, i, asi, api, asr, apr, K)
+        return
+    root = math.sqrt(T(2.0) * K / (T(1.0) + cos_scat * cos_scat))
+    ss = asr * asi * root * cp
+    ps = -(asr * api * root) * sp * ci
+    sp_ = -(apr * asi * root) * sp * cr
+    pp = apr * api * root * (si * sr - ci * cr * cp)
+    z = T(0.0)
+    write_mueller(out, i, ss, z, ps, z, sp_, z, pp, z)
+
+
+@njit(cache=True)
+def diffuse(ti, tr, pr, prm, j, iopt, out, i):
+    """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``prm[1]``: its scale."""
+    n = prm[0, j]
+    _, _, asi, api = amplitudes(math.cos(ti), n)
+    _, _, asr, apr = amplitudes(math.cos(tr), n)
+    write_depolarized(out, i, asi, api, asr, apr, prm[1, j])

@@ -1,0 +1,208 @@
+"""The compiled kernels against the numpy reference implementation (1e-12 relative to M00),
+model sets, the small-call path, float32, and the cache location."""
+
+import math
+
+import numpy as np
+import pytest
+
+import models
+from models import kernel_specs
+from models.evaluation import backend
+
+AL = 1.37 + 7.62j
+TOL = 1e-12
+
+
+def _configs():
+    S = models
+    slopes = [
+        S.ExponentialSlopes(0.1),
+        S.GaussianSlopes(0.2, coverage=0.7),
+        S.GGXSlopes(0.15),
+        S.AnisotropicExponentialSlopes(0.05, 0.3, rotation=0.4),
+        S.AnisotropicGaussianSlopes(0.1, 0.2, rotation=-1.0),
+        S.AnisotropicGGXSlopes(0.3, 0.1, rotation=2.0),
+        S.StrokeSlopes(0.05, 0.4, 0.3),
+        S.UnitSlopes(),
+        S.ExponentialSlopes(1e-4),
+        S.GaussianSlopes(5.0),
+    ]
+    out = []
+    for s in slopes:
+        for sub in (AL, 1.5, math.inf, 1.0 + 0j, 0.2 + 3j):
+            out.append(S.FacetBRDF(slopes=s, substrate=sub))
+        out.append(S.SubsurfaceFacetBRDF(slopes=s, coating=1.5, substrate=AL))
+        out.append(S.SubsurfaceFacetBRDF(slopes=s, coating=2.0, substrate=1.2))  # TIR at the flakes
+        out.append(S.FacetBTDF(slopes=s, substrate=1.5))
+        out.append(S.MaxwellBeardBRDF(slopes=s, rho_d=0.02, rho_v=0.01, polarized=True))
+    for s in (S.GaussianSlopes(0.3), S.GGXSlopes(0.2), S.AnisotropicGaussianSlopes(0.1, 0.4, rotation=0.3)):
+        for sh in ("smith", "smith-correlated"):
+            out.append(S.FacetBRDF(slopes=s, substrate=AL, shadowing=sh))
+            out.append(S.SubsurfaceFacetBRDF(slopes=s, coating=1.5, substrate=AL, shadowing=sh))
+            out.append(S.FacetBTDF(slopes=s, substrate=1.7, shadowing=sh))
+    for g, pol in ((0.3, True), (-0.9, False), (0.95, True), (0.0, False)):
+        out.append(S.SingleScatterBRDF(coating=1.5, phase=S.HenyeyGreenstein(g, pol)))
+        out.append(S.SingleScatterBRDF(coating=1.0, phase=S.HenyeyGreenstein(g, pol)))
+    for n, rho in ((1.5, 0.93), (1.0, 1.0), (2.5, 0.0)):
+        out.append(S.DiffuseSubsurfaceBRDF(coating=n, rho=rho))
+    for conv in ("paper", "corrected"):
+        for sh in ("blinn", "none"):
+            for sub in (2.29 + 3.37j, math.inf, 1.0 + 0j):
+                out.append(
+                    S.CookTorranceBRDF(
+                        slopes=S.GaussianSlopes(0.03), substrate=sub, convention=conv, shadowing=sh
+                    )
+                )
+                out.append(
+                    S.VarnishedCookTorranceBRDF(coating=1.5, substrate=sub, convention=conv, shadowing=sh)
+                )
+            out.append(
+                S.VarnishedCookTorranceBRDF(
+                    slopes=S.StrokeSlopes(0.05, 0.3, 0.7), coating=1.0, convention=conv
+                )
+            )
+    out.append(S.MaxwellBeardBRDF(polarized=False, rho_d=0.1, rho_v=0.2, tau=0.1, omega=2.0))
+    return out
+
+
+CONFIGS = _configs()
+
+
+def _geometries(transmission=False):
+    rng = np.random.default_rng(12)
+    n = 400
+    ti = rng.uniform(0, math.pi / 2, n)
+    tr = rng.uniform(0, math.pi / 2, n)
+    pr = rng.uniform(-math.pi, math.pi, n)
+    half = math.pi / 2
+    grazing = math.radians(89.99)
+    ext_ti = [0.0, 0.0, 0.6, 0.6, 0.6, half, 0.3, grazing, 1.2, 1.2, 0.7, 0.0, half, 1.0]
+    ext_tr = [0.0, 0.5, 0.6, 0.6, 0.6, 0.4, half, grazing, 1.2, 1.2, 0.2, half, half, 0.0]
+    ext_pr = [0.0, 0.0, 0.0, math.pi, -math.pi, 0.0, 2.0, math.pi, math.pi, 0.0, 1e-9, math.pi, 0.0, -2.0]
+    return (np.concatenate([ti, ext_ti]), np.concatenate([tr, ext_tr]), np.concatenate([pr, ext_pr]))
+
+
+def _relative(mk, mn):
+    """max |M_kernel - M_numpy| per geometry, relative to the numpy M00 (exact zeros stay zeros)."""
+    m00 = np.abs(mn[..., 0, 0])[..., None, None]
+    err = np.abs(mk - mn)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(err == 0, 0.0, err / m00)
+    return float(np.max(rel))
+
+
+@pytest.mark.parametrize("model", CONFIGS, ids=lambda m: type(m).__name__)
+def test_kernel_equals_numpy_reference(model):
+    assert model._kernel_spec() is not None, "a configuration the kernels cover"
+    ti, tr, pr = _geometries()
+    mk = model.mueller(ti, tr, pr)
+    bk = model.brdf(ti, tr, pr)
+    with backend("numpy"):
+        mn = model.mueller(ti, tr, pr)
+        bn = model.brdf(ti, tr, pr)
+    assert np.all(np.isfinite(mk))
+    assert _relative(mk, mn) <= TOL
+    with np.errstate(divide="ignore", invalid="ignore"):
+        assert float(np.max(np.where(bk == bn, 0.0, np.abs(bk - bn) / np.abs(bn)))) <= TOL
+    # float32 angles are validated (and promoted) the same way on both paths
+    t32 = [a.astype(np.float32) for a in (ti, tr, pr)]
+    with backend("numpy"):
+        mn32 = model.mueller(*t32)
+    assert _relative(model.mueller(*t32), mn32) <= TOL
+
+
+def test_uncovered_options_fall_back_to_numpy():
+    for m in (
+        models.FacetBRDF(slopes=models.TabulatedSlopes()),
+        models.FacetBRDF(slopes=models.GaussianAngles(0.2)),
+        models.FacetBRDF(slopes=models.ExponentialSlopes(0.2), shadowing="smith"),
+        models.FacetBRDF(
+            substrate=models.FilmStack(layers=((1.5, 100.0),), substrate=AL, wavelength_nm=550.0)
+        ),
+        models.FacetBTDF(convention="corrected"),
+    ):
+        assert m._kernel_spec() is None
+        assert m._compiled() is None
+
+
+def test_model_sets_in_the_kernels():
+    sig = np.array([0.05, 0.1, 0.3])[:, None]
+    coat = np.array([1.2, 1.5, 1.9])[:, None]
+    sub = np.array([AL, 1.5 + 0j, math.inf])[:, None]
+    m = models.SubsurfaceFacetBRDF(slopes=models.ExponentialSlopes(sigma=sig), coating=coat, substrate=sub)
+    ti, tr, pr = (a[:50] for a in _geometries())
+    assert m.param_shape == (3, 1)
+    M = m.mueller(ti, tr, pr)
+    assert M.shape == (3, 50, 4, 4)
+    with backend("numpy"):
+        Mn = m.mueller(ti, tr, pr)
+    assert _relative(M, Mn) <= TOL
+    for w in range(3):
+        one = models.SubsurfaceFacetBRDF(
+            slopes=models.ExponentialSlopes(float(sig[w, 0])),
+            coating=float(coat[w, 0]),
+            substrate=sub[w, 0].item(),
+        )
+        assert np.array_equal(one.mueller(ti, tr, pr), M[w])  # the same kernel, element by element
+        assert np.array_equal(one.brdf(ti, tr, pr), m.brdf(ti, tr, pr)[w])
+    s = m + models.DiffuseSubsurfaceBRDF(rho=np.array([0.1, 0.5, 0.9])[:, None])
+    assert s.mueller(0.4, tr, 0.2).shape == (3, 50, 4, 4)
+
+
+def test_model_set_validation_is_vectorized_and_names_the_first_bad_value():
+    with pytest.raises(ValueError, match=r"sigma must be .*\(0, inf\); got -0.3 at index \(1, 0\)"):
+        models.GaussianSlopes(sigma=np.array([[0.2], [-0.3], [-1.0]]))
+    with pytest.raises(ValueError, match=r"substrate must be n \+ ik .*got \(1-1j\) at index \(1,\)"):
+        models.FacetBRDF(substrate=np.array([1.5, 1 - 1j]))
+    with pytest.raises(ValueError, match="must broadcast to one parameter shape"):
+        models.SubsurfaceFacetBRDF(
+            slopes=models.GaussianSlopes(np.ones((2, 1))), coating=np.full((3, 1), 1.5)
+        )
+    m = models.FacetBRDF(slopes=models.GaussianSlopes(0.1))
+    trusted = m.with_values({"slopes.sigma": np.array([0.1, 0.2])}, check=False)
+    assert trusted.param_shape == (2,) and m.param_shape == ()
+    with pytest.raises(ValueError, match="sigma"):
+        m.with_values({"slopes.sigma": np.array([0.1, -0.2])})
+
+
+def test_small_calls_agree_with_the_general_path():
+    m = models.SubsurfaceFacetBRDF()
+    one = m.mueller(0.5, 0.6, 0.1)
+    assert one.shape == (4, 4)
+    assert np.array_equal(one, m.mueller(np.array([0.5]), 0.6, 0.1)[0])
+    assert np.array_equal(one, m.mueller([0.5], [0.6], [0.1])[0])
+    x = np.linspace(0.1, 1.4, 100)
+    assert np.array_equal(m.mueller(x, x[::-1].copy(), 0.3), m.mueller(list(x), list(x[::-1]), 0.3))
+    assert m.brdf(0.5, 0.6, 0.1).shape == ()
+    with pytest.raises(ValueError, match="theta_r"):
+        m.mueller(0.5, 1.7, 0.1)
+    with pytest.raises(ValueError, match="phi_r"):
+        m.mueller(x, x, np.full(100, np.nan))
+
+
+def test_float32_kernels_and_their_error():
+    m = models.SubsurfaceFacetBRDF()
+    ti, tr, pr = _geometries()
+    M64 = m.mueller(ti, tr, pr)
+    M32 = m.mueller(ti, tr, pr, precision="float32")
+    assert M32.dtype == np.float32
+    rel = _relative(M32.astype(float), M64)
+    assert 1e-9 < rel < 1e-3  # computed in float32: far from float64, far below the model's accuracy
+    with pytest.raises(ValueError, match="precision"):
+        m.mueller(0.5, 0.5, 0.0, precision="half")
+
+
+def test_cache_directory_is_writable_and_keyed_by_the_sources():
+    from models import kernels
+
+    d = kernels.cache_dir()
+    assert "scatterbench-" in d
+    import os
+
+    assert os.access(d, os.W_OK)
+
+
+def test_kernel_specs_have_no_numba_import():
+    assert kernel_specs.slope_rows(models.TabulatedSlopes()) is None
+    assert kernel_specs.index_rows(math.inf) == [math.inf, 0.0]
