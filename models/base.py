@@ -173,17 +173,24 @@ class Model(Declared):
             fast = self._fast(theta_i, theta_r, phi_r, 16)
             if fast is not None:
                 return fast
+        shape, out = self.mueller16(theta_i, theta_r, phi_r, out, precision)
+        return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
+
+    def mueller16(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
+        """``(shape, M)``: the Mueller BRDF as its element-major storage ``M`` ``(16, N)``
+        (row ``4 a + b`` is element ``ab``) and the broadcast ``shape`` of the geometries
+        (``N`` their number); :meth:`mueller` returns a ``shape + (4, 4)`` view of it."""
         plan = self._plan(theta_i, theta_r, phi_r)
         dtype = np.dtype(evaluation.check_precision(precision))
-        shape, n = plan.shape, plan.n
-        # Element-major storage: each chunk's (16, k) block is copied without a
-        # transpose; the (..., 4, 4) result is a strided view of it.
+        # Element-major storage: each chunk's (16, k) block is copied without a transpose.
         if out is None:
-            out = np.empty((16, n), dtype=dtype)
-        elif out.shape != (16, n) or out.dtype != dtype:
-            raise ValueError(f"out must have shape (16, {n}) and dtype {dtype}; got {out.shape} {out.dtype}")
+            out = np.empty((16, plan.n), dtype=dtype)
+        elif out.shape != (16, plan.n) or out.dtype != dtype:
+            raise ValueError(
+                f"out must have shape (16, {plan.n}) and dtype {dtype}; got {out.shape} {out.dtype}"
+            )
         self._fill(plan, out, 16, precision)
-        return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
+        return plan.shape, out
 
     def brdf(self, theta_i, theta_r, phi_r=0.0, precision="float64"):
         """Unpolarized-in, total-out BRDF ``M00`` (1/sr); ``precision`` as for :meth:`mueller`."""
@@ -202,7 +209,11 @@ class Model(Declared):
             kernel.fill(plan, out, rows, precision)  # the kernel loops over the chunks itself
             return
         for sl, ti, tr, pr, m in plan.blocks():
-            out[:, sl] = m._m16(ti, tr, pr) if rows == 16 else m._m00(ti, tr, pr)
+            k = m._compiled() if out.dtype == np.float64 and type(out) is np.ndarray else None
+            if k is not None:  # a model set's chunk: the kernel writes in place
+                k.call(ti, tr, pr, out, sl.start)
+            else:
+                out[:, sl] = m._m16(ti, tr, pr) if rows == 16 else m._m00(ti, tr, pr)
 
     def _fast(self, theta_i, theta_r, phi_r, rows):
         """A small call (floats, or float64 arrays of one shape) straight into the kernel,

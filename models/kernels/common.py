@@ -46,7 +46,7 @@ def csqrt(a, b):
     T = type(a)
     if a == T(0.0) and b == T(0.0):
         return T(0.0), T(0.0)
-    r = math.hypot(a, b)
+    r = math.sqrt(a * a + b * b)  # no overflow here: |a|, |b| are index-sized
     if a >= T(0.0):
         t = math.sqrt((a + r) * T(0.5))
         return t, b / (T(2.0) * t)
@@ -188,7 +188,7 @@ def smith_g(shadowing, kind, di, dio, sx, sy, rot):
     return T(1.0) / (T(1.0) + (li + lo))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def write_mueller(out, i, ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     """Mueller elements of a Jones matrix into ``out[:, i]`` (Bohren & Huffman, as
     :func:`models.polarization.mueller16_from_jones`); only ``M00`` when ``out`` has one row."""
@@ -228,7 +228,7 @@ def write_mueller(out, i, ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     out[15, i] = x5r - x6r
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def write_diag(out, i, m00):
     """A depolarizer ``diag(m00, 0, 0, 0)`` into ``out[:, i]`` (the scalar models)."""
     T = type(m00)

@@ -32,7 +32,7 @@ def fresnel_average(c, mr, mi, pec):
     return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ct_value(ci, cr, cp, sp, prm, j, mr, mi, blinn):
     """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``."""
     T = type(ci)
@@ -53,7 +53,7 @@ def ct_value(ci, cr, cp, sp, prm, j, mr, mi, blinn):
     return val
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def cook(ti, tr, pr, prm, j, iopt, out, i):
     """Cook-Torrance (``iopt[0] = 0``) or its varnished form (1); ``iopt[1]``: corrected
     convention, ``iopt[2]``: Blinn's G."""

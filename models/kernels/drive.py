@@ -24,7 +24,7 @@ FACET, BTDF, SINGLE, DIFFUSE, COOK, MAXWELL = range(6)
 CODES = {"facet": FACET, "btdf": BTDF, "single": SINGLE, "diffuse": DIFFUSE, "cook": COOK, "maxwell": MAXWELL}
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def element(code, a, b, c, prm, j, iopt, out, i):
     """One geometry of model ``code`` into ``out[:, i]``."""
     if code == FACET:

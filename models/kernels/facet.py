@@ -15,7 +15,7 @@ from .common import NO_SHADOWING, coating_t, p3, rs_k, smith_g, write_mueller
 FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def facet_jones(ti, tr, pr, prm, j, iopt):
     """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
     Mueller matrix is the BRDF (:func:`models.facet.facet_jones`)."""
@@ -76,7 +76,7 @@ def facet_jones(ti, tr, pr, prm, j, iopt):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def facet(ti, tr, pr, prm, j, iopt, out, i):
     """:class:`models.FacetBRDF` and :class:`models.SubsurfaceFacetBRDF` at one geometry."""
     a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, prm, j, iopt)
@@ -116,7 +116,7 @@ def transmission_factors(c, mr):
     return ts, delta * (T(1.0) / (w + mr * c))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     """Real Jones elements ``(ss, ps, sp, pp)`` of refraction through facet ``m`` and the local
     cosines ``(cos iota_in, cos iota_out)`` (the dyadic of seed 003 Eq. 40, Rodrigues' rotation)."""
@@ -143,7 +143,7 @@ def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     return res[0], res[1], res[2], res[3], c, c_out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def btdf(ti, tt, pt, prm, j, iopt, out, i):
     """:class:`models.FacetBTDF` (``convention="paper"``) at one geometry."""
     T = type(ti)

@@ -31,7 +31,7 @@ def shadow(ti, tr, pr, tau, omega):
     return (T(1.0) + x * math.exp(-T(2.0) * beta / tau)) / (T(1.0) + x)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def maxwell(ti, tr, pr, prm, j, iopt, out, i):
     """Maxwell-Beard at one geometry; ``iopt[2]``: the facet Mueller matrix on the specular term."""
     T = type(ti)

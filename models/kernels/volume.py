@@ -28,7 +28,7 @@ def amplitudes(c, n):
     return s_int, c_int, root / max(c + n * c_int, tiny), root / max(n * c + c_int, tiny)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def write_depolarized(out, i, asi, api, asr, apr, scale):
     """:func:`models.smooth_interface.depolarized_between` into ``out[:, i]``."""
     T = type(asi)
@@ -47,7 +47,7 @@ def write_depolarized(out, i, asi, api, asr, apr, scale):
     out[5, i] = d_out * d_in
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def single(ti, tr, pr, prm, j, iopt, out, i):
     """Single scattering under a smooth interface (seed 003 Eq. 20); ``iopt[0]``: polarized phase."""
     T = type(ti)
@@ -72,7 +72,7 @@ def single(ti, tr, pr, prm, j, iopt, out, i):
     write_mueller(out, i, ss, z, ps, z, sp_, z, pp, z)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def diffuse(ti, tr, pr, prm, j, iopt, out, i):
     """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``prm[1]``: its scale."""
     n = prm[0, j]

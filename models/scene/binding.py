@@ -46,23 +46,24 @@ class Binding:
 
     model: object
     targets: dict  # key -> tuple of _Target
+    reference: dict  # path -> (value, kind) of every real and index parameter of ``model``
 
     def values_model(self, values: dict, shape=()):
         """The model with each key's value(s) set (arrays of ``shape``; trusted, see module)."""
         leaves = {}
-        ref = modelset.scalar_leaves(self.model)
         for key, v in values.items():
             for t in self.targets[key]:
                 x = np.radians(v) if t.transform == "radians" else np.asarray(v, dtype=float)
-                cur = leaves.get(t.path, ref[t.path][0])
-                if ref[t.path][1] == "index":
-                    cur = np.asarray(cur, dtype=complex)
+                ref, kind = self.reference[t.path]
+                if kind == "index":
+                    cur = np.asarray(leaves.get(t.path, ref), dtype=complex)
                     x = x + 1j * cur.imag if t.part == "real" else cur.real + 1j * x
                 leaves[t.path] = x
-        shaped = {p: np.broadcast_to(a, np.broadcast_shapes(np.shape(a), shape)) for p, a in leaves.items()}
         if shape == ():
-            shaped = {p: modelset.scalar_value(a.reshape(())[()]) for p, a in shaped.items()}
-        return modelset.with_leaves(self.model, shaped)
+            leaves = {p: modelset.scalar_value(np.asarray(a).reshape(())[()]) for p, a in leaves.items()}
+        else:
+            leaves = {p: np.broadcast_to(a, shape) if a.shape != shape else a for p, a in leaves.items()}
+        return modelset.with_leaves(self.model, leaves)
 
     def check(self, model):
         """Vectorized validation of the bound parameters of ``model`` (a ``ValueError`` names
@@ -132,7 +133,7 @@ def bind(scene, bounds: dict, decisions=None, probe=None):
         if found is None:
             return None
         targets[key] = found
-    binding = Binding(m0, targets)
+    binding = Binding(m0, targets, modelset.scalar_leaves(m0))
     if probe is not None and not _verified(scene, binding, bounds, decisions, probe):
         return None
     return binding

@@ -143,9 +143,17 @@ def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
     samples = fit.chain.samples()
     pick = rng.choice(len(samples), size=min(n_draws, len(samples)), replace=False)
     out = {t: {"model": [], "replicated": []} for t in TERMS}
-    for u in samples[pick]:
+    U = samples[pick]
+    batch = None
+    if lik.binding is not None:  # every draw's model at once (a model set)
+        values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(lik.spec.free)}
+        batch = lik.predict(lik.model(values), data)
+    for j, u in enumerate(U):  # the replicates draw in the order they always did
         values = lik.spec.physical(u)
-        pred = lik.predict(lik.model(values), data)
+        if batch is None:
+            pred = lik.predict(lik.model(values), data)
+        else:
+            pred = {t: batch[t][j] for t in TERMS}
         rep = replicate(pred, term_variances(lik.spec.noise_values(values), data, TERMS), rng)
         for t in out:
             out[t]["model"].append(pred[t])

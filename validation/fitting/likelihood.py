@@ -32,6 +32,7 @@ import math
 import numpy as np
 
 from models.polarization import ellipsometric, wrap_axis
+from models.scene import binding
 
 from .fitspec import FitSpec
 
@@ -53,7 +54,7 @@ def term_variances(noise: dict, data, terms) -> dict:
             e = err("brdf_err")
             out[t] = f * f + (0.0 if e is None else (e / data.brdf) ** 2)
         else:
-            s = math.radians(noise.get("eta_deg", 0.0)) if t == "eta" else noise.get(t, 0.0)
+            s = np.radians(noise.get("eta_deg", 0.0)) if t == "eta" else noise.get(t, 0.0)
             e = err(f"{t}_err")
             out[t] = s * s + (0.0 if e is None else e**2)
     return out
@@ -84,7 +85,16 @@ def scene_for_data(scene, data):
 
 
 class Likelihood:
-    """``L(u)``: the log posterior in the spec's sampling coordinates is ``self(u)``."""
+    """``L(u)``: the log posterior in the spec's sampling coordinates is ``self(u)``.
+
+    :meth:`batch` evaluates many positions at once, ``(walkers, k)`` in, ``(walkers,)`` out:
+    the scene's model is evaluated once, as a model set over the walkers
+    (:mod:`models.scene.binding`), and the prior bounds are checked once, vectorized.  A
+    single position (``self(u)``, :meth:`pointwise`, :meth:`whitened`) is a batch of one, so
+    every path gives the same numbers, bit for bit, whatever the batch (the chains of a
+    vectorized sampler equal those of a per-walker one).  Scenes whose free keys cannot be
+    bound are rebuilt per position (:meth:`model_rebuilt`, the path before model sets).
+    """
 
     def __init__(self, scene, spec: FitSpec, data):
         self.scene = scene_for_data(scene, data)
@@ -97,43 +107,46 @@ class Likelihood:
         d = self.data
         self._log_obs = np.log(d.brdf)
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
-        free_noise = {p.key[6:] for p in spec.free if p.is_noise}
-        have = lambda t: t in spec.noise or t in free_noise  # noqa: E731
-        used = lambda t, col, err: (  # noqa: E731
-            t not in spec.off and col is not None and (have(t) or err is not None)
-        )
-        terms = ["brdf"]
-        if not (have("brdf") or d.brdf_err is not None):
-            raise ValueError(
-                "noise.brdf: the BRDF term needs a noise level (fixed or free: --noise brdf=0.05 or "
-                "--noise brdf:0.005:1:log) or a brdf_err column"
-            )
-        if used("eta_deg", d.eta, d.eta_err):
-            terms.append("eta")
-        if used("P", d.P, d.P_err):
-            terms.append("P")
-        if used("P_C", d.P_C, d.P_C_err):
-            terms.append("P_C")
-        self.terms = tuple(terms)
+        self.terms = _terms(spec, d)
         self.n_points = len(d)
         # Whether the point source and the aperture matter (and the aperture's quadrature) is
         # decided once, at the scene's own values: re-deciding per evaluation would make ln L
         # jump where a decision flips.
         self.decisions = self.scene.decisions()
+        self._bounds = spec.u_bounds()
+        scene_keys = {p.key: (p.low, p.high) for p in spec.free if not p.is_noise}
+        probe = (d.theta_i[:8], d.theta_r[:8], d.phi_r[:8])
+        self.binding = binding.bind(self.scene, scene_keys, self.decisions, probe)
 
     # -- model ---------------------------------------------------------------------
     def model(self, values: dict):
+        """The scene's model at physical ``values`` (scalars: one model; arrays of one shape:
+        a model set, trusted: callers check the prior bounds first)."""
+        scene_values = self.spec.scene_values(values)
+        if self.binding is None:  # scalars only: the scene rebuilt
+            return self.model_rebuilt({k: float(np.asarray(v).reshape(())) for k, v in values.items()})
+        shape = np.broadcast_shapes(*(np.shape(v) for v in scene_values.values()))
+        return self.binding.values_model(scene_values, shape)
+
+    def model_rebuilt(self, values: dict):
+        """The scene rebuilt and validated at scalar ``values`` (no model set)."""
         return self.scene.with_values(self.spec.scene_values(values)).build(decisions=self.decisions)
 
     def predict(self, model, data=None) -> dict:
-        """Model ``brdf, eta, P, P_C`` at the rows of ``data`` (default: the fitted rows)."""
+        """Model ``brdf, eta, P, P_C`` at the rows of ``data`` (default: the fitted rows); a
+        model set of shape ``(W, 1)`` gives ``(W, rows)`` arrays."""
         d = self.data if data is None else data
-        M = model.mueller(d.theta_i, d.theta_r, d.phi_r)
+        shape, M = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
+        M = M.reshape((4, 4) + shape)
         if self._same_incident and data is None:
-            S = M @ d.incident[0]
+            inc = d.incident[0]
+            S = M[:, 0] * inc[0]
+            for b in (1, 2, 3):
+                if inc[b] != 0.0:
+                    S += M[:, b] * inc[b]
         else:
-            S = np.einsum("nij,nj->ni", M, d.incident)
-        i, eta, pc, p = ellipsometric(S)
+            S = np.einsum("ab...n,nb->a...n", M, d.incident)
+        i, eta, pc, p = ellipsometric(np.moveaxis(S, 0, -1))
         return {"brdf": i / d.incident[:, 0], "eta": eta, "P": p, "P_C": pc}
 
     # -- likelihood ----------------------------------------------------------------
@@ -154,14 +167,15 @@ class Likelihood:
             out["P_C"] = d.P_C - pred["P_C"]
         return out
 
-    def pointwise(self, u) -> np.ndarray:
-        """Per-row log-likelihood (all terms summed per row), ``-inf`` where impossible."""
-        values = self.spec.physical(u)
-        noise = self.spec.noise_values(values)
-        pred = self.predict(self.model(values))
+    def _walkers(self, U):
+        """Physical values of positions ``U`` (``(W, k)``) as ``(W, 1)`` arrays, and the noise."""
+        values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(self.spec.free)}
+        return values, self.spec.noise_values(values)
+
+    def _pointwise_rows(self, values, noise, pred) -> np.ndarray:
         res = self.residuals(pred)
         var = self._variances(noise)
-        total = np.zeros(self.n_points)
+        total = np.zeros(res["brdf"].shape)
         for t in self.terms:
             v = np.broadcast_to(var[t], total.shape)
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -169,30 +183,124 @@ class Likelihood:
             total += np.where(np.isfinite(ll), ll, -np.inf)
         return total
 
+    def pointwise_batch(self, U) -> np.ndarray:
+        """Per-row log-likelihood ``(W, rows)`` of positions ``U`` (``(W, k)``), ``-inf`` where
+        impossible; positions the model refuses give rows of ``-inf``."""
+        U = np.atleast_2d(np.asarray(U, dtype=float))
+        if self.binding is None:
+            return self._pointwise_each(U)
+        values, noise = self._walkers(U)
+        try:
+            model = self.model(values)
+            self.binding.check(model)  # vectorized: every walker's parameters at once
+        except ValueError:
+            return self._pointwise_valid(U)
+        return self._pointwise_rows(values, noise, self.predict(model))
+
+    def _pointwise_valid(self, U):
+        """Rows of ``-inf`` for the positions the scene refuses (rebuilt and validated one by
+        one), the others still evaluated together: a walker's value must not depend on which
+        walkers share its batch (executors split the walkers differently)."""
+        ok = np.zeros(len(U), dtype=bool)
+        for w, u in enumerate(U):
+            try:
+                self.model_rebuilt(self.spec.physical(u))
+                ok[w] = True
+            except ValueError:
+                continue
+        out = np.full((len(U), self.n_points), -np.inf)
+        if ok.all():  # refused by the binding's check only: the scene itself decides, as before
+            for w, u in enumerate(U):
+                out[w] = self.pointwise_rebuilt(u)
+        elif ok.any():
+            out[ok] = self.pointwise_batch(U[ok])
+        return out
+
+    def _pointwise_each(self, U):
+        """Position by position, the scene rebuilt and validated for each (-inf where refused)."""
+        out = np.full((len(U), self.n_points), -np.inf)
+        for w, u in enumerate(U):
+            try:
+                out[w] = self.pointwise_rebuilt(u)
+            except ValueError:
+                continue
+        return out
+
+    def pointwise_rebuilt(self, u) -> np.ndarray:
+        """Per-row log-likelihood at one position with the scene rebuilt and validated there (the
+        per-walker path before model sets; a ``ValueError`` where the scene refuses ``u``)."""
+        values = self.spec.physical(u)
+        return self._pointwise_rows(
+            values, self.spec.noise_values(values), self.predict(self.model_rebuilt(values))
+        )
+
+    def pointwise(self, u) -> np.ndarray:
+        """Per-row log-likelihood (all terms summed per row), ``-inf`` where impossible."""
+        return self.pointwise_batch(np.asarray(u, dtype=float)[None])[0]
+
+    def loglike_batch(self, U) -> np.ndarray:
+        """``ln L`` of positions ``U`` ``(W, k)``: :meth:`pointwise_batch` summed per row."""
+        return np.sum(self.pointwise_batch(U), axis=1)
+
     def whitened(self, u) -> np.ndarray:
         """Residuals divided by their standard deviations (for least squares); large
         finite values where the model predicts no light."""
-        values = self.spec.physical(u)
-        noise = self.spec.noise_values(values)
+        values, noise = self._walkers(np.asarray(u, dtype=float)[None])
         res = self.residuals(self.predict(self.model(values)))
         var = self._variances(noise)
         out = []
         for t in self.terms:
             with np.errstate(divide="ignore", invalid="ignore"):
-                w = res[t] / np.sqrt(np.broadcast_to(var[t], res[t].shape))
+                w = (res[t] / np.sqrt(np.broadcast_to(var[t], res[t].shape)))[0]
             out.append(np.where(np.isfinite(w), w, 1e3))
         return np.concatenate(out)
 
     def loglike(self, u) -> float:
-        return float(np.sum(self.pointwise(u)))
+        return float(self.loglike_batch(np.asarray(u, dtype=float)[None])[0])
+
+    def loglike_rebuilt(self, u) -> float:
+        """``ln L`` with the scene rebuilt and validated at ``u`` (tests hold :meth:`loglike`
+        to it)."""
+        return float(np.sum(self.pointwise_rebuilt(u)))
+
+    def in_bounds(self, U) -> np.ndarray:
+        """Positions inside the prior's bounds (finite), ``(W,)`` booleans."""
+        b = self._bounds
+        return np.all(np.isfinite(U) & (U >= b[:, 0]) & (U <= b[:, 1]), axis=1)
+
+    def batch(self, U) -> np.ndarray:
+        """Log posterior of positions ``U`` ``(W, k)`` in one evaluation, ``(W,)``: the prior is
+        flat inside the bounds (checked once, vectorized), ``-inf`` outside or where the
+        model predicts no light at a used row."""
+        U = np.atleast_2d(np.asarray(U, dtype=float))
+        out = np.full(len(U), -math.inf)
+        inside = np.flatnonzero(self.in_bounds(U))
+        if inside.size:
+            ll = self.loglike_batch(U[inside])
+            out[inside] = np.where(np.isfinite(ll), ll, -math.inf)
+        return out
 
     def __call__(self, u) -> float:
-        lp = self.spec.log_prior(u)
-        if not math.isfinite(lp):
-            return -math.inf
-        try:
-            ll = self.loglike(u)
-        except ValueError:
-            # a parameter combination the model rejects (outside its declared range)
-            return -math.inf
-        return lp + ll if math.isfinite(ll) else -math.inf
+        return float(self.batch(np.asarray(u, dtype=float)[None])[0])
+
+
+def _terms(spec, d):
+    """The likelihood's terms for the spec and the data (see the module docstring)."""
+    free_noise = {p.key[6:] for p in spec.free if p.is_noise}
+    have = lambda t: t in spec.noise or t in free_noise  # noqa: E731
+    used = lambda t, col, err: (  # noqa: E731
+        t not in spec.off and col is not None and (have(t) or err is not None)
+    )
+    terms = ["brdf"]
+    if not (have("brdf") or d.brdf_err is not None):
+        raise ValueError(
+            "noise.brdf: the BRDF term needs a noise level (fixed or free: --noise brdf=0.05 or "
+            "--noise brdf:0.005:1:log) or a brdf_err column"
+        )
+    if used("eta_deg", d.eta, d.eta_err):
+        terms.append("eta")
+    if used("P", d.P, d.P_err):
+        terms.append("P")
+    if used("P_C", d.P_C, d.P_C_err):
+        terms.append("P_C")
+    return tuple(terms)

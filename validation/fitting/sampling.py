@@ -38,6 +38,7 @@ from .checkpoint import CheckpointBackend, CheckpointError
 from .settings import ChainSettings
 
 __all__ = [
+    "vectorized",
     "optimize",
     "initial_ball",
     "run_chain",
@@ -282,13 +283,39 @@ def _progress_bar(show, total, initial):
         bar.close()
 
 
+def vectorized(log_prob) -> bool:
+    """True when ``log_prob`` evaluates many positions at once (a ``batch`` method, as
+    :class:`~validation.fitting.likelihood.Likelihood` has): the sampler then hands it every
+    walker of a step in one call."""
+    return callable(getattr(log_prob, "batch", None))
+
+
+class _Batched:
+    """``log_prob.batch`` over the walkers of a step, ``(n, k) -> (n,)``: in one call, or with
+    an executor of several workers, one contiguous share of the walkers per worker (the
+    results are the same: each walker's value does not depend on the others)."""
+
+    def __init__(self, log_prob, executor):
+        self.fn = log_prob.batch  # one object: an executor ships it to its workers once
+        self.executor = executor
+        self.parts = max(1, int(getattr(executor, "workers", 1))) if executor is not None else 1
+
+    def __call__(self, P):
+        if self.parts == 1:
+            return self.fn(P)
+        shares = [c for c in np.array_split(P, self.parts) if len(c)]
+        return np.concatenate(self.executor.map(self.fn, shares))
+
+
 def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, progress=False):
     """Run (or resume) the ensemble until converged or out of steps; see the module docstring.
 
     Parameters
     ----------
     log_prob : callable
-        Log posterior of one walker's position (picklable for a process executor).
+        Log posterior of one walker's position (picklable for a process executor); with a
+        ``batch`` method (:func:`vectorized`) the sampler evaluates every walker of a step in
+        one call (``emcee``'s ``vectorize=True``).
     settings : ChainSettings, optional
         Walkers, seed, step budget, check interval and stopping rule (default:
         ``ChainSettings()``).
@@ -298,7 +325,8 @@ def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, 
         Where the chain is kept (and saved, if it has a path): a new one, or
         :meth:`CheckpointBackend.load` to resume.  Default: memory only.
     executor : optional
-        Maps the log posterior over walkers (``map(fn, items)``).
+        Maps the log posterior over walkers (``map(fn, items)``), or over shares of them for a
+        vectorized ``log_prob``.
     progress : bool
         Show a progress bar.
 
@@ -309,9 +337,15 @@ def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, 
     settings = ChainSettings() if settings is None else settings
     backend = CheckpointBackend() if backend is None else backend
     state = _first_state(backend, settings, p0)
-    sampler = emcee.EnsembleSampler(
-        settings.walkers, state.coords.shape[1], log_prob, pool=executor, backend=backend
-    )
+    if vectorized(log_prob):
+        fn = _Batched(log_prob, executor)
+        sampler = emcee.EnsembleSampler(
+            settings.walkers, state.coords.shape[1], fn, vectorize=True, backend=backend
+        )
+    else:
+        sampler = emcee.EnsembleSampler(
+            settings.walkers, state.coords.shape[1], log_prob, pool=executor, backend=backend
+        )
     with _progress_bar(progress, settings.max_steps, backend.iteration) as bar:
         while backend.iteration < settings.max_steps and not _converged(backend.tau_history, settings):
             done = backend.iteration
