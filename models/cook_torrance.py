@@ -193,7 +193,7 @@ class _CookTorranceBase(Model):
 
     def _validate(self):
         s = self.slopes
-        if not isinstance(s, (GaussianSlopes, StrokeSlopes)) or s.coverage != 1.0:
+        if not isinstance(s, (GaussianSlopes, StrokeSlopes)) or np.any(np.asarray(s.coverage) != 1.0):
             raise ValueError(
                 "slopes must be models.GaussianSlopes(sigma=m) (Eq. 8) or models.StrokeSlopes (Eq. 19), "
                 f"with coverage 1; got {s!r}"

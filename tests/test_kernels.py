@@ -150,6 +150,49 @@ def test_model_sets_in_the_kernels():
     assert s.mueller(0.4, tr, 0.2).shape == (3, 50, 4, 4)
 
 
+def _perturbed_set(model, rng, w=4):
+    """``model`` as a set of ``w`` models, each real parameter scaled by a factor in [0.9, 1]
+    and each finite index's real part by one in [1, 1.1] (staying in range), shape ``(w, 1)``."""
+    from models import modelset
+
+    leaves = {}
+    for path, (v, kind) in modelset.scalar_leaves(model).items():
+        if kind == "real":
+            a = v * rng.uniform(0.9, 1.0, (w, 1))
+        elif v != math.inf:
+            z = complex(v)
+            a = z.real * rng.uniform(1.0, 1.1, (w, 1)) + 1j * z.imag
+        else:
+            continue
+        try:  # parameters pinned to one value (e.g. a coverage of 1) stay scalar
+            modelset.rebuilt(model, {path: a})
+        except ValueError:
+            continue
+        leaves[path] = a
+    return modelset.rebuilt(model, leaves), leaves
+
+
+@pytest.mark.parametrize("model", CONFIGS[::3], ids=lambda m: type(m).__name__)
+def test_random_model_sets_equal_the_numpy_reference_and_their_elements(model):
+    """A set of every kernel's models (random parameters) against numpy within 1e-12, and
+    each element equal, bit for bit, to the single model with its values."""
+    from models import modelset
+
+    rng = np.random.default_rng(3)
+    mset, leaves = _perturbed_set(model, rng)
+    if not leaves:
+        pytest.skip("no real or finite index parameter to vary")
+    ti, tr, pr = (a[::4] for a in _geometries())
+    M = mset.mueller(ti, tr, pr)
+    assert M.shape == (4, len(ti), 4, 4) and np.all(np.isfinite(M))
+    with backend("numpy"):
+        Mn = mset.mueller(ti, tr, pr)
+    assert _relative(M, Mn) <= TOL
+    for w in (0, 3):
+        one = modelset.rebuilt(model, {p: modelset.scalar_value(a[w, 0]) for p, a in leaves.items()})
+        assert np.array_equal(one.mueller(ti, tr, pr), M[w])
+
+
 def test_model_set_validation_is_vectorized_and_names_the_first_bad_value():
     with pytest.raises(ValueError, match=r"sigma must be .*\(0, inf\); got -0.3 at index \(1, 0\)"):
         models.GaussianSlopes(sigma=np.array([[0.2], [-0.3], [-1.0]]))
@@ -193,14 +236,23 @@ def test_float32_kernels_and_their_error():
         m.mueller(0.5, 0.5, 0.0, precision="half")
 
 
-def test_cache_directory_is_writable_and_keyed_by_the_sources():
+def test_cache_directory_is_writable_and_keyed_by_the_sources(tmp_path, monkeypatch):
+    import os
+
     from models import kernels
 
     d = kernels.cache_dir()
-    assert "scatterbench-" in d
-    import os
-
+    assert os.path.basename(d) == f"scatterbench-{kernels._source_hash()}"
     assert os.access(d, os.W_OK)
+    # NUMBA_CACHE_DIR unusable (as beside a read-only site-packages): the user cache instead
+    blocked = tmp_path / "file"
+    blocked.write_text("not a directory")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(blocked / "numba"))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user"))
+    d = kernels.cache_dir()
+    assert d.startswith(str(tmp_path / "user" / "numba")) and os.access(d, os.W_OK)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocked / "user"))
+    assert kernels.cache_dir().startswith(os.path.realpath(__import__("tempfile").gettempdir()))
 
 
 def test_kernel_specs_have_no_numba_import():
