@@ -53,6 +53,7 @@ __all__ = [
     "load_model",
     "Contributed",
     "contributed_models",
+    "format_contributed",
     "shipped_models",
     "ContributedRow",
     "contributed_section",
@@ -207,7 +208,12 @@ def _resolve(obj, what):
     if not isinstance(obj, type) and callable(getattr(obj, "mueller", None)):
         return obj
     if callable(obj):
-        made = obj()
+        try:
+            made = obj()
+        except Exception as exc:  # noqa: BLE001 - reported as a bad argument, not a traceback
+            raise ValueError(
+                f"{what}: calling it with no arguments raised {type(exc).__name__}: {exc}"
+            ) from exc
         if callable(getattr(made, "mueller", None)):
             return made
         raise ValueError(
@@ -231,6 +237,8 @@ def load_model(spec: str):
         obj = importlib.import_module(module)
     except ImportError as exc:
         raise ValueError(f"model {spec!r}: module {module!r} not found ({exc})") from exc
+    except Exception as exc:  # noqa: BLE001 - a module that fails to import is a bad argument here
+        raise ValueError(f"model {spec!r}: importing {module!r} raised {type(exc).__name__}: {exc}") from exc
     for part in name.split("."):
         if not hasattr(obj, part):
             raise ValueError(f"model {spec!r}: {module!r} has no attribute {name!r}")
@@ -266,6 +274,25 @@ def contributed_models() -> list[Contributed]:
             continue
         out.append(Contributed(ep.name, ep.value, dist, model))
     return out
+
+
+def format_contributed(contributed=None) -> str:
+    """The contributed models as ``scatterbench models`` lists them: entry name, ``module:attr``,
+    distribution, and the model's parameters (a :class:`models.Model`) or docstring summary."""
+    import models
+
+    entries = contributed_models() if contributed is None else contributed
+    lines = [f"\nContributed models (entry-point group {ENTRY_POINT_GROUP}): {len(entries) or 'none'}"]
+    for c in entries:
+        lines.append(f"\n{c.name} = {c.value}  [{c.dist}]")
+        if c.model is None:
+            lines.append(f"    not loaded: {c.error}")
+        elif isinstance(c.model, models.Model):
+            lines.append("    " + type(c.model).info().replace("\n", "\n    "))
+        else:
+            doc = (type(c.model).__doc__ or "").strip().splitlines()
+            lines.append(f"    {type(c.model).__name__}: {doc[0] if doc else repr(c.model)}")
+    return "\n".join(lines)
 
 
 def shipped_models() -> list[tuple[str, object]]:

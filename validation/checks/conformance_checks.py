@@ -103,38 +103,82 @@ _TR = np.array([0.05, 0.7, 1.3, 0.2])
 _PR = np.array([0.4, -2.5])
 
 
+def _repeatable(model, ctx):
+    """Whether two calls at the same geometries give the same numbers (once per context):
+    the checks that compare numbers between calls need it (determinism judges it)."""
+
+    def compute():
+        ti, tr, pr = random_geometries(16, seed=12)
+        a, b = (np.asarray(model.mueller(ti, tr, pr)) for _ in range(2))
+        return bool(np.array_equal(a, b, equal_nan=True))
+
+    return _memo(ctx, "repeatable", model, compute)
+
+
+def _shapes(args):
+    return " x ".join(str(np.shape(a)) for a in args)
+
+
+def _judge_forms(check, model, ctx, forms, tol, what):
+    """Each call form ``(label, args, reference, geometry)`` must give the reference's shape
+    and (for a model that repeats its numbers) its values within ``tol`` of M00."""
+    repeat = _repeatable(model, ctx)
+    worst, at, label = 0.0, "", ""
+    for name, args, ref, geometry in forms:
+        try:
+            M = np.asarray(model.mueller(*args))
+        except Exception as exc:  # noqa: BLE001 - a call form the model cannot take fails this check
+            return verdict(check, math.inf, tol, f"{name} {_shapes(args)} raised {type(exc).__name__}: {exc}")
+        if M.shape != ref.shape:
+            return verdict(
+                check, math.inf, tol, f"{name} {_shapes(args)} gave shape {M.shape}, not {ref.shape}"
+            )
+        if repeat:
+            e, k = _worst(_relative(M.reshape(-1, 4, 4).astype(float), ref.reshape(-1, 4, 4)))
+            if e > worst:
+                worst, label = e, f"{name} (result dtype {M.dtype})"
+                at = where(*(np.broadcast_to(np.asarray(g, float), ref.shape[:-2]) for g in geometry), k)
+    if not repeat:
+        why = "shapes right; values not compared: the model does not repeat its own numbers (see determinism)"
+        return skipped(check, why)
+    return verdict(check, worst, tol, what + (f"; worst: {label}" if label else ""), where=at)
+
+
 def _reference(model):
-    """The Mueller matrix at each of the 3 x 4 x 2 geometries, one scalar call each."""
+    """The Mueller matrix at each of the 3 x 4 x 2 geometries, one scalar call each, or the
+    failure of the first scalar call that does not give a (4, 4) result."""
     R = np.empty((3, 4, 2, 4, 4))
     for i, j, k in np.ndindex(3, 4, 2):
         M = np.asarray(model.mueller(_TI[i], _TR[j], _PR[k]))
         if M.shape != (4, 4):
-            raise _ShapeError(
-                f"scalar angles gave shape {M.shape}, not (4, 4)", where(_TI[i], _TR[j], _PR[k])
+            at = where(_TI[i], _TR[j], _PR[k])
+            return verdict(
+                "broadcasting",
+                math.inf,
+                BROADCAST_TOL,
+                f"scalar angles gave shape {M.shape}, not (4, 4)",
+                where=at,
             )
         R[i, j, k] = M
     return R
 
 
-class _ShapeError(Exception):
-    def __init__(self, what, at=""):
-        super().__init__(what)
-        self.at = at
-
-
 def _forms(R):
-    """``(label, args, reference)`` of every call form, the reference from scalar calls."""
+    """``(label, args, reference, geometry)`` of every call form, the reference from scalar calls."""
     ti, tr, pr = np.meshgrid(_TI, _TR, _PR, indexing="ij")
     n = models.CHUNK + 5  # longer than one of models.Model's evaluation chunks
     rep = -(-n // ti.size)
-    long_args = tuple(np.tile(a.ravel(), rep)[:n] for a in (ti, tr, pr))
-    long_ref = np.tile(R.reshape(-1, 4, 4), (rep, 1, 1))[:n]
+    flat = (ti.ravel(), tr.ravel(), pr.ravel())
+    long_args = tuple(np.tile(a, rep)[:n] for a in flat)
+    zero_d = (np.asarray(_TI[1]), np.asarray(_TR[2]), np.asarray(_PR[1]))
+    outer = (_TI[:, None, None], _TR[None, :, None], _PR[None, None, :])
+    mixed = (_TI[2], _TR, _PR[0])
     return [
-        ("0-d arrays", (np.asarray(_TI[1]), np.asarray(_TR[2]), np.asarray(_PR[1])), R[1, 2, 1]),
-        ("equal-shape arrays", (ti.ravel(), tr.ravel(), pr.ravel()), R.reshape(-1, 4, 4)),
-        ("outer broadcast", (_TI[:, None, None], _TR[None, :, None], _PR[None, None, :]), R),
-        ("scalar and array", (_TI[2], _TR, _PR[0]), R[2, :, 0]),
-        (f"{n} geometries (chunked)", long_args, long_ref),
+        ("0-d arrays", zero_d, R[1, 2, 1], zero_d),
+        ("equal-shape arrays", flat, R.reshape(-1, 4, 4), flat),
+        ("outer broadcast", outer, R, outer),
+        ("scalar and array", mixed, R[2, :, 0], mixed),
+        (f"{n} geometries (chunked)", long_args, np.tile(R.reshape(-1, 4, 4), (rep, 1, 1))[:n], long_args),
     ]
 
 
@@ -143,56 +187,24 @@ def _forms(R):
     "scalar, 0-d, array, broadcast and chunked (more than models.CHUNK) calls give the same numbers"
 )
 def check_broadcasting(model, ctx):
-    try:
-        R = _reference(model)
-    except _ShapeError as e:
-        return verdict("broadcasting", math.inf, BROADCAST_TOL, str(e), where=e.at)
-    worst, at, label = 0.0, "", ""
-    for name, args, ref in _forms(R):
-        M = np.asarray(model.mueller(*args))
-        if M.shape != ref.shape:
-            shapes = " x ".join(str(np.shape(a)) for a in args)
-            return verdict(
-                "broadcasting",
-                math.inf,
-                BROADCAST_TOL,
-                f"{name} {shapes} gave shape {M.shape}, not {ref.shape}",
-            )
-        e, k = _worst(_relative(M.reshape(-1, 4, 4), ref.reshape(-1, 4, 4)))
-        if e > worst:
-            worst, label = e, name
-            at = where(*(np.broadcast_to(a, ref.shape[:-2]) for a in args), k)
-    detail = "max |M - M(scalar calls)| / M00 over 5 call forms" + (f"; worst: {label}" if label else "")
-    return verdict("broadcasting", worst, BROADCAST_TOL, detail, where=at)
+    R = _reference(model)
+    if not isinstance(R, np.ndarray):
+        return R
+    what = "max |M - M(scalar calls)| / M00 over 5 call forms"
+    return _judge_forms("broadcasting", model, ctx, _forms(R), BROADCAST_TOL, what)
 
 
 @model_check(
     tests="DESIGN.md: float64 evaluation whatever the angles' dtype (float32 arrays, Python and numpy integers)"
 )
 def check_dtypes(model, ctx):
-    ti, tr, pr = random_geometries(32, seed=7, max_deg=80.0)
-    f32 = tuple(a.astype(np.float32) for a in (ti, tr, pr))
-    cases = [
-        ("float32 arrays", f32, tuple(a.astype(float) for a in f32)),
-        ("Python ints", (0, 1, 2), (0.0, 1.0, 2.0)),
-        (
-            "int64 arrays",
-            (np.array([0, 1]), np.array([1, 0]), np.array([-3, 3])),
-            ([0.0, 1.0], [1.0, 0.0], [-3.0, 3.0]),
-        ),
-    ]
-    worst, at, label = 0.0, "", ""
-    for name, args, ref_args in cases:
-        M = np.asarray(model.mueller(*args))
-        R = np.asarray(model.mueller(*(np.asarray(a, dtype=float) for a in ref_args)))
-        if M.shape != R.shape:
-            return verdict("dtypes", math.inf, DTYPE_TOL, f"{name} gave shape {M.shape}, float64 {R.shape}")
-        e, k = _worst(_relative(M.reshape(-1, 4, 4).astype(float), R.reshape(-1, 4, 4)))
-        if e > worst:
-            worst, label = e, f"{name} (result dtype {M.dtype})"
-            at = where(*(np.broadcast_to(np.asarray(a, float), R.shape[:-2]) for a in ref_args), k)
-    detail = "max |M(x) - M(float64(x))| / M00" + (f"; worst: {label}" if label else "")
-    return verdict("dtypes", worst, DTYPE_TOL, detail, where=at)
+    f32 = tuple(a.astype(np.float32) for a in random_geometries(32, seed=7, max_deg=80.0))
+    ints = (np.array([0, 1]), np.array([1, 0]), np.array([-3, 3]))
+    forms = []
+    for name, args in (("float32 arrays", f32), ("Python ints", (0, 1, 2)), ("int64 arrays", ints)):
+        as64 = tuple(np.asarray(a, dtype=float) for a in args)
+        forms.append((name, args, np.asarray(model.mueller(*as64)), as64))
+    return _judge_forms("dtypes", model, ctx, forms, DTYPE_TOL, "max |M(x) - M(float64(x))| / M00")
 
 
 def _takes_out(model):
@@ -210,22 +222,22 @@ def check_out_argument(model, ctx):
     if not _takes_out(model):
         return skipped("out argument", "mueller() takes no out= argument")
     ti, tr, pr = random_geometries(37, seed=8)
-    ref = np.asarray(model.mueller(ti, tr, pr))
-    buf = np.full((16, ti.size), np.nan)
-    M = np.asarray(model.mueller(ti, tr, pr, out=buf))
-    e, k = _worst(np.maximum(_relative(M, ref), _relative(np.moveaxis(buf.reshape(4, 4, -1), -1, 0), ref)))
-    detail = "max |M(out=) - M| / M00 over the result and the buffer"
     try:
         model.mueller(ti, tr, pr, out=np.empty((16, ti.size + 1)))
     except ValueError:
         pass
     else:
-        return verdict(
-            "out argument",
-            math.inf,
-            BROADCAST_TOL,
-            "an out of shape (16, N + 1) was accepted (ValueError expected)",
-        )
+        why = "an out of shape (16, N + 1) was accepted (ValueError expected)"
+        return verdict("out argument", math.inf, BROADCAST_TOL, why)
+    buf = np.full((16, ti.size), np.nan)
+    M = np.asarray(model.mueller(ti, tr, pr, out=buf))
+    if not _repeatable(model, ctx):
+        why = "values not compared: the model does not repeat its own numbers (see determinism)"
+        return skipped("out argument", why)
+    ref = np.asarray(model.mueller(ti, tr, pr))
+    written = np.moveaxis(buf.reshape(4, 4, -1), -1, 0)
+    e, k = _worst(np.maximum(_relative(M, ref), _relative(written, ref)))
+    detail = "max |M(out=) - M| / M00 over the result and the buffer"
     return verdict("out argument", e, BROADCAST_TOL, detail, where=where(ti, tr, pr, k))
 
 
@@ -291,10 +303,25 @@ def check_realizable(model, ctx):
     )
 
 
-def _reversed(model, ti, tr, pr):
+def _reciprocity_errors(model, ctx):
+    """``(geometry, scalar, mueller, note)``: per grid geometry the relative violations of
+    ``f = f_rev`` and ``M_rev = D M^T D`` (relative to the larger M00 of the two paths)."""
     from validation.numerics.reciprocity import reversed_mueller
 
-    return np.asarray(reversed_mueller(as_model(model), ti, tr, pr)).reshape(-1, 4, 4)
+    ti, tr, pr, M, _, _ = _grid(model, ctx)
+    rev = np.asarray(reversed_mueller(as_model(model), ti, tr, pr)).reshape(-1, 4, 4)
+    # non-finite values are the finite check's failure: judged here where both paths are finite
+    fin = np.all(np.isfinite(M), axis=(-1, -2)) & np.all(np.isfinite(rev), axis=(-1, -2))
+    ti, tr, pr, M, rev = ti[fin], tr[fin], pr[fin], M[fin], rev[fin]
+    scale = np.maximum(np.abs(M[:, 0, 0]), np.abs(rev[:, 0, 0]))
+    lit = scale > 0
+    den = np.where(lit, scale, 1.0)
+    scalar = np.where(lit, np.abs(M[:, 0, 0] - rev[:, 0, 0]) / den, 0.0)
+    full = np.where(lit, np.max(np.abs(rev - reciprocal_mueller(M)), axis=(-1, -2)) / den, 0.0)
+    note = f"{int(lit.sum())} lit geometries"
+    if not fin.all():
+        note += f" ({int(np.sum(~fin))} non-finite ones left to the finite check)"
+    return (ti, tr, pr), scalar, full, note
 
 
 @model_check(
@@ -307,37 +334,24 @@ def check_reciprocity(model, ctx):
         return skipped("reciprocity", "the model does not claim reciprocity (reciprocal = False)")
     if _stochastic(model):
         return skipped("reciprocity", "stochastic: reciprocal only within its sampling error, not exactly")
-    ti, tr, pr, M, _, _ = _grid(model, ctx)
-    keep = (ti < math.pi / 2) & (
-        tr < math.pi / 2
-    )  # the reversed path of a grazing one is the same cosine-0 edge
-    ti, tr, pr, M = ti[keep], tr[keep], pr[keep], M[keep]
-    rev = _reversed(model, ti, tr, pr)
-    scale = np.maximum(np.abs(M[:, 0, 0]), np.abs(rev[:, 0, 0]))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        scalar = np.where(scale > 0, np.abs(M[:, 0, 0] - rev[:, 0, 0]) / scale, 0.0)
-        full = np.where(scale > 0, np.max(np.abs(rev - reciprocal_mueller(M)), axis=(-1, -2)) / scale, 0.0)
-    n = f"{int(np.sum(scale > 0))} lit geometries"
+    geometry, scalar, full, note = _reciprocity_errors(model, ctx)
     e, k = _worst(scalar)
     out = [
         verdict(
             "reciprocity: M00",
             e,
             RECIPROCITY_TOL,
-            f"max |f - f_rev| / f over {n}",
-            where=where(ti, tr, pr, k),
+            f"max |f - f_rev| / f over {note}",
+            where=where(*geometry, k),
         )
     ]
     if claim == "scalar":
-        out.append(
-            skipped(
-                "reciprocity: Mueller", "the model claims scalar reciprocity only (reciprocal = 'scalar')"
-            )
-        )
+        why = "the model claims scalar reciprocity only (reciprocal = 'scalar')"
+        out.append(skipped("reciprocity: Mueller", why))
     else:
         e, k = _worst(full)
-        detail = f"max |M_rev - D M^T D| / M00 over {n}"
-        out.append(verdict("reciprocity: Mueller", e, RECIPROCITY_TOL, detail, where=where(ti, tr, pr, k)))
+        detail = f"max |M_rev - D M^T D| / M00 over {note}"
+        out.append(verdict("reciprocity: Mueller", e, RECIPROCITY_TOL, detail, where=where(*geometry, k)))
     return out
 
 
@@ -449,7 +463,7 @@ def check_pickle(model, ctx):
     except Exception as exc:  # noqa: BLE001 - any pickling error is this check's failure
         return verdict("pickle", math.inf, 0.0, f"pickle round trip raised {type(exc).__name__}: {exc}")
     ti, tr, pr = random_geometries(16, seed=10)
-    if _same(model, [model], ti, tr, pr)[0] != 0:
+    if not _repeatable(model, ctx):
         return skipped(
             "pickle", "pickled and restored, but the model does not repeat its own numbers (see determinism)"
         )
