@@ -83,7 +83,11 @@ class LambertSpecular:
         hx, hy, hz = np.sin(tr) * np.cos(pr) - np.sin(ti), np.sin(tr) * np.sin(pr), ci + cr
         norm = np.sqrt(hx * hx + hy * hy + hz * hz)
         cos_h = hz / norm
-        cos_d = (ci * hz - np.sin(ti) * hx) / norm  # i . h = o . h
+        # i . h = o . h; their mean is the same expression for the reversed path, so the
+        # rounding near grazing incidence cannot break reciprocity
+        i_h = ci * hz - np.sin(ti) * hx
+        o_h = cr * hz + np.sin(tr) * (np.cos(pr) * hx + np.sin(pr) * hy)
+        cos_d = 0.5 * (i_h + o_h) / norm
         a2 = self.roughness**2
         with np.errstate(over="ignore", under="ignore"):
             tan2 = (1.0 - cos_h * cos_h) / (cos_h * cos_h)
