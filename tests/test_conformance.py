@@ -8,12 +8,14 @@ import os
 import pickle
 import subprocess
 import sys
+from dataclasses import dataclass
 
 import kit_models as km
 import numpy as np
 import pytest
 
 import models
+from models.params import param
 from validation.checks.conformance import Conformant, as_model, conformance_checks
 from validation.checks.conformance_scatmech import matching_cases
 from validation.checks.registry import CheckContext
@@ -141,6 +143,27 @@ def test_check_model_rejects_non_models_and_unknown_checks():
         check_model(object())
     with pytest.raises(ValueError, match="unknown name"):
         check_model(km.Lambertian(), checks=["nope"])
+
+
+@dataclass(frozen=True)
+class DeclaredLambertian(models.Model):
+    """A models.Model subclass written outside scatterbench: declared parameters, out=."""
+
+    depolarizing = True
+    rho: float = param(0.5, "albedo", low=0.0, high=1.0)
+
+    def _mueller16(self, ti, tr, pr):
+        out = np.zeros((16, ti.size))
+        out[0] = self.rho / math.pi
+        return out
+
+
+def test_a_model_subclass_gets_the_extremes_and_out_checks():
+    report = check_model(DeclaredLambertian())
+    status = {r.id: r.status for r in report.results}
+    assert report.passed and status["parameter_extremes"] == "pass" and status["out_argument"] == "pass"
+    extremes = next(r for r in report.results if r.id == "parameter_extremes")
+    assert "over 3 edge instances" in extremes.detail  # the defaults, rho = 0 and rho = 1
 
 
 def test_conformant_view_is_a_model():

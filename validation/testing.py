@@ -227,8 +227,21 @@ def _resolve(obj, what):
 def load_model(spec: str):
     """The model ``MODULE:NAME`` names: an instance, or a class or callable returning one.
 
-    Raises ``ValueError`` (naming ``spec``) when the module or the name is not found or the
-    object is not a model.
+    Parameters
+    ----------
+    spec : str
+        ``"module:name"``; ``name`` may be dotted (an attribute of an attribute).
+
+    Returns
+    -------
+    object
+        The model (it has a ``mueller`` method).
+
+    Raises
+    ------
+    ValueError
+        Naming ``spec``, when the module or the name is not found, importing or calling it
+        raises, or the object is not a model.
     """
     module, sep, name = spec.partition(":")
     if not sep or not module or not name:
@@ -345,9 +358,22 @@ class ContributedRow:
 
 def contributed_section(ctx, contributed=None) -> list[ContributedRow]:
     """The data of the report's contributed-models section: every entry point's model with
-    its conformance results (run with ``ctx``, so a quick report runs the quick kit).
+    its conformance results.
 
-    ``contributed``: the entries (default: :func:`contributed_models`)."""
+    Parameters
+    ----------
+    ctx : validation.checks.registry.CheckContext
+        The report's context: a quick report runs the quick kit, and the results stay in
+        its memo.
+    contributed : list of Contributed, optional
+        The entries (default: :func:`contributed_models`).
+
+    Returns
+    -------
+    list of ContributedRow
+        One per entry, in name order; ``report`` is :meth:`ModelReport.as_dict` (``None``
+        with ``error`` for an entry that did not load).
+    """
     rows = []
     for c in contributed_models() if contributed is None else contributed:
         if c.model is None:

@@ -166,12 +166,27 @@ def _stamped(spec, label, r):
 
 
 def run_model_checks(model, ctx=None, specs=None, label=None) -> list[ModelCheck]:
-    """Every result of the conformance checks ``specs`` (default: all) on ``model``.
+    """Every result of the conformance checks ``specs`` on ``model``.
 
     A check that raises fails, with the exception in its detail: a model that raises on
     valid input fails the check that called it.  Slow checks are skipped when
     ``ctx.quick``.  Results are kept in ``ctx.memo`` (a check runs once per model and
     context).
+
+    Parameters
+    ----------
+    model : object
+        Anything with ``mueller(theta_i, theta_r, phi_r)``.
+    ctx : CheckContext, optional
+        Quick flag and memo (default: a fresh full-run context).
+    specs : list of ConformanceSpec, optional
+        Default: every registered conformance check.
+    label : str, optional
+        The model's name in the results (default: its class name).
+
+    Returns
+    -------
+    list of ModelCheck
     """
     ctx = ctx if ctx is not None else CheckContext()
     specs = conformance_checks() if specs is None else specs

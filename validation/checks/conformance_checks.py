@@ -408,7 +408,10 @@ def check_energy(model, ctx):
     ladder = _memo(ctx, "energy", model, lambda: _energy_ladder(model, ctx))
     shown = ", ".join(f"{math.degrees(ti):g} deg {r.value:.4g} +- {r.error:.1g}" for ti, r in ladder)
     src = "declared energy_bound" if hasattr(model, "energy_bound") else "energy conservation"
-    detail = f"max over incidences of R - its error; R: {shown}; bound {bound:g} ({src})"
+    what = "transmittance (a BTDF)" if claims(model, "transmission", False) else "reflectance"
+    detail = (
+        f"max over incidences of R - its error, R the integrated {what}: {shown}; bound {bound:g} ({src})"
+    )
     unresolved = [ti for ti, r in ladder if not r.converged]
     if unresolved:
         at = ", ".join(f"{math.degrees(t):g}" for t in unresolved)
