@@ -241,6 +241,12 @@ def test_cli_check_exit_codes(tmp_path):
     assert "0 fail" in ok.stdout
     doc = json.loads((tmp_path / "ok.json").read_text())
     assert doc["passed"] and doc["model"] == "kit_models:Lambertian" and len(doc["results"]) == 13
+    energy = next(r for r in doc["results"] if r["id"] == "energy")
+    assert (
+        energy["status"] == "pass"
+        and energy["where"]
+        and energy["message"].startswith("kit_models:Lambertian: energy PASS")
+    )
     bad = _cli("check", "kit_models:CreatesEnergy", "--checks", "energy,finite")
     assert bad.returncode == 1 and "energy" in bad.stdout and "FAIL" in bad.stdout
     for arg, msg in [

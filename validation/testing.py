@@ -86,12 +86,13 @@ class ModelReport:
         return n
 
     def as_dict(self) -> dict:
-        """Strict-JSON-ready: the model, ``passed``, the summary and every result."""
+        """Strict-JSON-ready: the model, ``passed``, the summary and every result (its
+        fields, ``where`` the worst geometry, and its one-line ``message``)."""
         return {
             "model": self.model,
             "passed": self.passed,
             "summary": self.summary(),
-            "results": [check_record(r) for r in self.results],
+            "results": [{**check_record(r), "message": r.message} for r in self.results],
         }
 
     def format(self) -> str:
