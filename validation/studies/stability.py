@@ -1,6 +1,8 @@
 """Stability sweep: every model at the edges of its parameter space and geometry.
 
-For each public model class (``models.Model.registry``) the sweep builds
+For each public model class (``models.Model.registry``), and each model another package
+contributes (``scatterbench.models`` entry points, :func:`validation.testing.contributed_models`),
+the sweep builds
 instances at the edges of each declared parameter, one parameter at a time
 from the defaults (nested declared objects, such as slope distributions, are
 swept the same way), and evaluates them on edge geometries: polar angles 0,
