@@ -2,8 +2,7 @@
 
 For each public model class (``models.Model.registry``), and each model another package
 contributes (``scatterbench.models`` entry points, :func:`validation.testing.contributed_models`),
-the sweep builds
-instances at the edges of each declared parameter, one parameter at a time
+the sweep builds instances at the edges of each declared parameter, one parameter at a time
 from the defaults (nested declared objects, such as slope distributions, are
 swept the same way), and evaluates them on edge geometries: polar angles 0,
 1e-9, 89.99 deg and exactly 90 deg, exact specular and retroreflection, the
