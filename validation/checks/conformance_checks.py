@@ -35,7 +35,18 @@ from .conformance import (
 )
 from .registry import Finding
 
-__all__ = ["kit_geometries", "energy_incidences", "BROADCAST_TOL", "RECIPROCITY_TOL", "REALIZABLE_TOL"]
+__all__ = [
+    "kit_geometries",
+    "energy_incidences",
+    "BROADCAST_TOL",
+    "DTYPE_TOL",
+    "RECIPROCITY_TOL",
+    "REALIZABLE_TOL",
+    "ENERGY_TOL",
+    "ENERGY_BUDGET",
+    "ENERGY_LADDER_DEG",
+    "QUICK_LADDER_DEG",
+]
 
 #: relative to M00: the same geometry evaluated in another batch, shape or dtype (vectorized
 #: and scalar transcendental functions may differ in the last bit; DESIGN.md holds compiled
@@ -249,6 +260,8 @@ def _grid(model, ctx):
     def compute():
         ti, tr, pr = kit_geometries(model)
         M, warned = evaluate(model, ti, tr, pr)
+        if M.shape != (ti.size, 4, 4):
+            raise ValueError(f"mueller gave shape {M.shape} for {ti.size} geometries, not ({ti.size}, 4, 4)")
         J = None
         if callable(getattr(model, "jones", None)) and not claims(model, "depolarizing", False):
             J = np.asarray(model.jones(ti, tr, pr))
