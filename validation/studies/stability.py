@@ -27,8 +27,10 @@ Findings that physics explains are listed, each with its reason, in
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
+import threading
 import tomllib
 import warnings
 from dataclasses import dataclass, field
@@ -47,6 +49,7 @@ __all__ = [
     "edge_instances",
     "edge_geometries",
     "sweep",
+    "sweep_instance",
     "load_accepted",
     "classify",
     "FindingGroup",
@@ -316,19 +319,47 @@ def _check_energy(model, found, name, params):
             )
 
 
-def sweep(classes=None, energy=True):
-    """Run the sweep; returns every finding (accepted or not)."""
+#: The sweep records warnings with :func:`warnings.catch_warnings`, which swaps process-wide
+#: state: two instances swept at once in one process (threads of a Dask worker) would
+#: record each other's warnings, so within a process they take turns.
+_SWEEP_LOCK = threading.Lock()
+
+
+def sweep_instance(inst, energy=True):
+    """The findings of one model instance: its edge geometries, reciprocity and (with
+    ``energy``) its integrated reflectance; one task of :func:`sweep`."""
     found = []
-    classes = classes if classes is not None else [c for c in models.Model.registry if c is not models.Sum]
-    for cls in classes:
-        for inst in edge_instances(cls):
-            name, params = cls.__name__, repr(inst)
-            ti, tr, pr = edge_geometries(inst)
-            _evaluate(inst, ti, tr, pr, found, name, params)
-            _check_reciprocity(inst, ti, tr, pr, found, name, params)
-            if energy:
-                _check_energy(inst, found, name, params)
+    name, params = type(inst).__name__, repr(inst)
+    with _SWEEP_LOCK:
+        ti, tr, pr = edge_geometries(inst)
+        _evaluate(inst, ti, tr, pr, found, name, params)
+        _check_reciprocity(inst, ti, tr, pr, found, name, params)
+        if energy:
+            _check_energy(inst, found, name, params)
     return found
+
+
+def sweep(classes=None, energy=True, executor=None):
+    """Run the sweep; returns every finding (accepted or not).
+
+    Parameters
+    ----------
+    classes : list of type, optional
+        Model classes (default every registered model but :class:`models.Sum`).
+    energy : bool
+        Integrate each instance's reflectance (the slow part).
+    executor : optional
+        Runs the instances, one task each (:mod:`validation.fitting.executors`;
+        default in-process).  The findings, and their order, are the same on any
+        executor: each instance is swept alone and they are collected in order.
+    """
+    from validation.fitting.executors import SerialExecutor
+
+    classes = classes if classes is not None else [c for c in models.Model.registry if c is not models.Sum]
+    instances = [inst for cls in classes for inst in edge_instances(cls)]
+    work = functools.partial(sweep_instance, energy=energy)
+    per_instance = (executor or SerialExecutor()).map(work, instances, tasks=len(instances))
+    return [f for found in per_instance for f in found]
 
 
 def load_accepted(path=ACCEPTED_PATH):
