@@ -1,7 +1,8 @@
 """Stability sweep: every model at the edges of its parameter space and geometry.
 
-For each public model class (``models.Model.registry``) the sweep builds
-instances at the edges of each declared parameter, one parameter at a time
+For each public model class (``models.Model.registry``), and each model another package
+contributes (``scatterbench.models`` entry points, :func:`validation.testing.contributed_models`),
+the sweep builds instances at the edges of each declared parameter, one parameter at a time
 from the defaults (nested declared objects, such as slope distributions, are
 swept the same way), and evaluates them on edge geometries: polar angles 0,
 1e-9, 89.99 deg and exactly 90 deg, exact specular and retroreflection, the
@@ -49,7 +50,7 @@ __all__ = [
     "edge_instances",
     "edge_geometries",
     "sweep",
-    "sweep_instance",
+    "sweep_model",
     "load_accepted",
     "classify",
     "FindingGroup",
@@ -175,11 +176,15 @@ def _choice_combinations(base):
 
 def edge_instances(cls):
     """Model instances at the edges of each declared parameter (one at a time from the
-    defaults), plus every combination of the choice parameters at the defaults."""
-    try:
-        base = _BASES[cls.__name__]() if cls.__name__ in _BASES else cls()
-    except ValueError:
-        return []  # compositions without a default (Sum): their terms are swept
+    defaults, or from ``cls`` when it is a model instance), plus every combination of the
+    choice parameters at the defaults."""
+    if isinstance(cls, models.Model):
+        base = cls
+    else:
+        try:
+            base = _BASES[cls.__name__]() if cls.__name__ in _BASES else cls()
+        except ValueError:
+            return []  # compositions without a default (Sum): their terms are swept
     out = _one_at_a_time(base)
     for inst in _choice_combinations(base):
         if inst not in out:
@@ -325,11 +330,12 @@ def _check_energy(model, found, name, params):
 _SWEEP_LOCK = threading.Lock()
 
 
-def sweep_instance(inst, energy=True):
-    """The findings of one model instance: its edge geometries, reciprocity and (with
-    ``energy``) its integrated reflectance; one task of :func:`sweep`."""
+def sweep_model(inst, energy=True, name=None):
+    """The findings of one model instance at its edge geometries, its reciprocity and
+    (with ``energy``) its integrated reflectance (``name``: the model's name in them,
+    default its class name); one task of :func:`sweep`."""
     found = []
-    name, params = type(inst).__name__, repr(inst)
+    name, params = name or type(inst).__name__, repr(inst)
     with _SWEEP_LOCK:
         ti, tr, pr = edge_geometries(inst)
         _evaluate(inst, ti, tr, pr, found, name, params)
@@ -339,13 +345,20 @@ def sweep_instance(inst, energy=True):
     return found
 
 
+def _sweep_task(task, energy):
+    name, inst = task
+    return sweep_model(inst, energy, name)
+
+
 def sweep(classes=None, energy=True, executor=None):
     """Run the sweep; returns every finding (accepted or not).
 
     Parameters
     ----------
     classes : list of type, optional
-        Model classes (default every registered model but :class:`models.Sum`).
+        Model classes (default every registered model class but :class:`models.Sum`,
+        then the models other packages contribute, ``scatterbench.models`` entry
+        points, under their entry-point names).
     energy : bool
         Integrate each instance's reflectance (the slow part).
     executor : optional
@@ -355,11 +368,19 @@ def sweep(classes=None, energy=True, executor=None):
     """
     from validation.fitting.executors import SerialExecutor
 
-    classes = classes if classes is not None else [c for c in models.Model.registry if c is not models.Sum]
-    instances = [inst for cls in classes for inst in edge_instances(cls)]
-    work = functools.partial(sweep_instance, energy=energy)
-    per_instance = (executor or SerialExecutor()).map(work, instances, tasks=len(instances))
+    targets = [(None, c) for c in classes] if classes is not None else _default_targets()
+    tasks = [(name, inst) for name, cls in targets for inst in edge_instances(cls)]
+    work = functools.partial(_sweep_task, energy=energy)
+    per_instance = (executor or SerialExecutor()).map(work, tasks, tasks=len(tasks))
     return [f for found in per_instance for f in found]
+
+
+def _default_targets():
+    from validation.checks.conformance import as_model
+    from validation.testing import contributed_models
+
+    own = [(None, c) for c in models.Model.registry if c is not models.Sum]
+    return own + [(c.name, as_model(c.model)) for c in contributed_models() if c.model is not None]
 
 
 def load_accepted(path=ACCEPTED_PATH):
