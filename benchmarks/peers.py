@@ -58,6 +58,10 @@ DEFAULT_OUT = os.path.join(
     os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "references", "data", "peer_timings.json"
 )
 AL = 1.37 + 7.62j
+RBAR_NOTE = (
+    "SCATMECH integrates the diffuse R-bar on a 0.2-deg grid, we exactly: the values differ by "
+    "that (validation.checks.seed003 allows 2e-3 for this pair)"
+)
 #: Debian's LLVM for Dr.Jit's JIT variants (the older default LLVM fails with "Cannot select fmaximum")
 LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 
@@ -162,7 +166,8 @@ def scatmech_rows(g, loop):
         mine, me = time_ours(ours.mueller, g, loop)
         rows.append(
             Row(name, "pySCATMECH", sc_name, "float64", "double (C++)", *me, *peer,
-                _rel_diff(mine, theirs), "every Mueller element, relative to SCATMECH's M00")
+                _rel_diff(mine, theirs), "every Mueller element, relative to SCATMECH's M00",
+                [RBAR_NOTE] if name == "DiffuseSubsurfaceBRDF" else [])
         )  # fmt: skip
     return rows, None
 

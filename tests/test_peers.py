@@ -14,6 +14,9 @@ import pytest
 
 import models
 
+#: how far the peers may differ: float32 on Mitsuba's side; SCATMECH's diffuse R-bar is
+#: integrated on a 0.2-deg grid (validation.checks.seed003 allows 2e-3 for it); else 1e-6
+AGREE = {"FacetBRDF(GGX 0.2, smith)": 1e-5, "DiffuseSubsurfaceBRDF": 2e-3}
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -92,7 +95,7 @@ def test_main_writes_the_measured_table_with_provenance(peers, one_call, tmp_pat
             assert name not in peers_run
             assert any(s.startswith(name.split()[0]) and "not installed" in s for s in table["skipped"])
     for r in table["rows"]:  # the same quantity on both sides: float32 on Mitsuba's, double on SCATMECH's
-        assert r["max_rel_diff"] < (1e-5 if r["peer"] == "Mitsuba 3" else 1e-6), r
+        assert r["max_rel_diff"] < AGREE.get(r["model"], 1e-6), r
         assert math.isclose(r["ours_call_us"], 1.0) and math.isclose(r["peer_call_wall_us"], 2.0)
     assert "ratio = peer / scatterbench" in capsys.readouterr().out
 
