@@ -23,6 +23,21 @@ from .fit import _chain_settings, _executor_args, _load_and_describe, _mcmc_args
 __all__ = ["register"]
 
 
+def _open_executor(args):
+    """The executor ``--workers``/``--scheduler`` ask for, its description printed; or
+    ``None`` after printing the error (a worker count below 1, a scheduler that does not
+    answer)."""
+    from validation.fitting.executors import make_executor
+
+    try:
+        ex = make_executor(args.workers, args.scheduler)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return None
+    print(f"executor: {ex.describe()}")
+    return ex
+
+
 def _floats(text):
     return [float(x) for x in text.split(",") if x.strip()]
 
@@ -55,7 +70,6 @@ def _print_recovery(cells, injections):
 
 def _cmd_recovery(args) -> int:
     from validation.atomic import atomic_write_json
-    from validation.fitting.executors import make_executor
     from validation.fitting.recovery import check_inputs, recovery_study
 
     if not _out_ok(args.out, args.force, None):
@@ -71,8 +85,10 @@ def _cmd_recovery(args) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     t0 = time.perf_counter()
-    with make_executor(args.workers, args.scheduler) as ex:
-        print(f"executor: {ex.describe()}")
+    ex = _open_executor(args)
+    if ex is None:
+        return 2
+    with ex:
         cells = recovery_study(
             sc,
             spec,
@@ -238,7 +254,6 @@ def _compare_likelihoods(args):
 def _cmd_compare(args) -> int:
     from validation.atomic import atomic_write_json
     from validation.fitting.compare import check_comparable, compare_fits, format_comparison
-    from validation.fitting.executors import make_executor
 
     if not _out_ok(args.out, args.force, None):
         return 2
@@ -257,7 +272,10 @@ def _cmd_compare(args) -> int:
         print(
             f"{nm}: {len(lik.spec.free)} free ({', '.join(lik.spec.names)}); likelihood terms: {', '.join(lik.terms)}"
         )
-    with make_executor(args.workers, args.scheduler) as ex:
+    ex = _open_executor(args)
+    if ex is None:
+        return 2
+    with ex:
         rows, _ = compare_fits(liks, names, settings, executor=ex)
     os.makedirs(args.out, exist_ok=True)
     atomic_write_json(
