@@ -138,16 +138,14 @@ class RoundedFacet(models.FacetBRDF):
         return super().mueller(*f32).astype(np.float32)
 
 
-@dataclass(frozen=True)
-class Plain(Model):
-    """A model without a precision option."""
+class Plain:
+    """A model without a precision option (not a models.Model: every Model's mueller takes
+    ``precision``, the numpy path rounding its float64 result)."""
 
     depolarizing = True
 
-    def _mueller16(self, ti, tr, pr):
-        out = np.zeros((16, ti.size))
-        out[0] = 1 / math.pi
-        return out
+    def mueller(self, theta_i, theta_r, phi_r=0.0):
+        return np.broadcast_to(np.diag([1 / math.pi, 0, 0, 0]), np.shape(theta_i) + (4, 4))
 
 
 @dataclass(frozen=True)
