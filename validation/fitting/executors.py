@@ -41,6 +41,14 @@ def _run_chunk(fn, chunk):
 _WORKER_FNS: dict = {}
 
 
+def _ignore_sigint():
+    """Workers leave Ctrl-C to the parent (which stops the pool and says how to resume):
+    the terminal sends it to every process of the group, and each would print a traceback."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _run_pickled_chunk(key, blob, chunk):
     """Worker side: unpickle the function once per worker process and reuse it."""
     fn = _WORKER_FNS.get(key)
@@ -79,7 +87,9 @@ class ProcessExecutor(SerialExecutor):
         self.workers = workers
         # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
         self._fn = self._blob = self._key = None
-        self._pool = cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+        self._pool = cf.ProcessPoolExecutor(
+            workers, mp_context=multiprocessing.get_context("spawn"), initializer=_ignore_sigint
+        )
 
     def map(self, fn, items):
         # The function (e.g. a likelihood holding the data) is pickled once per
