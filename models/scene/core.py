@@ -11,7 +11,7 @@ from ..base import Model
 from . import editing
 from .assembly import Mechanism, mechanisms
 from .decisions import Assembly, assemble
-from .schema import SceneError, check_structure, parse
+from .schema import SceneError, check_structure, parse, utf8_text
 
 __all__ = ["Scene", "load", "loads", "from_dict"]
 
@@ -164,12 +164,9 @@ def load(path) -> Scene:
             raw = fh.read()
     except OSError as exc:
         raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from exc
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        good = raw[: exc.start].decode("utf-8-sig")
+    text, bad = utf8_text(raw)
+    if bad is not None:
         raise SceneError(
-            f"{path}:{_where(good, len(good))}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); "
-            "save the scene file as UTF-8"
-        ) from exc
+            f"{path}:{_where(text, len(text))}: not UTF-8 text (byte 0x{bad:02x}); save the scene file as UTF-8"
+        )
     return loads(text, path)

@@ -17,7 +17,7 @@ from ..polarization import stokes
 from ..subsurface_facet import SubsurfaceFacetBRDF
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
-__all__ = ["SceneError", "parse", "check_structure", "polarization_state", "MAX_DEPTH"]
+__all__ = ["SceneError", "parse", "check_structure", "polarization_state", "utf8_text", "MAX_DEPTH"]
 
 #: how deeply tables and arrays may nest in a scene file (the deepest schema entry,
 #: ``[fit.mask] exclude = [{theta_r_deg = [lo, hi]}]``, is 5 levels)
@@ -32,6 +32,16 @@ _SLOPE_KEYS = {k for e in TABLE.values() if e.kind == "distribution" for k in e.
 
 class SceneError(ValueError):
     """A scene file problem; the message names the file, the key and the allowed values."""
+
+
+def utf8_text(raw: bytes):
+    """``(text, None)`` for UTF-8 bytes (a byte-order mark dropped), else ``(the valid text
+    before the first bad byte, that byte)`` so that errors can say where it is."""
+    body = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw
+    try:
+        return body.decode("utf-8"), None
+    except UnicodeDecodeError as exc:
+        return body[: exc.start].decode("utf-8"), body[exc.start]
 
 
 def _key_path(keys):
@@ -57,8 +67,10 @@ def check_structure(data, path: str) -> None:
             raise _err(path, _key_path(keys[:2]), f"nested more than {MAX_DEPTH} levels deep")
         if isinstance(v, dict):
             for k, x in v.items():
-                if not k.isprintable():
-                    raise _err(path, _key_path(keys) + f" {k!r}", "a key with control characters")
+                if not isinstance(k, str) or not k.isprintable():
+                    raise _err(
+                        path, _key_path(keys) + f" {k!r}", "a key must be a string of printable characters"
+                    )
                 stack.append((keys + (k,), x))
         elif isinstance(v, list):
             stack.extend((keys + (i,), x) for i, x in enumerate(v))

@@ -61,7 +61,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from models.polarization import ellipsometric
-from models.scene.schema import polarization_state
+from models.scene.schema import polarization_state, utf8_text
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -172,14 +172,11 @@ def _text_of(path, what):
             raw = fh.read()
     except OSError as exc:
         raise DataFileError(path, 0, None, f"cannot read the {what} ({exc.strerror})") from exc
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        good = raw[: exc.start].decode("utf-8-sig", errors="replace")
-        line, col = good.count("\n") + 1, len(good) - good.rfind("\n")
-        raise DataFileError(
-            path, line, col, f"not UTF-8 text (byte 0x{raw[exc.start]:02x}); save the {what} as UTF-8"
-        ) from exc
+    text, bad = utf8_text(raw)
+    if bad is None:
+        return text
+    line, col = text.count("\n") + 1, len(text) - text.rfind("\n")
+    raise DataFileError(path, line, col, f"not UTF-8 text (byte 0x{bad:02x}); save the {what} as UTF-8")
 
 
 class _NotJSON(ValueError):

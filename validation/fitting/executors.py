@@ -15,6 +15,7 @@ in the calling process), so results are identical whatever the executor.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import hashlib
 import multiprocessing
 import pickle
@@ -58,12 +59,42 @@ def _run_pickled_chunk(key, blob, chunk):
     return [fn(x) for x in chunk]
 
 
+@contextlib.contextmanager
+def _sigint_between_calls():
+    """Ctrl-C during the block is held until the caller asks (``pending()``): a
+    KeyboardInterrupt raised inside emcee's wrapper of the log-probability makes it print
+    a traceback; raised between calls, the fit stops with one line saying how to resume."""
+    import signal
+    import threading
+
+    got = []
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
+    ):
+        yield lambda: False  # someone else handles Ctrl-C here: leave it to them
+        return
+    signal.signal(signal.SIGINT, lambda *_: got.append(True))
+    try:
+        yield lambda: bool(got)
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    if got:
+        raise KeyboardInterrupt
+
+
 class SerialExecutor:
     workers = 1
     kind = "serial"
 
     def map(self, fn, items):
-        return [fn(x) for x in items]
+        out = []
+        with _sigint_between_calls() as pending:
+            for x in items:
+                out.append(fn(x))
+                if pending():
+                    break
+        return out
 
     def close(self):
         pass
