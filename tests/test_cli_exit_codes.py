@@ -135,3 +135,18 @@ def test_two_nightlies_into_one_history_take_turns(tmp_path):
     with open(os.path.join(latest, "results.json")) as fh:
         assert json.load(fh)["history_notes"] == []
     assert sorted(os.listdir(hist)) == [".lock", "latest", "runs"]  # nothing half-built
+
+
+def test_readme_documents_every_exit_code():
+    """Cron users read the codes in the README: the table there lists exactly main()'s codes."""
+    import re
+
+    import validation.cli as cli
+
+    readme = open(
+        os.path.join(os.path.dirname(os.path.dirname(__file__)), "README.md"), encoding="utf-8"
+    ).read()
+    table = readme.split("Exit codes, the same for every command", 1)[1].split("\n\n", 2)[1]
+    documented = [int(m) for m in re.findall(r"^\| (\d+) \|", table, re.M)]
+    codes = [cli.EXIT_OK, cli.EXIT_FAILED, cli.EXIT_USAGE, cli.EXIT_INTERNAL, cli.EXIT_INTERRUPTED]
+    assert documented == codes == [0, 1, 2, 3, 130]
