@@ -636,6 +636,13 @@ cli_case(
     "f",
     files={"f": "a file"},
 )
+cli_case("stability workers zero", ["stability", "--workers", "0"], "--workers")
+cli_case(
+    "stability workers and scheduler",
+    ["stability", "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"],
+    "--workers",
+    "--scheduler",
+)
 cli_case("unknown command", ["frobnicate"], "frobnicate")
 cli_case("no command", [], "command")
 cli_case("fit without --scene", ["fit", "d.csv", "--out", "o"], "--scene")
