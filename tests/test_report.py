@@ -61,7 +61,7 @@ def test_scene_names_are_escaped(tmp_path):
 def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):
     hist = str(tmp_path / "hist")
     kw = dict(quick=True, only=["table1"], checks=["seed000.check_table1"])
-    code, reg, run1 = nightly(hist, stamp="2026-01-01T000000Z", **kw)
+    code, reg, run1, _ = nightly(hist, stamp="2026-01-01T000000Z", **kw)
     assert code == 0 and reg == []
     assert os.path.realpath(os.path.join(hist, "latest")) == os.path.realpath(run1)
 
@@ -74,7 +74,7 @@ def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):
 
     monkeypatch.setattr(models.facet, "reflection_rs_k", broken)
     with models.backend("numpy"):  # the patched function is the numpy path's (kernels: models.kernels)
-        code, reg, run2 = nightly(hist, stamp="2026-01-02T000000Z", **kw)
+        code, reg, run2, _ = nightly(hist, stamp="2026-01-02T000000Z", **kw)
     assert code != 0 and reg
     assert any("passed before and now fails" in r for r in reg)
     assert any("moved from" in r for r in reg)
@@ -97,10 +97,10 @@ def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):
     with open(os.path.join(hist, "latest", "results.json")) as fh:
         assert json.load(fh) == res2
     # the next run cleans the leftover and compares with the last completed night (the broken one)
-    code, reg, run4 = nightly(hist, stamp="2026-01-04T000000Z", **kw)
+    code, reg, run4, _ = nightly(hist, stamp="2026-01-04T000000Z", **kw)
     assert not [n for n in os.listdir(hist) if n.startswith(".tmp-")]
     # the repaired figures moved back: a moved figure is flagged whatever its direction,
     # but no check went from pass to fail
     assert reg and not any("passed before and now fails" in r for r in reg)
-    code, reg, _ = nightly(hist, stamp="2026-01-05T000000Z", **kw)
+    code, reg, _, _ = nightly(hist, stamp="2026-01-05T000000Z", **kw)
     assert code == 0 and reg == []

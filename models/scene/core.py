@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import re
 import tomllib
 from dataclasses import dataclass, field
 
@@ -10,7 +11,7 @@ from ..base import Model
 from . import editing
 from .assembly import Mechanism, mechanisms
 from .decisions import Assembly, assemble
-from .schema import SceneError, parse
+from .schema import SceneError, check_structure, parse, utf8_text
 
 __all__ = ["Scene", "load", "loads", "from_dict"]
 
@@ -110,24 +111,62 @@ class Scene:
 
 def from_dict(data: dict, path: str = "<scene>") -> Scene:
     """Validate a scene given as the dict a TOML file parses to."""
+    check_structure(data, path)  # before anything walks it: depth and numbers a float can hold
     return Scene(path=path, raw=copy.deepcopy(data), **parse(data, path))
 
 
+def _where(text, offset):
+    """``line:column`` (1-based) of a character offset of ``text``."""
+    line = text.count("\n", 0, offset) + 1
+    return f"{line}:{offset - (text.rfind(chr(10), 0, offset) + 1) + 1}"
+
+
+def _toml_error(text, path, exc):
+    """A :class:`SceneError` for a TOML syntax error, ``file:line:column`` first."""
+    msg = str(exc)
+    m = re.search(r" \(at line (\d+), column (\d+)\)$", msg)
+    if m:
+        return SceneError(f"{path}:{m.group(1)}:{m.group(2)}: not valid TOML: {msg[: m.start()]}")
+    if msg.endswith(" (at end of document)"):
+        return SceneError(f"{path}:{_where(text, len(text))}: not valid TOML: {msg[:-21]} (at the end)")
+    return SceneError(f"{path}: not valid TOML: {msg}")
+
+
 def loads(text: str, path: str = "<scene>") -> Scene:
-    """Parse and validate scene TOML text."""
+    """Parse and validate scene TOML text (a leading byte-order mark is ignored)."""
+    text = text.removeprefix("\ufeff")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: not valid TOML: {exc}") from exc
+        raise _toml_error(text, path, exc) from exc
+    except RecursionError as exc:
+        raise SceneError(
+            f"{path}: not valid TOML for a scene: arrays or inline tables nested too deeply for the parser"
+        ) from exc
+    except ValueError as exc:  # Python refuses to convert an integer of thousands of digits
+        digits = re.search(r"\d{4300,}", text)
+        if digits is None:
+            raise SceneError(f"{path}: not valid TOML: {exc}") from exc
+        start = text.rfind("\n", 0, digits.start()) + 1
+        key = text[start : digits.start()].split("=")[0].strip() or "value"
+        raise SceneError(
+            f"{path}:{_where(text, digits.start())}: {key}: a number of {len(digits.group())} digits "
+            "is too long to read"
+        ) from exc
     return from_dict(data, path)
 
 
 def load(path) -> Scene:
-    """Read and validate a scene file."""
+    """Read and validate a scene file (UTF-8, with or without a byte-order mark)."""
     path = str(path)
     try:
         with open(path, "rb") as fh:
-            text = fh.read().decode("utf-8")
+            raw = fh.read()
     except OSError as exc:
         raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from exc
+    text, bad = utf8_text(raw)
+    if bad is not None:
+        raise SceneError(
+            f"{path}:{_where(text, len(text))}: not UTF-8 text (byte 0x{bad:02x}); save the scene file as UTF-8"
+        )
     return loads(text, path)

@@ -17,23 +17,81 @@ from ..polarization import stokes
 from ..subsurface_facet import SubsurfaceFacetBRDF
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
-__all__ = ["SceneError", "parse"]
+__all__ = ["SceneError", "parse", "check_structure", "polarization_state", "utf8_text", "MAX_DEPTH"]
+
+#: how deeply tables and arrays may nest in a scene file (the deepest schema entry,
+#: ``[fit.mask] exclude = [{theta_r_deg = [lo, hi]}]``, is 5 levels)
+MAX_DEPTH = 16
 
 _TOP = {"name", "description", "illumination", "coating", "substrate", "volume", "detector", "fit"}
 _ILLUM = {"theta_i_deg", "polarization", "wavelength_nm", "source", "distance_mm", "sample_radius_mm"}
 _SUBSTRATE_KEYS = {"index", "distribution", "model"} | {k for e in TABLE.values() for k in e.keys}
+#: the keys of the slope distributions (sigma, sigma_x, ..., coverage)
+_SLOPE_KEYS = {k for e in TABLE.values() if e.kind == "distribution" for k in e.keys}
 
 
 class SceneError(ValueError):
     """A scene file problem; the message names the file, the key and the allowed values."""
 
 
+def utf8_text(raw: bytes):
+    """``(text, None)`` for UTF-8 bytes (a byte-order mark dropped), else ``(the valid text
+    before the first bad byte, that byte)`` so that errors can say where it is."""
+    body = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw
+    try:
+        return body.decode("utf-8"), None
+    except UnicodeDecodeError as exc:
+        return body[: exc.start].decode("utf-8"), body[exc.start]
+
+
+def _key_path(keys):
+    """``[substrate] sigma``, ``[fit] free[0].low``: a value's place, as the errors name it."""
+    if not keys:
+        return "scene"
+    head, rest = keys[0], keys[1:]
+    if not rest:
+        return str(head)
+    tail = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in rest)
+    return f"[{head}] {tail.lstrip('.')}"
+
+
+def check_structure(data, path: str) -> None:
+    """Raise :class:`SceneError` for what no key of a scene can hold: tables or arrays nested
+    deeper than :data:`MAX_DEPTH`, integers no float can hold (the values are numbers of
+    double precision), control characters in keys.  Iterative: a pathological file cannot
+    exhaust the stack here."""
+    stack = [((), data)]
+    while stack:
+        keys, v = stack.pop()
+        if len(keys) > MAX_DEPTH:
+            raise _err(path, _key_path(keys[:2]), f"nested more than {MAX_DEPTH} levels deep")
+        if isinstance(v, dict):
+            for k, x in v.items():
+                if not isinstance(k, str) or not k.isprintable():
+                    raise _err(
+                        path, _key_path(keys) + f" {k!r}", "a key must be a string of printable characters"
+                    )
+                stack.append((keys + (k,), x))
+        elif isinstance(v, list):
+            stack.extend((keys + (i,), x) for i, x in enumerate(v))
+        elif isinstance(v, int) and not isinstance(v, bool) and abs(v) > 1.7e308:
+            raise _err(
+                path, _key_path(keys), f"{str(v)[:20]}... ({len(str(v))} digits) is too large a number"
+            )
+
+
 def parse(data: dict, path: str) -> dict:
     """The validated fields of :class:`models.scene.Scene` from the dict a TOML file parses to."""
     _unknown(path, "", data, _TOP)
     name = data.get("name")
-    if not isinstance(name, str) or not name.strip():
-        raise _err(path, "name", "a non-empty string is required")
+    if not isinstance(name, str) or not name.strip() or not name.isprintable():
+        raise _err(
+            path,
+            "name",
+            f"a non-empty, one-line string of printable characters is required; got {_shown(name)}",
+        )
+    if "fit" in data and not isinstance(data["fit"], dict):
+        raise _err(path, "[fit]", f"must be a table (free, noise, mask); got {_shown(data['fit'])}")
     out = {"name": name, **_illumination(path, data.get("illumination"))}
     out["coating"] = _coating(path, data["coating"]) if "coating" in data else None
     out["substrate"] = _substrate(path, data["substrate"], data) if "substrate" in data else None
@@ -47,6 +105,12 @@ def _err(path, key, msg):
     return SceneError(f"{path}: {key}: {msg}")
 
 
+def _shown(value):
+    """``repr(value)``, cut to a readable length."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _unknown(path, section, table, allowed):
     if not isinstance(table, dict):
         raise _err(path, section.strip() or "scene", "must be a table")
@@ -58,11 +122,11 @@ def _unknown(path, section, table, allowed):
 def _number(path, key, value, low=None, high=None, low_open=False):
     """A quantity of the scene itself (not a model parameter): a finite number in range."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise _err(path, key, f"must be a finite number; got {value!r}")
+        raise _err(path, key, f"must be a finite number; got {_shown(value)}")
     if low is not None and (value < low or (low_open and value == low)):
-        raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {value!r}")
+        raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {_shown(value)}")
     if high is not None and value > high:
-        raise _err(path, key, f"must be <= {high:g}; got {value!r}")
+        raise _err(path, key, f"must be <= {high:g}; got {_shown(value)}")
     return float(value)
 
 
@@ -90,7 +154,9 @@ def _illumination(path, ill):
         "theta_i": math.radians(_number(path, "[illumination] theta_i_deg", ill["theta_i_deg"], 0.0, 90.0))
     }
     try:
-        out["polarization"] = tuple(float(x) for x in stokes(ill.get("polarization", "unpolarized")))
+        out["polarization"] = tuple(
+            float(x) for x in polarization_state(ill.get("polarization", "unpolarized"))
+        )
     except ValueError as exc:
         raise _err(path, "[illumination] polarization", str(exc)) from exc
     wl = ill.get("wavelength_nm")
@@ -110,7 +176,35 @@ def _illumination(path, ill):
             out[key] = _declared(path, f"[illumination] {key}", PointSourceBRDF, name, ill[key])
         if out["sample_radius_mm"] > out["distance_mm"]:
             raise _err(path, "[illumination] sample_radius_mm", "must not exceed distance_mm")
+    for key in ("distance_mm", "sample_radius_mm"):
+        if source == "collimated" and key in ill:
+            raise _err(
+                path, f"[illumination] {key}", "only for source = 'point' (a collimated beam has none)"
+            )
     return out
+
+
+def polarization_state(value):
+    """The unit-intensity Stokes vector of a polarization given in a file: a name of
+    :func:`models.polarization.stokes` or ``[I, Q, U, V]``; ``ValueError`` for anything
+    else, a non-finite angle included."""
+    if isinstance(value, str):
+        if value.startswith("linear:"):
+            try:
+                angle = float(value[7:])
+            except ValueError:
+                angle = math.nan
+            if not math.isfinite(angle):
+                raise ValueError(f"linear:<deg> needs a finite angle in degrees; got {_shown(value)}")
+        return stokes(value)
+    if not isinstance(value, list) or not all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) for x in value
+    ):
+        raise ValueError(
+            "must be a name (unpolarized, s, p, +45, -45, left, right, linear:<deg>) or "
+            f"[I, Q, U, V] numbers; got {_shown(value)}"
+        )
+    return stokes(value)
 
 
 def _coating(path, c):
@@ -125,11 +219,18 @@ def _coating(path, c):
 
 def _distribution(path, section, table):
     """The slope distribution a table names (``distribution = ...``) with its keys."""
-    _unknown(path, section, table, {"distribution"} | {k for e in TABLE.values() for k in e.keys})
+    _unknown(path, section, table, {"distribution"} | _SLOPE_KEYS)
     kind = table.get("distribution")
     names = [n for n, e in TABLE.items() if e.kind == "distribution"]
     if kind not in names:
-        raise _err(path, f"{section}distribution", f"must be one of {', '.join(names)}; got {kind!r}")
+        raise _err(path, f"{section}distribution", f"must be one of {', '.join(names)}; got {_shown(kind)}")
+    for k in table:
+        if k != "distribution" and k not in TABLE[kind].keys:
+            raise _err(
+                path,
+                f"{section}{k}",
+                f"not a key of distribution {kind!r} (its keys: {', '.join(TABLE[kind].keys)})",
+            )
     return _built(path, section, kind, table)[0]
 
 
@@ -143,13 +244,17 @@ def _built(path, section, name, table, **given):
 
 def _index(path, key, value):
     """A TOML index (a number n, a pair [n, k], or "inf") as a Python one."""
+
+    def real(v):
+        return isinstance(v, (int, float)) and not isinstance(v, bool)
+
     if value == "inf":
         return math.inf
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
+    if real(value):
         return complex(float(value), 0.0)
-    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value):
+    if isinstance(value, list) and len(value) == 2 and all(real(v) for v in value):
         return complex(float(value[0]), float(value[1]))
-    raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {value!r}')
+    raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {_shown(value)}')
 
 
 def _substrate(path, s, data):
@@ -180,6 +285,7 @@ def _substrate(path, s, data):
         raise _err(
             path, "[substrate] distribution", f"required for model = {kind!r} (the specular facet term)"
         )
+    _slope_keys_apply(path, s, kind, entry)
     out = {"index": index, "model": kind, "entry": entry, "slopes": None, "params": {}}
     if entry.slopes != "ignored" and "distribution" in s:
         dist = {k: v for k, v in s.items() if k not in entry.keys and k not in ("index", "model")}
@@ -189,6 +295,23 @@ def _substrate(path, s, data):
         keys = {k: v for k, v in s.items() if k in entry.keys}
         out["params"] = _built(path, "[substrate] ", kind, keys, substrate=index, **given)[1]
     return out
+
+
+def _slope_keys_apply(path, s, kind, entry):
+    """A slope key (or ``distribution``) in ``[substrate]`` only where it sets the slopes."""
+    for k in sorted(set(s) & (_SLOPE_KEYS | {"distribution"})):
+        if entry.slopes == "ignored":
+            raise _err(
+                path,
+                f"[substrate] {k}",
+                f"not for model = {kind!r}: its roughness is its own ({', '.join(entry.required[0])})",
+            )
+        if k != "distribution" and "distribution" not in s:
+            raise _err(
+                path,
+                f"[substrate] {k}",
+                "only with a slope distribution (distribution = ...); without one the substrate is flat",
+            )
 
 
 def _volume(path, v, coating):
@@ -211,6 +334,19 @@ def _volume(path, v, coating):
     out["interface"] = interface
     if out["rho"] == 0 and not out["single"]:
         raise _err(path, "[volume]", "declares no scattering: set rho > 0 or single = true")
+    monte_carlo = coating.get("roughness") is not None and interface == "rough"
+    for key in ("pairs", "seed"):
+        if key in v and not monte_carlo:
+            raise _err(
+                path,
+                f"[volume] {key}",
+                "only for the Monte Carlo model (a [coating.roughness] with interface = 'rough'); "
+                "this volume is evaluated in closed form",
+            )
+    if "single_weight" in v and not out["single"]:
+        raise _err(
+            path, "[volume] single_weight", "only with single = true (the weight of single scattering)"
+        )
     return out
 
 

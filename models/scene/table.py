@@ -63,7 +63,8 @@ class Entry:
     substrate models only: ``slopes`` says whether ``[substrate] distribution`` gives the
     class's slopes (``"optional"``, ``"required"``) or is not used (``"ignored"``), ``alone``
     that the model has no interface, so no ``[coating]`` or ``[volume]`` may come with it,
-    and ``mechanisms`` turns the validated ``[substrate]`` into mechanisms.
+    and ``mechanisms`` turns the validated ``[substrate]`` into mechanisms; ``flags`` are the
+    keys that take ``true``/``false`` (every other key refuses a bool: it is not a number).
     """
 
     kind: str  # "distribution" or "model"
@@ -74,6 +75,7 @@ class Entry:
     slopes: str = "optional"
     alone: bool = False
     mechanisms: Callable | None = None
+    flags: tuple = ()
 
 
 def _slopes(cls, *keys, required=("sigma",)):
@@ -113,6 +115,7 @@ TABLE = {
         slopes="required",
         alone=True,
         mechanisms=maxwell_beard_mechanisms,
+        flags=("polarized",),
     ),
 }
 
@@ -155,6 +158,8 @@ def build(name: str, table: dict, **given):
     kwargs = {}
     for key in entry.keys:
         if key in table:
+            if isinstance(table[key], bool) and key not in entry.flags:
+                raise KeyProblem(key, f"must be a number, not {str(table[key]).lower()}")
             kwargs[parameter(key)] = _file_value(key, table[key])
     for key, value in entry.defaults.items():
         if key not in kwargs and _target(entry.cls, key) not in kwargs:

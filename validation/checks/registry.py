@@ -26,12 +26,13 @@ with :func:`text_section`.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import operator
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
+
+from validation.atomic import strict_json  # re-exported: validate --json writes it
 
 __all__ = [
     "Check",
@@ -267,21 +268,6 @@ def check_record(r):
     detail, fails_if (``None`` unless finding-type), slow; non-finite numbers as ``None``."""
     d = r.as_dict()
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
-
-
-def strict_json(obj) -> str:
-    """``obj`` as strict JSON (NaN and infinities become ``null``; raises on anything else)."""
-
-    def clean(v):
-        if isinstance(v, float) and not math.isfinite(v):
-            return None
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, list | tuple):
-            return [clean(x) for x in v]
-        return v
-
-    return json.dumps(clean(obj), indent=2, sort_keys=True, allow_nan=False) + "\n"
 
 
 def _limit(r, width):

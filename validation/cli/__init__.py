@@ -2,27 +2,91 @@
 
 Each command module defines ``register(subparsers)``, which adds its parser and sets
 ``func`` (returning the exit code).
+
+Exit codes, the same for every command (:func:`main`):
+
+* 0: done, every check passed;
+* 1: a check failed or a regression was found (the command says which);
+* 2: a usage or input error: a flag out of range, a malformed scene, data or fit
+  file, an unusable checkpoint, a history folder the nightly run cannot use;
+  one ``error: ...`` line naming the file (``file:line:column`` where known), key
+  or flag, no traceback;
+* 3: an internal error (a bug or a failing machine): ``error: internal: ...``;
+  ``SCATTERBENCH_TRACEBACK=1`` shows the traceback;
+* 130: interrupted (Ctrl-C).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 
 from . import check, fit, models, report, scene, stability, study, table1, tradeoff, validate
 
-__all__ = ["main", "COMMANDS"]
+__all__ = ["main", "COMMANDS", "INPUT_ERRORS", "EXIT_OK", "EXIT_FAILED", "EXIT_USAGE", "EXIT_INTERNAL"]
 
 #: every command module, in the order ``scatterbench --help`` lists them
 COMMANDS = (validate, table1, stability, tradeoff, scene, models, fit, study, report, check)
 
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
-def main(argv=None) -> int:
+#: the exceptions the project raises for bad input, by module: exit 2.  Any other
+#: exception that reaches :func:`main` is a bug (exit 3); a ``ValueError`` is not
+#: input's by itself (numpy raises them too), only these subclasses are.
+INPUT_ERRORS = {
+    "validation.cli.args": "UsageError",
+    "models.scene.schema": "SceneError",
+    "validation.fitting.datafile": "DataFileError",
+    "validation.fitting.fitspec": "FitSpecError",
+    "validation.fitting.checkpoint": "CheckpointError",
+    "validation.report.nightly": "HistoryError",
+}
+
+
+def _is_input_error(exc) -> bool:
+    # only modules already imported can have raised their class: nothing is imported here
+    for module, name in INPUT_ERRORS.items():
+        mod = sys.modules.get(module)
+        if mod is not None and isinstance(exc, getattr(mod, name)):
+            return True
+    return False
+
+
+def _parser():
     ap = argparse.ArgumentParser(
         prog="scatterbench",
         description="Validation and benchmark harness for polarized light-scattering models.",
+        epilog="exit codes: 0 ok, 1 a failed check or regression, 2 usage or input error, "
+        "3 internal error, 130 interrupted",
     )
     sub = ap.add_subparsers(dest="command", required=True)
     for command in COMMANDS:
         command.register(sub)
-    args = ap.parse_args(argv)
-    return args.func(args)
+    return ap
+
+
+def main(argv=None) -> int:
+    """Run one command; returns its exit code (see the module docstring), never raises."""
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as exc:  # argparse has printed usage and ``error: ...`` (2) or --help (0)
+        return exc.code if isinstance(exc.code, int) else EXIT_USAGE
+    try:
+        return args.func(args)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as exc:
+        if _is_input_error(exc):
+            print(f"error: {exc}", file=sys.stderr)
+            return EXIT_USAGE
+        if os.environ.get("SCATTERBENCH_TRACEBACK"):
+            raise
+        print(
+            f"error: internal: {type(exc).__name__}: {exc}\n"
+            "(a bug or a failing machine, not your input: set SCATTERBENCH_TRACEBACK=1 for the "
+            "traceback and report it with the command line)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL

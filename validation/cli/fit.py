@@ -3,7 +3,8 @@
 Output folders are refused when they exist and are not empty, unless
 ``--force`` (replace the results; files are replaced atomically, so a failed
 run leaves the previous ones intact) or, for ``fit``, ``--resume`` (continue
-the chain saved in ``DIR/chain.npz``).
+the chain saved in ``DIR/chain.npz``); every flag and input is checked before
+the optimizer starts.  Ctrl-C during a fit says how to resume (exit 130).
 """
 
 from __future__ import annotations
@@ -12,23 +13,44 @@ import os
 import sys
 import time
 
+from .args import MAX_WORKERS, UsageError, int_in, scheduler_address, writable_folder
+
 __all__ = ["register"]
 
 
-def _out_ok(out, force, resume=False):
-    if os.path.isdir(out) and os.listdir(out) and not (force or resume):
-        print(
-            f"error: {out} exists and is not empty; use --force to overwrite it"
-            + (" or --resume" if resume is not None else ""),
-            file=sys.stderr,
+def _check_out(out, force, resume=None):
+    """Raise :class:`UsageError` unless ``out`` can take the results: a writable folder,
+    empty unless ``force`` (or ``resume``: ``None`` where the command has no --resume)."""
+    if force and resume:
+        raise UsageError(
+            "--force and --resume: give one (--force replaces the results, --resume continues them)"
         )
-        return False
-    return True
+    writable_folder(out, "--out")
+    if os.path.isdir(out) and os.listdir(out) and not (force or resume):
+        raise UsageError(
+            f"{out} exists and is not empty; use --force to overwrite it"
+            + (" or --resume" if resume is not None else "")
+        )
+
+
+def _check_executor(args):
+    if args.scheduler and args.workers != 1:
+        raise UsageError("--workers and --scheduler: give one (local processes or a Dask cluster)")
 
 
 def _executor_args(p):
-    p.add_argument("--workers", type=int, default=1, help="local processes (default 1: in-process)")
-    p.add_argument("--scheduler", default=None, help="dask.distributed scheduler ADDRESS (tcp://host:8786)")
+    p.add_argument(
+        "--workers",
+        type=int_in(1, MAX_WORKERS),
+        default=1,
+        help=f"local processes, 1-{MAX_WORKERS} (default 1: in-process)",
+    )
+    p.add_argument(
+        "--scheduler",
+        type=scheduler_address,
+        default=None,
+        help="dask.distributed scheduler ADDRESS (tcp://host:8786)",
+    )
 
 
 def _spec_args(p):
@@ -75,35 +97,26 @@ def _mcmc_args(p, walkers=None, max_steps=None):
 
 
 def _load(args):
+    """The scene, data, fit spec and likelihood of the command line, every one checked
+    (and against each other) before any work."""
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import fitspec_from
+    from validation.fitting.fitspec import check_against_data, fitspec_from
     from validation.fitting.likelihood import Likelihood
 
     sc = scene_mod.load(args.scene)
     data = load_data(args.data)
     spec = fitspec_from(sc, args.free, args.noise, args.near_specular_deg, args.exclude)
-    wl_s, wl_d = sc.wavelength_nm, data.meta.get("wavelength_nm")
-    if wl_s is not None and wl_d is not None and abs(wl_s - wl_d) > 1e-9 * wl_s:
-        raise ValueError(
-            f"wavelength: the data ({wl_d:g} nm, {data.path}) and the scene ({wl_s:g} nm, {sc.path}) differ; "
-            "the scene's optical constants are for its wavelength"
-        )
+    check_against_data(sc, spec, data)
     return sc, data, spec, Likelihood(sc, spec, data)
 
 
 def _load_and_describe(args):
     """The chain settings from the flags and ``_load``'s inputs, ``(settings, scene, data,
-    spec, likelihood)``, with the scene and fit spec printed; or ``None`` after printing
-    the error."""
+    spec, likelihood)``, with the scene and fit spec printed."""
     settings = _chain_settings(args)
-    if settings is None:
-        return None
-    try:
-        sc, data, spec, lik = _load(args)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return None
+    sc, data, spec, lik = _load(args)
+    _require_walkers(settings, len(spec.free))
     if lik.scene is not sc:
         print(
             f"detector: the data's sidecar records aperture_deg = {lik.scene.aperture_deg:g} "
@@ -116,7 +129,7 @@ def _load_and_describe(args):
 
 def _chain_settings(args):
     """The sampler settings of fit and the studies, built from their flags here and only
-    here; ``None`` after printing the error when a flag is out of range."""
+    here; a flag out of range is a :class:`UsageError` naming it."""
     from validation.fitting.settings import ChainSettings
 
     try:
@@ -129,13 +142,38 @@ def _chain_settings(args):
             starts=args.starts,
         )
     except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return None
+        raise UsageError(str(exc)) from exc
+
+
+def _require_walkers(settings, ndim):
+    try:
+        settings.require_walkers(ndim)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from exc
+
+
+def _interrupted(args, ck, final):
+    """The one line Ctrl-C prints: where the chain is and how to continue it."""
+    from validation.fitting.checkpoint import saved_steps
+
+    saved = ck if os.path.exists(ck) else final if os.path.exists(final) else None
+    if saved is None:
+        print(
+            "interrupted before the first checkpoint: nothing saved; run the command again", file=sys.stderr
+        )
+    else:
+        steps = saved_steps(saved)
+        print(
+            f"interrupted: the chain{'' if steps is None else f' ({steps} steps)'} is saved in {saved}; "
+            "continue it with the same command and --resume (instead of --force)",
+            file=sys.stderr,
+        )
+    return 130
 
 
 def _run_fit(args, lik, settings):
     """Run (or resume) the chain in ``args.out`` and write the results; returns the
-    posterior summary, or ``None`` after printing the error.  The running checkpoint is
+    posterior summary, or the exit code 130 after Ctrl-C.  The running checkpoint is
     chain.partial.npz; it becomes chain.npz when the run ends, so a failed --force
     run never replaces a previous complete chain."""
     from validation.fitting.executors import make_executor
@@ -144,9 +182,9 @@ def _run_fit(args, lik, settings):
     os.makedirs(args.out, exist_ok=True)
     ck = os.path.join(args.out, "chain.partial.npz")
     final = os.path.join(args.out, "chain.npz")
-    with make_executor(args.workers, args.scheduler) as ex:
-        print(f"executor: {ex.describe()}")
-        try:
+    try:
+        with make_executor(args.workers, args.scheduler) as ex:
+            print(f"executor: {ex.describe()}")
             res = run_fit(
                 lik,
                 settings,
@@ -156,23 +194,23 @@ def _run_fit(args, lik, settings):
                 resume_from=ck if os.path.exists(ck) else final,
                 progress=not args.no_progress,
             )
-        except ValueError as exc:  # settings this spec cannot use, a checkpoint that cannot be resumed
-            print(f"error: {exc}", file=sys.stderr)
-            return None
-        if os.path.exists(ck):
-            os.replace(ck, final)
-        post = write_fit(
-            res,
-            args.out,
-            data_path=args.data,
-            scene_path=args.scene,
-            executor_desc=ex.describe(),
-            plots=not args.no_plots,
-        )
-    return post
+            executor = ex.describe()
+    except KeyboardInterrupt:
+        return _interrupted(args, ck, final)
+    if os.path.exists(ck):
+        os.replace(ck, final)
+    return write_fit(
+        res,
+        args.out,
+        data_path=args.data,
+        scene_path=args.scene,
+        executor_desc=executor,
+        plots=not args.no_plots,
+    )
 
 
-def _print_sampling(s, total_seconds):
+def _print_sampling(post, total_seconds):
+    s, timing = post["sampling"], post["timing"]
     print(f"\n{s['stop_reason']}")
     print(
         f"walkers {s['walkers']}, steps {s['steps']}, tau (steps) "
@@ -180,8 +218,8 @@ def _print_sampling(s, total_seconds):
         + f"; acceptance {s['acceptance_mean']:.3f} (min {s['acceptance_min']:.3f}); burn-in {s['burn_in']}, thin {s['thin']}"
     )
     print(
-        f"sampling time {s['seconds']:.1f} s, {s['log_prob_evaluations']} likelihood evaluations, "
-        f"{s['evaluations_per_second']:.0f} evaluations/s (total {total_seconds:.1f} s)"
+        f"sampling time {timing['sampling_seconds']:.1f} s, {s['log_prob_evaluations']} likelihood "
+        f"evaluations, {timing['evaluations_per_second']:.0f} evaluations/s (total {total_seconds:.1f} s)"
     )
 
 
@@ -205,20 +243,17 @@ def _print_posterior(post):
 
 
 def _cmd_fit(args) -> int:
-    if not _out_ok(args.out, args.force, args.resume):
-        return 2
-    loaded = _load_and_describe(args)
-    if loaded is None:
-        return 2
-    settings, _, data, _, lik = loaded
+    _check_out(args.out, args.force, args.resume)
+    _check_executor(args)
+    settings, _, data, _, lik = _load_and_describe(args)
     print(
         f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
     )
     t0 = time.perf_counter()
     post = _run_fit(args, lik, settings)
-    if post is None:
-        return 2
-    _print_sampling(post["sampling"], time.perf_counter() - t0)
+    if isinstance(post, int):  # interrupted
+        return post
+    _print_sampling(post, time.perf_counter() - t0)
     _print_posterior(post)
     print(
         f"wrote {args.out}/posterior.json, chain.npz"

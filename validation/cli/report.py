@@ -4,11 +4,16 @@ from __future__ import annotations
 
 import os
 
+from .args import nonneg_float, writable_folder
+
 
 def _report(args) -> int:
     from validation.report import write_report
 
+    writable_folder(args.out, "--out")
     res = write_report(args.out, quick=args.quick)
+    if res["meta"].get("previous_problem"):
+        print(f"note: no change since the previous report: {res['meta']['previous_problem']}")
     s = res["summary"]
     print(
         f"wrote {os.path.join(args.out, 'report.html')} and results.json: {s['n_checks']} checks, "
@@ -20,13 +25,15 @@ def _report(args) -> int:
 def _nightly(args) -> int:
     from validation.report import nightly
 
-    code, regressions, run_dir = nightly(args.history, quick=args.quick)
-    print(f"nightly run written to {run_dir}; latest -> {os.path.relpath(run_dir, args.history)}")
-    for r in regressions:
+    run = nightly(args.history, quick=args.quick, wait=args.wait)
+    print(f"nightly run written to {run.run_dir}; latest -> {os.path.relpath(run.run_dir, args.history)}")
+    for n in run.notes:
+        print(f"HISTORY: {n}")
+    for r in run.regressions:
         print(f"REGRESSION: {r}")
-    if not regressions:
+    if not run.regressions:
         print("no regression against the previous night")
-    return code
+    return run.code
 
 
 def register(sub):
@@ -39,4 +46,10 @@ def register(sub):
     )
     p.add_argument("--history", required=True, help="history folder (runs/, latest)")
     p.add_argument("--quick", action="store_true")
+    p.add_argument(
+        "--wait",
+        type=nonneg_float,
+        default=3600.0,
+        help="seconds to wait for another nightly run holding the history (default 3600), then exit 2",
+    )
     p.set_defaults(func=_nightly)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import sys
+from .args import positive_float, writable_folder
 
 __all__ = ["register"]
 
@@ -11,11 +11,8 @@ def _cmd_scene(args) -> int:
     from models import scene as scene_mod
     from validation.studies.scenes import write_scene_outputs
 
-    try:
-        sc = scene_mod.load(args.file)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    writable_folder(args.out, "--out")
+    sc = scene_mod.load(args.file)
     print(sc.describe())
     if args.tol is None:
         csv_path, png_path = write_scene_outputs(sc, args.out)
@@ -33,8 +30,8 @@ def register(sub):
     p.add_argument("--out", default="reports/scenes", help="output folder")
     p.add_argument(
         "--tol",
-        type=float,
+        type=positive_float,
         default=None,
-        help="pick grid, Monte Carlo pairs and point-source resolution from the measured curves",
+        help="(> 0) pick grid, Monte Carlo pairs and point-source resolution from the measured curves",
     )
     p.set_defaults(func=_cmd_scene)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 
-from .fit import _executor_args
+from .fit import _check_executor, _executor_args
 from .study import _open_executor
 
 __all__ = ["register"]
@@ -13,11 +13,9 @@ __all__ = ["register"]
 def _cmd_stability(args) -> int:
     from validation.studies.stability import classify, format_sweep, sweep
 
+    _check_executor(args)
     t0 = time.perf_counter()
-    ex = _open_executor(args)
-    if ex is None:
-        return 2
-    with ex:
+    with _open_executor(args) as ex:
         findings = sweep(energy=not args.no_energy, executor=ex)
     print(format_sweep(findings))
     print(f"stability sweep finished in {time.perf_counter() - t0:.1f} s")

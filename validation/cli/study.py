@@ -13,37 +13,41 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 
 import numpy as np
 
-from .fit import _chain_settings, _executor_args, _load_and_describe, _mcmc_args, _out_ok, _spec_args
+from .args import UsageError, int_at_least, ints_at_least, positive_floats
+from .fit import (
+    _chain_settings,
+    _check_executor,
+    _check_out,
+    _executor_args,
+    _load_and_describe,
+    _mcmc_args,
+    _require_walkers,
+    _spec_args,
+)
 
 __all__ = ["register"]
 
 
 def _open_executor(args):
-    """The executor ``--workers``/``--scheduler`` ask for, its description printed; or
-    ``None`` after printing the error (a worker count below 1, a scheduler that does not
-    answer)."""
+    """The executor ``--workers``/``--scheduler`` ask for, its description printed.
+
+    Raises
+    ------
+    UsageError
+        A scheduler that does not answer (exit 2).
+    """
     from validation.fitting.executors import make_executor
 
     try:
         ex = make_executor(args.workers, args.scheduler)
     except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return None
+        raise UsageError(str(exc)) from exc
     print(f"executor: {ex.describe()}")
     return ex
-
-
-def _floats(text):
-    return [float(x) for x in text.split(",") if x.strip()]
-
-
-def _ints(text):
-    return [int(x) for x in text.split(",") if x.strip()]
 
 
 # ----------------------------------------------------------------------------- recovery
@@ -72,30 +76,23 @@ def _cmd_recovery(args) -> int:
     from validation.atomic import atomic_write_json
     from validation.fitting.recovery import check_inputs, recovery_study
 
-    if not _out_ok(args.out, args.force, None):
-        return 2
-    loaded = _load_and_describe(args)
-    if loaded is None:
-        return 2
-    settings, sc, data, spec, _ = loaded
+    _check_out(args.out, args.force)
+    _check_executor(args)
+    settings, sc, data, spec, _ = _load_and_describe(args)
     extra = {k: v for k, v in spec.noise.items() if k != "brdf"}
     try:
         check_inputs(spec, settings, extra, args.injections)
     except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        raise UsageError(str(exc)) from exc
     t0 = time.perf_counter()
-    ex = _open_executor(args)
-    if ex is None:
-        return 2
-    with ex:
+    with _open_executor(args) as ex:
         cells = recovery_study(
             sc,
             spec,
             data,
             settings,
-            noise_levels=_floats(args.noise_levels),
-            n_geometries=_ints(args.n_geometries) if args.n_geometries else (None,),
+            noise_levels=args.noise_levels,
+            n_geometries=args.n_geometries or (None,),
             injections=args.injections,
             executor=ex,
             noise_extra=extra,
@@ -170,13 +167,11 @@ def _inversion_model(args):
     from models import DetectorAperture
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import FitSpec, parse_exclude
+    from validation.fitting.fitspec import masked_rows
     from validation.fitting.likelihood import scene_for_data
 
     sc = scene_mod.load(args.scene)
-    data = load_data(args.data)
-    spec = FitSpec((), {}, args.near_specular_deg or 0.0, tuple(parse_exclude(t) for t in args.exclude or []))
-    data = data.subset(spec.mask(data))
+    data = masked_rows(load_data(args.data), args.near_specular_deg, args.exclude)
     model = scene_for_data(sc, data).build()
     if isinstance(model, DetectorAperture):
         print(
@@ -213,14 +208,12 @@ def _cmd_inversion(args) -> int:
     from validation.atomic import atomic_savefig, atomic_write_json
     from validation.fitting.inversion import inversion_figure, inversion_study
 
-    if not _out_ok(args.out, args.force, None):
-        return 2
+    _check_out(args.out, args.force)
+    data, model = _inversion_model(args)
     try:
-        data, model = _inversion_model(args)
         study = inversion_study(model, data, bins=args.bins, n_bootstrap=args.bootstrap, seed=args.seed)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    except ValueError as exc:  # too few distinct slopes for the curve, a model it cannot invert
+        raise UsageError(f"{args.data}: {exc}") from exc
     os.makedirs(args.out, exist_ok=True)
     atomic_write_json(
         os.path.join(args.out, "inversion.json"), {"data": args.data, "scene": args.scene, **study.as_dict()}
@@ -238,7 +231,7 @@ def _compare_likelihoods(args):
     """One likelihood per ``--scene`` on the data, named by the scene file."""
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import fitspec_from
+    from validation.fitting.fitspec import check_against_data, fitspec_from
     from validation.fitting.likelihood import Likelihood
 
     data = load_data(args.data)
@@ -246,6 +239,7 @@ def _compare_likelihoods(args):
     for path in args.scene:
         sc = scene_mod.load(path)
         spec = fitspec_from(sc, None, args.noise, args.near_specular_deg, args.exclude)
+        check_against_data(sc, spec, data)
         liks.append(Likelihood(sc, spec, data))
         names.append(os.path.basename(path))
     return liks, names
@@ -255,27 +249,21 @@ def _cmd_compare(args) -> int:
     from validation.atomic import atomic_write_json
     from validation.fitting.compare import check_comparable, compare_fits, format_comparison
 
-    if not _out_ok(args.out, args.force, None):
-        return 2
+    _check_out(args.out, args.force)
+    _check_executor(args)
     settings = _chain_settings(args)
-    if settings is None:
-        return 2
+    liks, names = _compare_likelihoods(args)
     try:
-        liks, names = _compare_likelihoods(args)
         check_comparable(liks, names)
-        for lik in liks:
-            settings.require_walkers(len(lik.spec.free))
     except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        raise UsageError(str(exc)) from exc
+    for lik in liks:
+        _require_walkers(settings, len(lik.spec.free))
     for nm, lik in zip(names, liks, strict=True):
         print(
             f"{nm}: {len(lik.spec.free)} free ({', '.join(lik.spec.names)}); likelihood terms: {', '.join(lik.terms)}"
         )
-    ex = _open_executor(args)
-    if ex is None:
-        return 2
-    with ex:
+    with _open_executor(args) as ex:
         rows, _ = compare_fits(liks, names, settings, executor=ex)
     os.makedirs(args.out, exist_ok=True)
     atomic_write_json(
@@ -295,11 +283,19 @@ def register(sub):
     r = ss.add_parser("recovery", help="injection-recovery coverage, bias and width")
     r.add_argument("data", help="data file whose geometries and incident states the injections use")
     _spec_args(r)
-    r.add_argument("--noise-levels", default="0.05", help="fractional BRDF noise levels, comma separated")
     r.add_argument(
-        "--n-geometries", default="", help="numbers of geometries (evenly spread subsets), comma separated"
+        "--noise-levels",
+        type=positive_floats,
+        default=[0.05],
+        help="fractional BRDF noise levels (> 0), comma separated",
     )
-    r.add_argument("--injections", type=int, default=50)
+    r.add_argument(
+        "--n-geometries",
+        type=ints_at_least(1),
+        default=None,
+        help="numbers of geometries (evenly spread subsets, >= 1), comma separated; default: every row",
+    )
+    r.add_argument("--injections", type=int, default=50, help="injections per cell, >= 1")
     r.add_argument("--out", required=True)
     r.add_argument("--force", action="store_true")
     r.add_argument("--no-progress", action="store_true")
@@ -311,10 +307,13 @@ def register(sub):
     v.add_argument("data")
     v.add_argument("--scene", required=True, help="scene with a single facet mechanism")
     v.add_argument(
-        "--bins", type=int, default=None, help="bin ln P3 in |zeta| (noisy data); default: every slope"
+        "--bins",
+        type=int_at_least(4),
+        default=None,
+        help="bin ln P3 in |zeta| (noisy data; >= 4 bins, the curve's knots); default: every slope",
     )
-    v.add_argument("--bootstrap", type=int, default=200)
-    v.add_argument("--seed", type=int, default=0)
+    v.add_argument("--bootstrap", type=int_at_least(1), default=200, help="bootstrap replicates, >= 1")
+    v.add_argument("--seed", type=int_at_least(0), default=0)
     v.add_argument("--near-specular-deg", type=float, default=None)
     v.add_argument("--exclude", action="append", default=None)
     v.add_argument("--out", required=True)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from .args import positive_float
+
 __all__ = ["register"]
 
 
@@ -16,5 +18,5 @@ def _cmd_table1(args) -> int:
 
 def register(sub):
     p = sub.add_parser("table1", help="seed 000 Table I beside the printed values")
-    p.add_argument("--tol", type=float, default=1e-4, help="absolute integration tolerance")
+    p.add_argument("--tol", type=positive_float, default=1e-4, help="absolute integration tolerance (> 0)")
     p.set_defaults(func=_cmd_table1)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from .args import positive_float, writable_folder
+
 __all__ = ["register"]
 
 
@@ -63,6 +65,7 @@ def _cmd_tradeoff(args) -> int:
     from validation.atomic import atomic_write_json
     from validation.studies.tradeoff import BATCH, MIN_BATCHES, MIN_WORK, study
 
+    writable_folder(args.out, "--out")  # refused before the study, not after
     skipped = {}
     results = study(quick=args.quick, skipped=skipped)
     os.makedirs(args.out, exist_ok=True)
@@ -88,5 +91,10 @@ def register(sub):
     p = sub.add_parser("tradeoff", help="measure error versus cost for every accuracy knob")
     p.add_argument("--out", default="reports/tradeoff", help="output folder (JSON and PNG)")
     p.add_argument("--quick", action="store_true", help="fewer settings per knob")
-    p.add_argument("--tol", type=float, default=None, help="report the cheapest setting meeting this error")
+    p.add_argument(
+        "--tol",
+        type=positive_float,
+        default=None,
+        help="report the cheapest setting meeting this error (> 0)",
+    )
     p.set_defaults(func=_cmd_tradeoff)

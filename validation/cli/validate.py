@@ -51,6 +51,10 @@ def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
 
 
 def _cmd_validate(args) -> int:
+    if args.json:
+        from .args import writable_file
+
+        writable_file(args.json, "--json")
     return run(quick=args.quick, json_path=args.json)
 
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from validation.atomic import atomic_write_bytes
 
-__all__ = ["CheckpointBackend", "CheckpointError", "FORMAT"]
+__all__ = ["CheckpointBackend", "CheckpointError", "FORMAT", "saved_steps"]
 
 FORMAT = "scatterbench-chain/2"
 
@@ -202,3 +202,13 @@ def _read(path) -> dict:
         raise CheckpointError(f"{path}: a corrupt checkpoint (missing {', '.join(missing)}); start a new run")
     entries["fingerprint"] = str(entries["fingerprint"])
     return entries
+
+
+def saved_steps(path) -> int | None:
+    """The number of steps the checkpoint ``path`` holds; ``None`` if it cannot be read
+    (for messages only: never raises)."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return int(z["chain"].shape[0])
+    except Exception:  # noqa: BLE001 - a message must not fail
+        return None

@@ -55,11 +55,13 @@ import io
 import json
 import math
 import os
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from models.polarization import ellipsometric, stokes
+from models.polarization import ellipsometric
+from models.scene.schema import polarization_state, utf8_text
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -163,19 +165,64 @@ def _sidecar_path(path):
     return os.path.splitext(path)[0] + ".json"
 
 
+def _text_of(path, what):
+    """The UTF-8 text of a file (a byte-order mark dropped); errors name ``file:line:column``."""
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise DataFileError(path, 0, None, f"cannot read the {what} ({exc.strerror})") from exc
+    text, bad = utf8_text(raw)
+    if bad is None:
+        return text
+    line, col = text.count("\n") + 1, len(text) - text.rfind("\n")
+    raise DataFileError(path, line, col, f"not UTF-8 text (byte 0x{bad:02x}); save the {what} as UTF-8")
+
+
+class _NotJSON(ValueError):
+    """A token JSON does not have (NaN, Infinity) or a key given twice; ``pattern`` finds
+    it in the text (the parser does not say where)."""
+
+    def __init__(self, message, pattern):
+        super().__init__(message)
+        self.pattern = pattern
+
+
+def _no_constants(token):
+    raise _NotJSON(f"{token} is not a JSON number (write null, or leave the key out)", re.escape(token))
+
+
+def _no_duplicates(pairs):
+    keys = [k for k, _ in pairs]
+    for k in keys:
+        if keys.count(k) > 1:
+            raise _NotJSON(f"key {k!r} given twice", re.escape(json.dumps(k)))
+    return dict(pairs)
+
+
+def _parse_json(side, text):
+    """The sidecar's JSON value: strict (no NaN/Infinity, no key twice), errors located."""
+    try:
+        return json.loads(text, parse_constant=_no_constants, object_pairs_hook=_no_duplicates)
+    except json.JSONDecodeError as exc:
+        raise DataFileError(side, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}") from exc
+    except RecursionError as exc:
+        raise DataFileError(side, 1, None, "not valid JSON for a sidecar: nested too deeply") from exc
+    except ValueError as exc:  # _NotJSON, or an integer of thousands of digits Python will not read
+        found = list(re.finditer(getattr(exc, "pattern", r"\d{4300,}"), text))
+        at = found[-1].start() if found else 0
+        line, col = text.count("\n", 0, at) + 1, at - text.rfind("\n", 0, at)
+        keys = re.findall(r'"((?:[^"\\]|\\.)*)"\s*:', text[:at])  # the key the token belongs to
+        key = f"{keys[-1]}: " if keys and "twice" not in str(exc) else ""
+        raise DataFileError(side, line, col, f"{key}not valid JSON: {exc}") from exc
+
+
 def _load_sidecar(path):
     side = _sidecar_path(path)
     if not os.path.exists(side):
         return {}, None
-    try:
-        with open(side, encoding="utf-8") as fh:
-            text = fh.read()
-    except OSError as exc:
-        raise DataFileError(side, 0, None, f"cannot read the sidecar ({exc.strerror})") from exc
-    try:
-        meta = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise DataFileError(side, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}") from exc
+    text = _text_of(side, "sidecar")
+    meta = _parse_json(side, text)
     if not isinstance(meta, dict):
         raise DataFileError(side, 1, 1, "the sidecar must be a JSON object")
 
@@ -187,31 +234,50 @@ def _load_sidecar(path):
         return 1, None
 
     for key, value in meta.items():
-        ln, col = line_of(key)
-        if key not in SIDECAR_KEYS:
-            raise DataFileError(
-                side, ln, col, f"unknown key {key!r}; allowed: {', '.join(sorted(SIDECAR_KEYS))}"
-            )
-        if key == "format" and value != FORMAT:
-            raise DataFileError(side, ln, col, f"format must be {FORMAT!r}; got {value!r}")
-        if key in ("sample", "instrument", "description") and not isinstance(value, str):
-            raise DataFileError(side, ln, col, f"{key} must be a string; got {value!r}")
-        if key == "wavelength_nm" and not (_is_num(value) and value > 0):
-            raise DataFileError(side, ln, col, f"wavelength_nm must be a finite number > 0; got {value!r}")
-        if key == "aperture_deg" and not (_is_num(value) and 0 <= value <= 90):
-            raise DataFileError(side, ln, col, f"aperture_deg must be a number in [0, 90]; got {value!r}")
-        if key == "incident_polarization":
-            try:
-                stokes(value if isinstance(value, str) else list(value))
-            except (ValueError, TypeError) as exc:
-                raise DataFileError(side, ln, col, f"incident_polarization: {exc}") from exc
-        if key == "truth" and not isinstance(value, dict):
-            raise DataFileError(side, ln, col, "truth must be an object {scene key: value}")
+        problem = _sidecar_problem(key, value)
+        if problem:
+            raise DataFileError(side, *line_of(key), problem)
     return meta, side
 
 
+def _sidecar_problem(key, value):
+    """What is wrong with a sidecar entry (None: nothing)."""
+    if key not in SIDECAR_KEYS:
+        return f"unknown key {key!r}; allowed: {', '.join(sorted(SIDECAR_KEYS))}"
+    if key == "format" and value != FORMAT:
+        return f"format must be {FORMAT!r}; got {_shown(value)}"
+    if key in ("sample", "instrument", "description") and not isinstance(value, str):
+        return f"{key} must be a string; got {_shown(value)}"
+    if key == "wavelength_nm" and not (_is_num(value) and value > 0):
+        return f"wavelength_nm must be a finite number > 0; got {_shown(value)}"
+    if key == "aperture_deg" and not (_is_num(value) and 0 <= value <= 90):
+        return f"aperture_deg must be a number in [0, 90]; got {_shown(value)}"
+    if key == "incident_polarization":
+        try:
+            polarization_state(value)
+        except ValueError as exc:
+            return f"incident_polarization: {exc}"
+    if key == "truth":
+        if not isinstance(value, dict):
+            return "truth must be an object {scene key: value}"
+        for k, v in value.items():
+            if not _is_num(v):
+                return f"truth: {k}: must be a finite number (the true value); got {_shown(v)}"
+    return None
+
+
+def _shown(value):
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _is_num(v):
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # an integer no float can hold
+        return False
 
 
 def _range_text(lo, hi, lo_open, hi_open):
@@ -219,13 +285,7 @@ def _range_text(lo, hi, lo_open, hi_open):
 
 
 def _read_lines(path):
-    try:
-        with open(path, encoding="utf-8", newline="") as fh:
-            return fh.read().splitlines()
-    except OSError as exc:
-        raise DataFileError(path, 0, None, f"cannot read the data file ({exc.strerror})") from exc
-    except UnicodeDecodeError as exc:
-        raise DataFileError(path, 0, None, f"not UTF-8 text ({exc.reason})") from exc
+    return _text_of(path, "data file").splitlines()
 
 
 def _split(path, raw_lines):
@@ -234,7 +294,10 @@ def _split(path, raw_lines):
     for lineno, text in enumerate(raw_lines, 1):
         if not text.strip() or text.lstrip().startswith("#"):
             continue
-        fields = next(csv.reader([text]))
+        try:
+            fields = next(csv.reader([text]))
+        except csv.Error as exc:  # a NUL byte, a field beyond the csv module's size limit
+            raise DataFileError(path, lineno, None, f"not a CSV line ({exc})") from exc
         if header is None:
             header, header_line = [f.strip() for f in fields], lineno
         else:
@@ -343,7 +406,7 @@ def _parse_rows(path, header, rows, col_of):
                 continue
             if cell not in cache:
                 try:
-                    cache[cell] = stokes(cell)
+                    cache[cell] = polarization_state(cell)
                 except ValueError as exc:
                     raise DataFileError(path, lineno, j, f"column 'incident': {exc}") from exc
             incident[i] = cache[cell]
@@ -388,8 +451,7 @@ def load_data(path) -> Dataset:
         raise DataFileError(path, header_line, None, "no data rows")
     values, incident = _parse_rows(path, header, rows, col_of)
     if "incident_polarization" in meta:
-        v = meta["incident_polarization"]
-        incident[:] = stokes(v if isinstance(v, str) else list(v))
+        incident[:] = polarization_state(meta["incident_polarization"])
     eta, P, PC = _ellipsometric(values, len(rows))
     return Dataset(
         path=path,
@@ -427,8 +489,8 @@ def write_data(path, columns: dict, meta: dict | None = None, comments=()):
     if len(n_rows) != 1:
         raise ValueError("columns: every column must have the same length")
     buf = io.StringIO()
-    for c in comments:
-        buf.write(f"# {c}\n")
+    for c in comments:  # one comment line each: a newline in a comment must not start a row
+        buf.write("# " + " ".join(str(c).splitlines()) + "\n")
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(names)
     cols = [columns[n] for n in names]

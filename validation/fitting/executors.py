@@ -21,6 +21,7 @@ and however the items are grouped.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import hashlib
 import multiprocessing
 import pickle
@@ -48,6 +49,14 @@ def _run_chunk(fn, chunk):
 _WORKER_FNS: dict = {}
 
 
+def _ignore_sigint():
+    """Workers leave Ctrl-C to the parent (which stops the pool and says how to resume):
+    the terminal sends it to every process of the group, and each would print a traceback."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _run_pickled_chunk(key, blob, chunk):
     """Worker side: unpickle the function once per worker process and reuse it."""
     fn = _WORKER_FNS.get(key)
@@ -57,6 +66,30 @@ def _run_pickled_chunk(key, blob, chunk):
     return [fn(x) for x in chunk]
 
 
+@contextlib.contextmanager
+def _sigint_between_calls():
+    """Ctrl-C during the block is held until the caller asks (``pending()``): a
+    KeyboardInterrupt raised inside emcee's wrapper of the log-probability makes it print
+    a traceback; raised between calls, the fit stops with one line saying how to resume."""
+    import signal
+    import threading
+
+    got = []
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
+    ):
+        yield lambda: False  # someone else handles Ctrl-C here: leave it to them
+        return
+    signal.signal(signal.SIGINT, lambda *_: got.append(True))
+    try:
+        yield lambda: bool(got)
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    if got:
+        raise KeyboardInterrupt
+
+
 class SerialExecutor:
     workers = 1
     kind = "serial"
@@ -64,7 +97,13 @@ class SerialExecutor:
     def map(self, fn, items, tasks=None):
         """``[fn(x) for x in items]``; ``tasks`` (how many pieces the work is cut
         into elsewhere) changes nothing in-process."""
-        return [fn(x) for x in items]
+        out = []
+        with _sigint_between_calls() as pending:
+            for x in items:
+                out.append(fn(x))
+                if pending():
+                    break
+        return out
 
     def close(self):
         pass
@@ -88,7 +127,9 @@ class ProcessExecutor(SerialExecutor):
         self.workers = workers
         # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
         self._fn = self._blob = self._key = None
-        self._pool = cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+        self._pool = cf.ProcessPoolExecutor(
+            workers, mp_context=multiprocessing.get_context("spawn"), initializer=_ignore_sigint
+        )
 
     def map(self, fn, items, tasks=None):
         """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker)."""

@@ -15,7 +15,7 @@ from validation.checks.registry import SEED, check_record, judge, select, tally
 from .core import Context, Section, render_html
 from .sections import SECTION_FUNCS, _git_commit, report_checks
 
-__all__ = ["build_report", "write_report"]
+__all__ = ["build_report", "write_report", "read_results", "read_results_checked"]
 
 
 def _progress(total, label):
@@ -121,24 +121,43 @@ def build_report(
     return results, html
 
 
-def read_results(path):
+def read_results_checked(path):
+    """``(results, problem)`` of a results.json: ``(dict, None)`` when it holds a report's
+    results; ``(None, None)`` when there is no such file; ``(None, why)`` when it cannot
+    be used (unreadable, not JSON, not a results object)."""
+    if not os.path.lexists(path):
+        return None, None
     try:
-        with open(path) as fh:
-            return json.load(fh)
-    except (OSError, ValueError):
-        return None
+        with open(path, encoding="utf-8") as fh:
+            res = json.load(fh)
+    except OSError as exc:
+        return None, f"{path}: cannot be read ({exc.strerror})"
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError, bad UTF-8, too deeply nested
+        return None, f"{path}: not valid JSON ({exc})"
+    if not isinstance(res, dict) or not isinstance(res.get("checks"), list):
+        return None, f"{path}: not a report's results (an object with a list of checks)"
+    return res, None
+
+
+def read_results(path):
+    """The results in ``path``, or ``None`` when there are none that can be used."""
+    return read_results_checked(path)[0]
 
 
 def write_report(out_dir, quick=False, previous=None, **kwargs):
     """Write ``report.html`` and ``results.json`` into ``out_dir`` (each atomically).
 
     The previous ``results.json`` of that folder (if any) is the comparison base
-    for "change since previous" unless ``previous`` is given.
+    for "change since previous" unless ``previous`` is given; one that cannot be
+    used is said so in ``results["meta"]["previous_problem"]``.
     """
     os.makedirs(out_dir, exist_ok=True)
+    problem = None
     if previous is None:
-        previous = read_results(os.path.join(out_dir, "results.json"))
+        previous, problem = read_results_checked(os.path.join(out_dir, "results.json"))
     results, html = build_report(quick=quick, previous=previous, **kwargs)
+    if problem:
+        results["meta"]["previous_problem"] = problem
     atomic_write_json(os.path.join(out_dir, "results.json"), results)
     atomic_write_text(os.path.join(out_dir, "report.html"), html)
     return results

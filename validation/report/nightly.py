@@ -4,24 +4,59 @@ Layout of the history folder::
 
     HISTORY/runs/<stamp>/report.html, results.json   one folder per completed run
     HISTORY/latest -> runs/<stamp>                   the last completed run (a symlink)
+    HISTORY/.lock                                     held by the run in progress
 
 A run is built in ``HISTORY/.tmp-<stamp>/`` and only renamed into ``runs/``
 when complete; then ``latest`` is switched atomically (a new symlink renamed
 over the old one).  Killing a run at any point therefore leaves the previous
 ``latest`` report and every earlier results.json untouched.  The history of
 results.json is the ``runs`` folder itself.
+
+Runs that overlap (two cron entries, a manual run during the nightly one) take
+turns: a run holds ``HISTORY/.lock`` (an ``flock``, released by the kernel when
+the process ends, however it ends) from before it reads the previous night until
+``latest`` is switched; the next one waits for it, up to ``wait`` seconds, then
+refuses with a :class:`HistoryError` naming the holder.  Only the holder removes
+the leftovers of killed runs, so no run deletes another's work in progress.  A
+second run in the same second gets the stamp ``<stamp>-1`` (``-2``, ...).
+
+Everything a run needs from the folder is checked before any work: the folder
+and ``runs/`` writable, ``latest`` absent or a symlink (a real file or folder there
+is refused, never replaced).  A previous night that cannot be read (``latest``
+pointing nowhere, a corrupt results.json) is said so in :attr:`NightlyRun.notes`:
+the run compares with the newest earlier run that can be read, if any, and exits 1.
 """
 
 from __future__ import annotations
 
 import datetime
-import json
 import os
+import re
 import shutil
+from typing import NamedTuple
 
-from .build import read_results, write_report
+from validation.atomic import LockHeld, atomic_write_json, file_lock
 
-__all__ = ["nightly", "compare_results"]
+from .build import read_results_checked, write_report
+
+__all__ = ["nightly", "compare_results", "HistoryError", "NightlyRun"]
+
+_STAMP = re.compile(r"^[0-9A-Za-z][0-9A-Za-z._:+-]*$")
+
+
+class HistoryError(ValueError):
+    """A history folder a nightly run cannot use (not writable, a ``latest`` that is not the
+    symlink it maintains, held by another run for too long); the message names the path."""
+
+
+class NightlyRun(NamedTuple):
+    """What :func:`nightly` did: its exit code (1 on a failed check, a regression or a
+    note), the regressions, the run's folder and notes on the history."""
+
+    code: int
+    regressions: list
+    run_dir: str
+    notes: list
 
 
 def compare_results(old, new):
@@ -52,34 +87,172 @@ def compare_results(old, new):
     return out
 
 
-def _latest_results(history):
-    link = os.path.join(history, "latest")
-    if os.path.islink(link) or os.path.isdir(link):
-        return read_results(os.path.join(link, "results.json"))
+def _writable(folder):
+    """Why this process cannot create a file in ``folder`` (None: it can)."""
+    try:
+        probe = os.path.join(folder, f".probe-{os.getpid()}")
+        with open(probe, "w"):
+            pass
+        os.unlink(probe)
+    except OSError as exc:
+        return exc.strerror or str(exc)
     return None
 
 
-def nightly(history, quick=False, stamp=None, _after_build=None, **kwargs):
-    """Run the suite into the history folder; returns ``(exit_code, regressions, run_dir)``."""
-    os.makedirs(os.path.join(history, "runs"), exist_ok=True)
-    for name in os.listdir(history):  # leftovers of killed runs
-        if name.startswith(".tmp-"):
-            shutil.rmtree(os.path.join(history, name), ignore_errors=True)
-    stamp = stamp or datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H%M%SZ")
-    previous = _latest_results(history)
+def _check_folder(history):
+    """The history folder exists (made if need be) and this process can write in it."""
+    if os.path.lexists(history) and not os.path.isdir(history):
+        raise HistoryError(f"{history}: not a folder; the history is a folder (runs/, latest)")
+    try:
+        os.makedirs(history, exist_ok=True)
+    except OSError as exc:
+        raise HistoryError(f"{history}: cannot create the history folder ({exc.strerror})") from exc
+    problem = _writable(history)
+    if problem:
+        raise HistoryError(
+            f"{history}: cannot write in the history folder ({problem}); a nightly run writes its "
+            "run, its lock and latest there"
+        )
+
+
+def _check_layout(history):
+    """``runs/`` a writable folder, ``latest`` absent or a symlink: before any work."""
+    runs = os.path.join(history, "runs")
+    if os.path.lexists(runs) and not os.path.isdir(runs):
+        raise HistoryError(f"{runs}: not a folder; the history keeps one folder per run there")
+    os.makedirs(runs, exist_ok=True)
+    problem = _writable(runs)
+    if problem:
+        raise HistoryError(f"{runs}: cannot write in it ({problem})")
+    latest = os.path.join(history, "latest")
+    if os.path.lexists(latest) and not os.path.islink(latest):
+        kind = "a folder" if os.path.isdir(latest) else "a file"
+        raise HistoryError(
+            f"{latest}: {kind}, not the symlink nightly maintains (latest -> runs/<stamp>); "
+            "move it away: it is not replaced"
+        )
+
+
+def _remove_leftovers(history):
+    """Build folders and links of killed runs (only the lock's holder calls this)."""
+    for name in os.listdir(history):
+        p = os.path.join(history, name)
+        if name.startswith(".tmp-latest-"):
+            os.unlink(p)
+        elif name.startswith(".tmp-"):
+            shutil.rmtree(p, ignore_errors=True)
+
+
+def _readable_run(history, skip=()):
+    """``(results, name)`` of the newest run in ``runs/`` whose results.json can be read."""
+    runs = os.path.join(history, "runs")
+    for name in sorted(os.listdir(runs), reverse=True):
+        if name in skip:
+            continue
+        res, problem = read_results_checked(os.path.join(runs, name, "results.json"))
+        if res is not None and problem is None:
+            return res, name
+    return None, None
+
+
+def _previous(history):
+    """``(results of the previous night or None, notes)``: ``latest``'s results, or, when
+    they cannot be read, the newest earlier run's, with a note saying so."""
+    latest = os.path.join(history, "latest")
+    if not os.path.lexists(latest):
+        res, name = _readable_run(history)
+        if res is None:
+            return None, []  # the first night
+        return res, [f"{latest} is missing; compared with runs/{name}, the newest run"]
+    target = os.readlink(latest)
+    res, problem = read_results_checked(os.path.join(latest, "results.json"))
+    if problem is None and res is None:
+        problem = f"{latest} -> {target} does not exist"
+    if problem is None:
+        return res, []
+    res, name = _readable_run(history, skip={os.path.basename(os.path.normpath(target))})
+    then = (
+        f"compared with runs/{name} instead" if res else "no earlier run can be read: no regression detection"
+    )
+    return res, [f"the previous night cannot be read: {problem}; {then}"]
+
+
+def _stamp(history, stamp):
+    """A stamp no run of the history has: ``stamp`` (default: now, UTC), or with ``-1``, ``-2``, ..."""
+    base = stamp or datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H%M%SZ")
+    if not isinstance(base, str) or not _STAMP.match(base):
+        raise HistoryError(f"stamp: a run's folder name (letters, digits, ._:+-); got {base!r}")
+    taken = set(os.listdir(os.path.join(history, "runs")))
+    out, n = base, 0
+    while out in taken:
+        n += 1
+        out = f"{base}-{n}"
+    return out
+
+
+def _say_waiting(history):
+    def say(holder):
+        print(f"nightly: {history}/.lock is held by {holder or 'another run'}; waiting for it", flush=True)
+
+    return say
+
+
+def nightly(history, quick=False, stamp=None, wait=3600.0, _after_build=None, **kwargs):
+    """Run the suite into the history folder (see the module docstring).
+
+    Parameters
+    ----------
+    history : str
+        The history folder (made if need be).
+    quick : bool
+        The quick report.
+    stamp : str, optional
+        The run's folder name (default: the UTC time); made unique if taken.
+    wait : float or None
+        Seconds to wait for another run holding the history (``None``: as long as it takes).
+    **kwargs
+        Passed to :func:`~validation.report.build.build_report` (``only``, ``checks``, ...).
+
+    Returns
+    -------
+    NightlyRun
+
+    Raises
+    ------
+    HistoryError
+        The folder cannot be used, or another run held it for longer than ``wait``.
+    """
+    _check_folder(history)
+    lock = file_lock(os.path.join(history, ".lock"), wait=wait, on_wait=_say_waiting(history))
+    try:
+        with lock:
+            return _run(history, quick, stamp, _after_build, kwargs)
+    except LockHeld as exc:
+        raise HistoryError(
+            f"{exc.path}: another nightly run holds the history ({exc.holder or 'holder unknown'}); "
+            f"waited {exc.waited:.0f} s"
+        ) from exc
+
+
+def _run(history, quick, stamp, after_build, kwargs):
+    """The run itself, under the history's lock."""
+    _check_layout(history)
+    _remove_leftovers(history)
+    stamp = _stamp(history, stamp)
+    previous, notes = _previous(history)
     tmp = os.path.join(history, f".tmp-{stamp}")
     os.makedirs(tmp)
     results = write_report(tmp, quick=quick, previous=previous or {}, **kwargs)
     regressions = compare_results(previous, results)
     results["regressions"] = regressions
-    with open(os.path.join(tmp, "results.json"), "w") as fh:
-        json.dump(results, fh, indent=2, sort_keys=True)
-    if _after_build is not None:
-        _after_build(tmp)  # test hook: simulate a kill before the commit point
+    results["history_notes"] = notes
+    atomic_write_json(os.path.join(tmp, "results.json"), results)
+    if after_build is not None:
+        after_build(tmp)  # test hook: simulate a kill before the commit point
     final = os.path.join(history, "runs", stamp)
     os.replace(tmp, final)
     link_tmp = os.path.join(history, f".tmp-latest-{stamp}")
     os.symlink(os.path.join("runs", stamp), link_tmp)
     os.replace(link_tmp, os.path.join(history, "latest"))
     failed = any(c["status"] == "fail" for c in results["checks"])
-    return (1 if (regressions or failed) else 0), regressions, final
+    return NightlyRun(1 if (regressions or failed or notes) else 0, regressions, final, notes)

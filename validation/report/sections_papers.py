@@ -631,7 +631,7 @@ def section_uncertainty(ctx):
             "converged (rule incl. tau stable)": "yes" if samp["converged"] else "NO",
             "acceptance mean": samp["acceptance_mean"],
             "acceptance min": samp["acceptance_min"],
-            "seconds": samp["seconds"],
+            "seconds": post["timing"]["sampling_seconds"],
         }
     ]
     s.blocks.append(table_block(s, "sampling", list(srow[0]), srow, fmt={"N / max tau": ".1f"}))

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 import os
 
@@ -19,7 +20,7 @@ from models.geometry import signed_inplane
 from models.polarization import ellipsometric
 from validation.atomic import atomic_savefig, atomic_write_text
 
-__all__ = ["scan", "write_scene_outputs"]
+__all__ = ["scan", "scene_csv", "write_scene_outputs"]
 
 
 def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
@@ -111,6 +112,72 @@ def choose_settings(scene, tol):
     return model, n_inplane, _choose_precision(model, tol, notes), notes
 
 
+def scene_csv(scene, model, rows) -> str:
+    """The scans as CSV text: ``#`` comment lines (scene, file, model, incident Stokes
+    vector, each user string JSON-quoted so a newline in it cannot start a row), then a
+    header and one row per point, written by the csv module."""
+    buf = io.StringIO()
+    for key, value in (
+        ("scene", scene.name),
+        ("file", str(scene.path)),
+        ("model", repr(model)),
+        ("incident Stokes", str(list(scene.polarization))),
+    ):
+        buf.write(f"# {key}: {json.dumps(value)}\n")
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["scan", "theta_i_deg", "theta_r_deg", "phi_r_deg", "brdf", "eta_deg", "P", "P_C"])
+    ti_deg = math.degrees(scene.theta_i)
+    for label, r in rows.items():
+        for k in range(len(r["brdf"])):
+            w.writerow(
+                [label, f"{ti_deg:.6g}", f"{r['theta_r_deg'][k]:.6g}", f"{r['phi_r_deg'][k]:.6g}"]
+                + [f"{r[c][k]:.10g}" for c in ("brdf", "eta_deg", "P", "P_C")]
+            )
+    return buf.getvalue()
+
+
+#: below this degree of polarization eta is undefined (and the light unpolarized)
+P_FLOOR = 1e-12
+
+
+def _unpolarized(r) -> bool:
+    """No polarization anywhere the scan receives light (e.g. an unpolarized source on a
+    depolarizing model): its eta, P and P_C panels would be flat zeros."""
+    lit = r["brdf"] > 0
+    return bool(lit.any()) and bool(np.all(np.abs(r["P"][lit]) < P_FLOOR))
+
+
+def _plot_scan(axes, label, r, ti_deg):
+    """One column of the figure: BRDF (zero BRDF a gap: no light there, nothing to draw on a
+    log axis), eta, P, P_C (gaps where undefined), or one "unpolarized" note for all three."""
+    ax = axes[0]
+    lit = r["brdf"] > 0
+    ax.semilogy(r["coord"], np.where(lit, r["brdf"], np.nan))
+    if not lit.any():
+        ax.text(0.5, 0.5, "no light reaches this scan (BRDF = 0)", ha="center", transform=ax.transAxes)
+    ax.set_ylabel("BRDF (1/sr)")
+    ax.set_title(f"{label}, theta_i = {ti_deg:g} deg")
+    if _unpolarized(r):
+        for ax, name in zip(axes[1:], ("eta (deg)", "P", "P_C"), strict=True):
+            ax.text(
+                0.5, 0.5, f"unpolarized (P < {P_FLOOR:g}): eta undefined, P = P_C = 0",
+                ha="center", va="center", transform=ax.transAxes,
+            )  # fmt: skip
+            ax.set_ylabel(name)
+            ax.set_yticks([])
+        return
+    # eta is defined modulo 180 deg where the light is polarized: unwrap it there for the plot
+    # (the CSV keeps (-90, 90])
+    ok = lit & np.isfinite(r["eta_deg"]) & (np.abs(np.nan_to_num(r["P"])) >= P_FLOOR)
+    eta = np.full(len(ok), np.nan)
+    eta[ok] = np.degrees(np.unwrap(np.radians(2 * r["eta_deg"][ok])) / 2)
+    axes[1].plot(r["coord"], eta)
+    axes[1].set_ylabel("eta (deg)")
+    for ax, key in ((axes[2], "P"), (axes[3], "P_C")):
+        ax.plot(r["coord"], np.where(lit, r[key], np.nan))
+        ax.set_ylabel(key)
+
+
 def write_scene_outputs(scene, out_dir, tol=None):
     """Write ``<stem>.csv`` and ``<stem>.png``; returns their paths (and notes on the
     settings chosen for ``tol``)."""
@@ -126,34 +193,13 @@ def write_scene_outputs(scene, out_dir, tol=None):
         chosen, n_inplane, precision, notes = choose_settings(scene, tol)
         model, rows = scan(scene, n_inplane=max(n_inplane, 3), model=chosen, precision=precision)
     stem = os.path.splitext(os.path.basename(scene.path))[0]
-    buf = io.StringIO()
-    buf.write(f"# scene: {scene.name}\n# file: {scene.path}\n")
-    buf.write(f"# model: {model!r}\n# incident Stokes: {list(scene.polarization)}\n")
-    w = csv.writer(buf)
-    w.writerow(["scan", "theta_i_deg", "theta_r_deg", "phi_r_deg", "brdf", "eta_deg", "P", "P_C"])
-    ti_deg = math.degrees(scene.theta_i)
-    for label, r in rows.items():
-        for k in range(len(r["brdf"])):
-            w.writerow(
-                [label, f"{ti_deg:.6g}", f"{r['theta_r_deg'][k]:.6g}", f"{r['phi_r_deg'][k]:.6g}"]
-                + [f"{r[c][k]:.10g}" for c in ("brdf", "eta_deg", "P", "P_C")]
-            )
     csv_path = os.path.join(out_dir, f"{stem}.csv")
-    atomic_write_text(csv_path, buf.getvalue())
+    atomic_write_text(csv_path, scene_csv(scene, model, rows))
     fig, axes = plt.subplots(4, 2, figsize=(10, 10), sharex="col")
+    ti_deg = math.degrees(scene.theta_i)
     for col, (label, r) in enumerate(rows.items()):
+        _plot_scan(axes[:, col], label, r, ti_deg)
         xlab = "signed scattering angle (deg)" if label == "in-plane" else "phi_r (deg), theta_r = theta_i"
-        ax = axes[0, col]
-        ax.semilogy(r["coord"], np.maximum(r["brdf"], 1e-12))
-        ax.set_ylabel("BRDF (1/sr)")
-        ax.set_title(f"{label}, theta_i = {ti_deg:g} deg")
-        # eta is defined modulo 180 deg: unwrap it for the plot (the CSV keeps (-90, 90])
-        eta = np.degrees(np.unwrap(np.radians(2 * np.nan_to_num(r["eta_deg"]))) / 2)
-        axes[1, col].plot(r["coord"], eta)
-        axes[1, col].set_ylabel("eta (deg)")
-        for row, key, ylab in ((2, "P", "P"), (3, "P_C", "P_C")):
-            axes[row, col].plot(r["coord"], r[key])
-            axes[row, col].set_ylabel(ylab)
         axes[3, col].set_xlabel(xlab)
     fig.suptitle(scene.name)
     fig.tight_layout()
