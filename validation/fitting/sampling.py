@@ -352,11 +352,23 @@ def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, 
             # segments end on multiples of check_every, so a resumed run checks where the original did
             n = min(settings.check_every - done % settings.check_every, settings.max_steps - done)
             t0 = time.perf_counter()
-            for _ in sampler.sample(state, iterations=n, store=True):
-                bar.update(1)
+            _segment(sampler, state, n, bar, hold_sigint=vectorized(log_prob))
             backend.end_segment(time.perf_counter() - t0)
             state = backend.get_last_sample()  # the ensemble and random state after the segment
     return _result(backend, settings)
+
+
+def _segment(sampler, state, n, bar, hold_sigint):
+    """``n`` steps from ``state``.  ``hold_sigint``: Ctrl-C is held until the step ends and
+    raised there, as the executors do between per-walker calls: a vectorized log-probability
+    runs inside emcee's wrapper, which prints a traceback for an exception raised in it."""
+    from .executors import _sigint_between_calls
+
+    with _sigint_between_calls() if hold_sigint else contextlib.nullcontext(lambda: False) as pending:
+        for _ in sampler.sample(state, iterations=n, store=True):
+            bar.update(1)
+            if pending():
+                break  # the interrupt is raised when the block closes, the step stored
 
 
 def _result(backend, settings) -> ChainResult:
