@@ -11,7 +11,7 @@ import numpy as np  # noqa: E402
 import models  # noqa: E402
 from models.geometry import signed_inplane  # noqa: E402
 
-__all__ = ["plt", "AL", "signed", "inplane", "default_models", "is_heavy"]
+__all__ = ["plt", "AL", "signed", "inplane", "default_models", "is_heavy", "finish"]
 
 #: aluminium, seed 000's substrate
 AL = 1.37 + 7.62j
@@ -47,3 +47,12 @@ def default_models():
 def is_heavy(m):
     """Monte Carlo models and wrappers: hundreds of inner evaluations per geometry."""
     return hasattr(m, "pairs") or isinstance(getattr(m, "model", None), models.Model)
+
+
+def finish(fig, ax, xlabel, ylabel, legend_size):
+    """Label ``ax``, give it a legend and lay ``fig`` out; returns ``fig``."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=legend_size)
+    fig.tight_layout()
+    return fig

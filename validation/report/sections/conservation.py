@@ -10,7 +10,7 @@ from validation.numerics.integrate import integrated_reflectance
 from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 
 from ..core import figure_block, table_block, text_block
-from ._common import default_models, is_heavy, plt
+from ._common import default_models, finish, is_heavy, plt
 
 __all__ = ["ConservationData", "compute", "render"]
 
@@ -90,11 +90,7 @@ def _draw_albedo(d):
     for name, ti_deg, vals in d.albedo:
         ax.plot(ti_deg, vals, "o-", label=name)
     ax.axhline(1.0, color="k", lw=0.6)
-    ax.set_xlabel("theta_i (deg)")
-    ax.set_ylabel("integrated reflectance")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
+    return finish(fig, ax, "theta_i (deg)", "integrated reflectance", 8)
 
 
 def render(s, d: ConservationData):

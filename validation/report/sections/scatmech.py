@@ -9,7 +9,7 @@ import numpy as np
 import models
 
 from ..core import figure_block, table_block, text_block
-from ._common import AL, plt
+from ._common import AL, finish, plt
 
 __all__ = ["ScatmechData", "compute", "render"]
 
@@ -72,11 +72,7 @@ def _draw(d):
     fig, ax = plt.subplots(figsize=(7, 4))
     for label, e in d.errors:
         ax.hist(np.log10(np.maximum(e, 1e-18)), bins=40, histtype="step", label=label)
-    ax.set_xlabel("log10 max |M - M_scatmech| / M00 per case")
-    ax.set_ylabel("cases")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
+    return finish(fig, ax, "log10 max |M - M_scatmech| / M00 per case", "cases", 8)
 
 
 def render(s, d: ScatmechData):

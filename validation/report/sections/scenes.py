@@ -10,7 +10,7 @@ import numpy as np
 import references
 
 from ..core import figure_block, table_block
-from ._common import inplane, plt
+from ._common import finish, inplane, plt
 
 __all__ = ["ScenesData", "compute", "render"]
 
@@ -67,11 +67,7 @@ def _draw(d):
     fig, ax = plt.subplots(figsize=(7.5, 4))
     for name, f in d.curves:
         ax.semilogy(d.x, np.maximum(f, 1e-10), label=name)
-    ax.set_xlabel("scattering angle theta_r (deg)")
-    ax.set_ylabel("BRDF (1/sr)")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    return fig
+    return finish(fig, ax, "scattering angle theta_r (deg)", "BRDF (1/sr)", 7)
 
 
 def render(s, d: ScenesData):

@@ -10,7 +10,7 @@ import numpy as np
 import models
 
 from ..core import figure_block, table_block, text_block
-from ._common import plt, signed
+from ._common import finish, plt, signed
 
 __all__ = ["Fig1Data", "compute", "render"]
 
@@ -102,11 +102,7 @@ def _draw(d):
     ax.set_xlim(-20, 89)
     ax.legend(fontsize=7)
     bx.plot([0, 1], [0, 1 / d.n_index], "k:", lw=0.8, label=f"Snell, n = {d.n_index:g}")
-    bx.set_xlabel("sin(theta_i)")
-    bx.set_ylabel("sin(BTDF-weighted mean theta_t)")
-    bx.legend(fontsize=7)
-    fig.tight_layout()
-    return fig
+    return finish(fig, bx, "sin(theta_i)", "sin(BTDF-weighted mean theta_t)", 7)
 
 
 def render(s, d: Fig1Data):
