@@ -121,7 +121,7 @@ def render(s, d: Fig1Data):
             "The paper prints neither the sigma values nor the weighting's domain; the sigmas are "
             + ", ".join(f"{v:g}" for v in d.sigmas)
             + ". The peak is the 0.01-deg grid maximum refined by a parabola; the effective index n_eff is "
-            "1/slope of sin(mean theta_t) = sin(theta_i)/n_eff (validation/fig1_seed003.py)."
+            "1/slope of sin(mean theta_t) = sin(theta_i)/n_eff (validation/checks/fig1.py)."
         )
     )
     caption = f"peak angles at theta_i = 60 deg (Snell: {d.snell_deg:.3f} deg) and effective indices"

@@ -213,7 +213,7 @@ def _fit_text(d):
 def _recovery_text(d):
     r = d.recovery
     return (
-        f"Injection-recovery (validation/recovery.py): scene references/scenes/{r.scene}, free "
+        f"Injection-recovery (validation/fitting/recovery.py): scene references/scenes/{r.scene}, free "
         f"{', '.join(r.free)}, geometries from the data file (evenly spread subsets), log-normal speckle "
         f"at the listed level; {r.injections} injections per cell, each fitted with {r.walkers} walkers "
         f"and at most {r.max_steps} steps, seed {d.seed}"
