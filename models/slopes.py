@@ -211,23 +211,9 @@ class GaussianSlopes(SlopeDistribution):
 
 
 @dataclass(frozen=True)
-class _Anisotropic(SlopeDistribution):
-    """Shared parameters of the anisotropic families: scales along axes rotated by ``rotation``."""
-
-    sigma_x: float = param(
-        0.1,
-        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
-        low=0.0,
-        low_open=True,
-    )
-    sigma_y: float = param(
-        0.1,
-        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
-        low=0.0,
-        low_open=True,
-    )
-    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
+class _Elliptical(SlopeDistribution):
+    """Anisotropic families whose slope density is an isotropic one stretched along axes
+    rotated by ``rotation``: ``sigma_x`` and ``sigma_y`` are the stretches."""
 
     isotropic = False
 
@@ -250,6 +236,26 @@ class _Anisotropic(SlopeDistribution):
 
     def rotated(self, angle):
         return self.replace(rotation=(self.rotation + angle) % (2 * math.pi))
+
+
+@dataclass(frozen=True)
+class _Anisotropic(_Elliptical):
+    """Shared parameters of the anisotropic exponential and Gaussian families."""
+
+    sigma_x: float = param(
+        0.1,
+        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    sigma_y: float = param(
+        0.1,
+        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
+        low=0.0,
+        low_open=True,
+    )
+    rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
+    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
 
 @dataclass(frozen=True)
@@ -497,7 +503,7 @@ class GGXSlopes(SlopeDistribution):
 
 
 @dataclass(frozen=True)
-class AnisotropicGGXSlopes(_Anisotropic):
+class AnisotropicGGXSlopes(_Elliptical):
     """Anisotropic GGX slopes ``C / (pi ax ay (1 + (u/ax)^2 + (v/ay)^2)^2)``.
 
     ``(u, v)`` are the slopes in axes rotated by ``rotation`` from x;

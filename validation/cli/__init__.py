@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import argparse
 
-from . import fit, models, report, scene, stability, study, table1, tradeoff, validate
+from . import check, fit, models, report, scene, stability, study, table1, tradeoff, validate
 
 __all__ = ["main", "COMMANDS"]
 
 #: every command module, in the order ``scatterbench --help`` lists them
-COMMANDS = (validate, table1, stability, tradeoff, scene, models, fit, study, report)
+COMMANDS = (validate, table1, stability, tradeoff, scene, models, fit, study, report, check)
 
 
 def main(argv=None) -> int:

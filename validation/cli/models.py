@@ -7,8 +7,10 @@ __all__ = ["register"]
 
 def _cmd_models(args) -> int:
     import models
+    from validation.testing import format_contributed
 
     print(models.list_models())
+    print(format_contributed())
     return 0
 
 

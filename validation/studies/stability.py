@@ -1,7 +1,8 @@
 """Stability sweep: every model at the edges of its parameter space and geometry.
 
-For each public model class (``models.Model.registry``) the sweep builds
-instances at the edges of each declared parameter, one parameter at a time
+For each public model class (``models.Model.registry``), and each model another package
+contributes (``scatterbench.models`` entry points, :func:`validation.testing.contributed_models`),
+the sweep builds instances at the edges of each declared parameter, one parameter at a time
 from the defaults (nested declared objects, such as slope distributions, are
 swept the same way), and evaluates them on edge geometries: polar angles 0,
 1e-9, 89.99 deg and exactly 90 deg, exact specular and retroreflection, the
@@ -47,6 +48,7 @@ __all__ = [
     "edge_instances",
     "edge_geometries",
     "sweep",
+    "sweep_model",
     "load_accepted",
     "classify",
     "FindingGroup",
@@ -172,11 +174,15 @@ def _choice_combinations(base):
 
 def edge_instances(cls):
     """Model instances at the edges of each declared parameter (one at a time from the
-    defaults), plus every combination of the choice parameters at the defaults."""
-    try:
-        base = _BASES[cls.__name__]() if cls.__name__ in _BASES else cls()
-    except ValueError:
-        return []  # compositions without a default (Sum): their terms are swept
+    defaults, or from ``cls`` when it is a model instance), plus every combination of the
+    choice parameters at the defaults."""
+    if isinstance(cls, models.Model):
+        base = cls
+    else:
+        try:
+            base = _BASES[cls.__name__]() if cls.__name__ in _BASES else cls()
+        except ValueError:
+            return []  # compositions without a default (Sum): their terms are swept
     out = _one_at_a_time(base)
     for inst in _choice_combinations(base):
         if inst not in out:
@@ -316,19 +322,37 @@ def _check_energy(model, found, name, params):
             )
 
 
-def sweep(classes=None, energy=True):
-    """Run the sweep; returns every finding (accepted or not)."""
+def sweep_model(inst, energy=True, name=None):
+    """The findings of one model instance at its edge geometries (``name``: the model's
+    name in them, default its class name)."""
     found = []
-    classes = classes if classes is not None else [c for c in models.Model.registry if c is not models.Sum]
-    for cls in classes:
-        for inst in edge_instances(cls):
-            name, params = cls.__name__, repr(inst)
-            ti, tr, pr = edge_geometries(inst)
-            _evaluate(inst, ti, tr, pr, found, name, params)
-            _check_reciprocity(inst, ti, tr, pr, found, name, params)
-            if energy:
-                _check_energy(inst, found, name, params)
+    name, params = name or type(inst).__name__, repr(inst)
+    ti, tr, pr = edge_geometries(inst)
+    _evaluate(inst, ti, tr, pr, found, name, params)
+    _check_reciprocity(inst, ti, tr, pr, found, name, params)
+    if energy:
+        _check_energy(inst, found, name, params)
     return found
+
+
+def sweep(classes=None, energy=True):
+    """Run the sweep; returns every finding (accepted or not).  By default: every model
+    class, then the models other packages contribute (``scatterbench.models`` entry
+    points, under their entry-point names)."""
+    found = []
+    targets = [(None, c) for c in classes] if classes is not None else _default_targets()
+    for name, cls in targets:
+        for inst in edge_instances(cls):
+            found += sweep_model(inst, energy, name)
+    return found
+
+
+def _default_targets():
+    from validation.checks.conformance import as_model
+    from validation.testing import contributed_models
+
+    own = [(None, c) for c in models.Model.registry if c is not models.Sum]
+    return own + [(c.name, as_model(c.model)) for c in contributed_models() if c.model is not None]
 
 
 def load_accepted(path=ACCEPTED_PATH):

@@ -1,0 +1,60 @@
+"""``scatterbench check MODULE:NAME``: the conformance kit on any model (validation.testing)."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+__all__ = ["register", "run"]
+
+
+def run(spec, json_path=None, quick=False, checks=None) -> int:
+    """Check the model ``spec`` names, print the table, write ``json_path`` (strict JSON,
+    atomically) if given; 0 when no check fails, 1 when one does, 2 on a bad argument."""
+    from validation.atomic import atomic_write_text
+    from validation.checks.registry import strict_json
+    from validation.testing import check_model, load_model
+
+    # like pytest, a module beside the user is importable: `scatterbench check mybrdf:Model`
+    if os.getcwd() not in sys.path:
+        sys.path.insert(0, os.getcwd())
+    try:
+        model = load_model(spec)
+        names = [c.strip() for c in checks.split(",") if c.strip()] if checks else None
+        t0 = time.perf_counter()
+        report = check_model(model, checks=names, quick=quick, label=spec)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(report.format())
+    print(f"check finished in {time.perf_counter() - t0:.1f} s")
+    if json_path:
+        atomic_write_text(json_path, strict_json({"quick": quick, **report.as_dict()}))
+    return 0 if report.passed else 1
+
+
+def _cmd_check(args) -> int:
+    return run(args.model, json_path=args.json, quick=args.quick, checks=args.checks)
+
+
+def register(sub):
+    p = sub.add_parser(
+        "check",
+        help="run the conformance kit on a model (MODULE:NAME); exit 1 if a check fails",
+        description="Every conformance check (validation.testing.check_model) on the model MODULE:NAME "
+        "names: an instance, or a class or callable returning one.  Exit 0 when every check passes "
+        "(or is skipped, or is a finding accepted with its reason), 1 when one fails, 2 on a bad "
+        "argument.",
+    )
+    p.add_argument(
+        "model", metavar="MODULE:NAME", help="e.g. mypkg.brdf:MyModel (the current directory is importable)"
+    )
+    p.add_argument("--json", metavar="FILE", help="also write every result as strict JSON to FILE")
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="skip the slow checks; energy at normal and grazing incidence only",
+    )
+    p.add_argument("--checks", metavar="NAMES", help="comma-separated check names to run (default: all)")
+    p.set_defaults(func=_cmd_check)
