@@ -13,7 +13,9 @@ import matplotlib
 matplotlib.use("Agg")
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
-sys.path.insert(0, ROOT)  # the checkout being documented wins over an installed copy
+if os.path.isdir(os.path.join(ROOT, "models")):
+    sys.path.insert(0, ROOT)  # the checkout being documented wins over an installed copy
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "_ext"))
 
 project = "scatterbench"
 author = "scatterbench contributors"
@@ -28,7 +30,9 @@ extensions = [
     "myst_parser",
     "sphinx_gallery.gen_gallery",
     "matplotlib.sphinxext.plot_directive",
+    "sbdocs",
 ]
+templates_path = ["_templates"]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 exclude_patterns = ["_build", "gallery", "auto_examples/*.ipynb", "auto_examples/*.py"]
@@ -36,6 +40,8 @@ myst_enable_extensions = ["colon_fence", "dollarmath", "deflist"]
 myst_heading_anchors = 3
 
 autosummary_generate = True
+# importing validation/cli/__main__.py runs the CLI: autosummary must not import it
+autosummary_mock_imports = ["validation.cli.__main__"]
 autodoc_default_options = {"members": True, "inherited-members": False}
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types
 numpydoc_show_class_members = False  # autosummary tables list the members
