@@ -73,5 +73,7 @@ html_theme_options = {
     "show_prev_next": True,
     "secondary_sidebar_items": ["page-toc"],
 }
+# an explicit mode: without it the theme logs "invalid theme mode" to the console on a first visit
+html_context = {"default_mode": "light"}
 html_show_sourcelink = False
 html_copy_source = False
