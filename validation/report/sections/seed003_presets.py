@@ -16,7 +16,7 @@ from models.polarization import ellipsometric, stokes
 from ..core import figure_block, table_block, text_block
 from ._common import plt, signed
 
-__all__ = ["PresetsData", "PresetCurves", "compute", "render"]
+__all__ = ["PresetsData", "PresetCurves", "fit_maxwell_beard", "compute", "render"]
 
 INCIDENT = "linear:45"  # Sec. 3: "using 45 deg incident polarization"
 #: the tabulated in-plane angles (signed, deg)
@@ -61,7 +61,7 @@ def _pol_from_mueller(M, incident):
     return i / s_in[0], eta, p
 
 
-def _fit_maxwell_beard(x_deg, target, theta_i, slopes_cls, n):
+def fit_maxwell_beard(x_deg, target, theta_i, slopes_cls, n):
     """Least squares in log10 BRDF of MaxwellBeardBRDF(sigma, rho_d, rho_v) to the in-plane target;
     tau and Omega at their defaults, substrate index the preset's."""
     tr, pr = signed(x_deg)
@@ -139,7 +139,7 @@ def _preset(name, pre, sc, model, x):
     f, eta, P = _pol_from_mueller(M, INCIDENT)
     rough = sc.coating.get("roughness")
     slopes_cls = type(rough) if rough is not None else models.GaussianSlopes
-    mb, par = _fit_maxwell_beard(x, M[..., 0, 0], ti, slopes_cls, sc.coating["index"])
+    mb, par = fit_maxwell_beard(x, M[..., 0, 0], ti, slopes_cls, sc.coating["index"])
     fm, etam, Pm = _pol_from_mueller(mb.mueller(ti, tr, pr), INCIDENT)
     label = f"preset ({pre['model'].split(' (')[0]})"
     title = f"{pre['sample']} ({sc.wavelength_nm:g} nm)"
