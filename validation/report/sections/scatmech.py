@@ -16,7 +16,7 @@ __all__ = ["ScatmechData", "compute", "render"]
 
 @dataclass(frozen=True)
 class ScatmechData:
-    """``errors``: per reference set, (label, max |M - M_scatmech| / M00 per case);
+    """``errors``: per reference set, (label, ``max |M - M_scatmech| / M00`` per case);
     ``live``: whether pySCATMECH was importable (its row is then the last of ``rows``)."""
 
     errors: tuple
