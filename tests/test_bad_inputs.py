@@ -623,6 +623,26 @@ cli_case(
 )
 cli_case("validate json is a folder", ["validate", "--quick", "--json", "sub"], "sub", files={"sub": None})
 cli_case("report out is a file", ["report", "--quick", "--out", "o"], "o", files={"o": "a file"})
+cli_case("check model without a colon", ["check", "models"], "MODULE:NAME")
+cli_case("check model module missing", ["check", "nosuch_module_x:Model"], "nosuch_module_x")
+cli_case("check model name missing", ["check", "models:NoSuchModel"], "NoSuchModel")
+cli_case("check unknown check name", ["check", "models:FacetBRDF", "--checks", "nosuch"], "nosuch")
+cli_case(
+    "check json is a folder", ["check", "models:FacetBRDF", "--json", "sub"], "--json", files={"sub": None}
+)
+cli_case(
+    "check json in a file's folder",
+    ["check", "models:FacetBRDF", "--json", "f/x.json"],
+    "f",
+    files={"f": "a file"},
+)
+cli_case("stability workers zero", ["stability", "--workers", "0"], "--workers")
+cli_case(
+    "stability workers and scheduler",
+    ["stability", "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"],
+    "--workers",
+    "--scheduler",
+)
 cli_case("unknown command", ["frobnicate"], "frobnicate")
 cli_case("no command", [], "command")
 cli_case("fit without --scene", ["fit", "d.csv", "--out", "o"], "--scene")

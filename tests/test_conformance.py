@@ -188,7 +188,11 @@ class _Declares:
         return self.inner.mueller(theta_i, theta_r, phi_r)
 
 
-def test_scatmech_committed_references():
+def test_scatmech_committed_references(monkeypatch):
+    # the committed path, even where pySCATMECH is installed (None in sys.modules makes
+    # its import fail, as on a machine without it)
+    monkeypatch.setitem(sys.modules, "pySCATMECH", None)
+    monkeypatch.setitem(sys.modules, "pySCATMECH.brdf", None)
     assert matching_cases("Facet_BRDF_Model", {"substrate": "(1.37, 7.62)", "sdf.s": 0.05}) is None
     ok = check_model(_Declares(0.05, 0.05), checks=["scatmech"]).results[0]
     assert ok.status == "pass" and "10 geometries (committed" in ok.detail
@@ -196,6 +200,16 @@ def test_scatmech_committed_references():
     assert off.status == "fail" and off.where
     none = check_model(_Declares(0.07, 0.07), checks=["scatmech"]).results[0]
     assert none.status == "skip" and "no committed reference values" in none.detail
+
+
+def test_scatmech_live_pyscatmech():
+    """Where the real pySCATMECH is installed, the kit's live comparison passes for a model
+    that is SCATMECH's Facet_BRDF_Model and fails for one 2% off in roughness."""
+    pytest.importorskip("pySCATMECH.brdf")
+    ok = check_model(_Declares(0.05, 0.05), checks=["scatmech"]).results[0]
+    assert ok.status == "pass" and "live pySCATMECH" in ok.detail
+    off = check_model(_Declares(0.051, 0.05), checks=["scatmech"]).results[0]
+    assert off.status == "fail" and off.where
 
 
 def test_scatmech_live_path(monkeypatch):

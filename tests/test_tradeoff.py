@@ -1,13 +1,29 @@
 """Speed/accuracy knobs: errors measured against independent references; --tol picks honestly."""
 
 import json
+import math
 import os
+from dataclasses import dataclass
 
+import numpy as np
 import pytest
 
+import models
+from models.base import Model
+from models.params import param
 from validation.atomic import atomic_write_json
 from validation.cli import main
-from validation.studies.tradeoff import Point, choose, pareto, study
+from validation.studies.tradeoff import (
+    MIN_BATCHES,
+    Point,
+    at_precision,
+    choose,
+    knob_precision,
+    pareto,
+    precision_option,
+    study,
+    time_call,
+)
 
 
 @pytest.fixture(scope="module")
@@ -41,9 +57,14 @@ def test_cli_writes_json_and_png(tmp_path, capsys):
     out = tmp_path / "t"
     assert main(["tradeoff", "--quick", "--out", str(out), "--tol", "1e-4"]) == 0
     data = json.loads((out / "tradeoff.json").read_text())
-    assert {d["knob"] for d in data} >= {"integration tolerance", "in-plane grid"}
+    assert {d["knob"] for d in data} >= {"integration tolerance", "in-plane grid", "precision"}
+    for d in data:  # measured, or skipped with its reason
+        assert d.get("skipped") or all(
+            {"seconds", "spread", "calls", "wall_seconds"} <= set(p) for p in d["points"]
+        )
     assert (out / "tradeoff.png").stat().st_size > 1000
-    assert "chose" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "chose" in printed and "cost: CPU seconds per call" in printed
 
 
 def test_atomic_write_keeps_previous_on_failure(tmp_path):
@@ -82,3 +103,91 @@ def test_scene_tol_picks_settings_that_meet_it(tmp_path, capsys):
     assert "point-source resolution: chose" in out
     # the grid knob cannot reach 1e-6 with the measured settings: said, not hidden
     assert "in-plane grid: no measured setting reaches" in out
+
+
+def test_costs_are_resolved_best_of_batches(results):
+    """Every setting is timed over >= MIN_WORK s of CPU time in >= MIN_BATCHES batches, so
+    the sub-millisecond grid settings are resolved: the curve's cost rises with the
+    number of points instead of running backwards."""
+    for r in results.values():
+        for p in r.points:
+            assert p.calls >= MIN_BATCHES and p.spread >= 0 and p.wall_seconds > 0
+    grid = results["in-plane grid"].points
+    assert grid[0].calls > 100  # a ~0.1 ms call: batched, not timed once
+    assert grid[-1].seconds > grid[0].seconds  # 361 points cost more than 19
+
+
+def test_time_call_measures_the_work_of_one_call():
+    x = np.linspace(0, 1, 20_000)
+    out, small = time_call(lambda: np.sin(x).sum())
+    _, large = time_call(lambda: np.sin(np.concatenate([x] * 8)).sum())
+    assert out == pytest.approx(np.sin(x).sum())
+    assert 3 < large.seconds / small.seconds < 20  # 8 x the work, per call
+    assert small.calls > large.calls >= MIN_BATCHES
+
+
+@dataclass(frozen=True)
+class RoundedFacet(models.FacetBRDF):
+    """A stand-in for a model with float32 kernels: ``precision="float32"`` rounds the
+    angles and the result to float32 (the numpy path itself computes in float64)."""
+
+    def mueller(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
+        if precision == "float64":
+            return super().mueller(theta_i, theta_r, phi_r, out)
+        f32 = [np.asarray(a, dtype=np.float32) for a in (theta_i, theta_r, phi_r)]
+        return super().mueller(*f32).astype(np.float32)
+
+
+@dataclass(frozen=True)
+class Plain(Model):
+    """A model without a precision option."""
+
+    depolarizing = True
+
+    def _mueller16(self, ti, tr, pr):
+        out = np.zeros((16, ti.size))
+        out[0] = 1 / math.pi
+        return out
+
+
+@dataclass(frozen=True)
+class Flat(Model):
+    """A model whose precision is a declared parameter (the other form the option may take)."""
+
+    depolarizing = True
+    precision: str = param("float64", "evaluation precision", kind="choice", choices=("float64", "float32"))
+
+    def _mueller16(self, ti, tr, pr):
+        out = np.zeros((16, ti.size))
+        out[0] = 1 / math.pi if self.precision == "float64" else np.float32(1 / math.pi)
+        return out
+
+
+def test_precision_option_forms():
+    assert precision_option(RoundedFacet()) == "keyword" and precision_option(Flat()) == "parameter"
+    assert precision_option(Plain()) is None
+    assert at_precision(Flat(), "float32")(0.1, 0.2, 0.3)[0, 0] == np.float32(1 / math.pi)
+    with pytest.raises(ValueError, match="precision must be 'float64' or 'float32'; got 'half'"):
+        at_precision(Flat(), "half")
+    with pytest.raises(ValueError, match="precision: Plain has no precision option"):
+        at_precision(Plain(), "float32")
+
+
+def test_precision_knob_measures_float32_against_float64():
+    r = knob_precision(model=RoundedFacet(slopes=models.ExponentialSlopes(0.1)))
+    by = {p.setting: p for p in r.points}
+    assert set(by) == {64, 32} and by[64].error == 0.0  # the reference itself
+    assert 1e-9 < by[32].error < 1e-4  # float32 rounding, resolved and small
+    assert choose(r, 1e-12) is by[64]  # float32 does not meet 1e-12
+    pick = choose(r, 1e-3)  # both meet it: the cheaper measured one
+    assert pick is min(r.points, key=lambda p: p.seconds)
+
+
+def test_precision_knob_is_skipped_with_its_reason_where_no_model_has_the_option():
+    skipped = {}
+    out = study(names=["precision"], quick=True, skipped=skipped)
+    default = models.SubsurfaceFacetBRDF()
+    if precision_option(default) is None:
+        assert out == [] and "SubsurfaceFacetBRDF has no precision option" in skipped["precision"]
+    else:  # the kernels' option exists: the knob is measured
+        assert [r.knob for r in out] == ["precision"] and not skipped

@@ -35,6 +35,10 @@ def run(spec, json_path=None, quick=False, checks=None) -> int:
 
 
 def _cmd_check(args) -> int:
+    if args.json:  # refused before the kit runs, not after
+        from .args import writable_file
+
+        writable_file(args.json, "--json")
     return run(args.model, json_path=args.json, quick=args.quick, checks=args.checks)
 
 

@@ -4,14 +4,19 @@ from __future__ import annotations
 
 import time
 
+from .fit import _check_executor, _executor_args
+from .study import _open_executor
+
 __all__ = ["register"]
 
 
 def _cmd_stability(args) -> int:
     from validation.studies.stability import classify, format_sweep, sweep
 
+    _check_executor(args)
     t0 = time.perf_counter()
-    findings = sweep(energy=not args.no_energy)
+    with _open_executor(args) as ex:
+        findings = sweep(energy=not args.no_energy, executor=ex)
     print(format_sweep(findings))
     print(f"stability sweep finished in {time.perf_counter() - t0:.1f} s")
     _, bad = classify(findings)
@@ -21,4 +26,5 @@ def _cmd_stability(args) -> int:
 def register(sub):
     p = sub.add_parser("stability", help="sweep every model at its extremes; exit 1 on unaccepted findings")
     p.add_argument("--no-energy", action="store_true", help="skip the integrated-reflectance checks")
+    _executor_args(p)
     p.set_defaults(func=_cmd_stability)

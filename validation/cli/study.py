@@ -32,6 +32,24 @@ from .fit import (
 __all__ = ["register"]
 
 
+def _open_executor(args):
+    """The executor ``--workers``/``--scheduler`` ask for, its description printed.
+
+    Raises
+    ------
+    UsageError
+        A scheduler that does not answer (exit 2).
+    """
+    from validation.fitting.executors import make_executor
+
+    try:
+        ex = make_executor(args.workers, args.scheduler)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from exc
+    print(f"executor: {ex.describe()}")
+    return ex
+
+
 # ----------------------------------------------------------------------------- recovery
 def _print_recovery(cells, injections):
     print(
@@ -56,7 +74,6 @@ def _print_recovery(cells, injections):
 
 def _cmd_recovery(args) -> int:
     from validation.atomic import atomic_write_json
-    from validation.fitting.executors import make_executor
     from validation.fitting.recovery import check_inputs, recovery_study
 
     _check_out(args.out, args.force)
@@ -68,8 +85,7 @@ def _cmd_recovery(args) -> int:
     except ValueError as exc:
         raise UsageError(str(exc)) from exc
     t0 = time.perf_counter()
-    with make_executor(args.workers, args.scheduler) as ex:
-        print(f"executor: {ex.describe()}")
+    with _open_executor(args) as ex:
         cells = recovery_study(
             sc,
             spec,
@@ -232,7 +248,6 @@ def _compare_likelihoods(args):
 def _cmd_compare(args) -> int:
     from validation.atomic import atomic_write_json
     from validation.fitting.compare import check_comparable, compare_fits, format_comparison
-    from validation.fitting.executors import make_executor
 
     _check_out(args.out, args.force)
     _check_executor(args)
@@ -248,7 +263,7 @@ def _cmd_compare(args) -> int:
         print(
             f"{nm}: {len(lik.spec.free)} free ({', '.join(lik.spec.names)}); likelihood terms: {', '.join(lik.terms)}"
         )
-    with make_executor(args.workers, args.scheduler) as ex:
+    with _open_executor(args) as ex:
         rows, _ = compare_fits(liks, names, settings, executor=ex)
     os.makedirs(args.out, exist_ok=True)
     atomic_write_json(

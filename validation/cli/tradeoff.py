@@ -7,21 +7,15 @@ from .args import positive_float, writable_folder
 __all__ = ["register"]
 
 
-def _cmd_tradeoff(args) -> int:
-    import os
-
+def _plot(results, path):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from validation.atomic import atomic_savefig, atomic_write_json
-    from validation.studies.tradeoff import choose, pareto, study
+    from validation.atomic import atomic_savefig
+    from validation.studies.tradeoff import pareto
 
-    writable_folder(args.out, "--out")
-    results = study(quick=args.quick)
-    os.makedirs(args.out, exist_ok=True)
-    atomic_write_json(os.path.join(args.out, "tradeoff.json"), [r.as_dict() for r in results])
     fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 4.2), squeeze=False)
     for ax, r in zip(axes[0], results, strict=True):
         secs = [p.seconds for p in r.points]
@@ -33,27 +27,62 @@ def _cmd_tradeoff(args) -> int:
         )
         for p in r.points:
             ax.annotate(f"{p.setting:g}", (p.seconds, max(p.error, 1e-18)), fontsize=7)
-        ax.set_xlabel("cost (s)")
+        ax.set_xlabel("cost: CPU s per call (best of repeated batches)")
         ax.set_ylabel("error vs reference")
         ax.set_title(r.knob)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    atomic_savefig(fig, os.path.join(args.out, "tradeoff.png"), dpi=110)
+    atomic_savefig(fig, path, dpi=110)
     plt.close(fig)
+
+
+def _print_knob(r, tol):
+    from validation.studies.tradeoff import choose, pareto
+
+    print(f"{r.knob}: {r.quantity}")
+    print(f"  reference: {r.reference}")
+    print(
+        f"  {'setting':>10} {'error':>11} {'CPU s':>11} {'spread':>7} {'calls':>6} {'wall s':>11} {'evals':>9}  pareto"
+    )
+    front = pareto(r.points)
+    for p in r.points:
+        mark = "*" if p in front else ""
+        print(
+            f"  {p.setting:>10g} {p.error:>11.3g} {p.seconds:>11.4g} {p.spread:>7.0%} {p.calls:>6} "
+            f"{p.wall_seconds:>11.4g} {p.evaluations:>9}  {mark}"
+        )
+    if tol is not None:
+        pick = choose(r, tol)
+        if pick is None:
+            print(f"  --tol {tol:g}: no measured setting reaches it")
+        else:
+            print(f"  --tol {tol:g}: chose {pick.setting:g} (measured error {pick.error:.3g})")
+
+
+def _cmd_tradeoff(args) -> int:
+    import os
+
+    from validation.atomic import atomic_write_json
+    from validation.studies.tradeoff import BATCH, MIN_BATCHES, MIN_WORK, study
+
+    writable_folder(args.out, "--out")  # refused before the study, not after
+    skipped = {}
+    results = study(quick=args.quick, skipped=skipped)
+    os.makedirs(args.out, exist_ok=True)
+    atomic_write_json(
+        os.path.join(args.out, "tradeoff.json"),
+        [r.as_dict() for r in results] + [{"knob": k, "skipped": why} for k, why in skipped.items()],
+    )
+    _plot(results, os.path.join(args.out, "tradeoff.png"))
+    print(
+        f"cost: CPU seconds per call (this process, every thread) in the best of >= {MIN_BATCHES} "
+        f"batches of ~{BATCH * 1e3:g} ms, >= {MIN_WORK:g} s of work per setting; spread: (median - best) / best "
+        "batch; wall s: the best batch on the wall clock (inflated by other work on the machine)"
+    )
     for r in results:
-        print(f"{r.knob}: {r.quantity}")
-        print(f"  reference: {r.reference}")
-        print(f"  {'setting':>10} {'error':>11} {'seconds':>10} {'evals':>9}  pareto")
-        front = pareto(r.points)
-        for p in r.points:
-            mark = "*" if p in front else ""
-            print(f"  {p.setting:>10g} {p.error:>11.3g} {p.seconds:>10.4f} {p.evaluations:>9}  {mark}")
-        if args.tol is not None:
-            pick = choose(r, args.tol)
-            if pick is None:
-                print(f"  --tol {args.tol:g}: no measured setting reaches it")
-            else:
-                print(f"  --tol {args.tol:g}: chose {pick.setting:g} (measured error {pick.error:.3g})")
+        _print_knob(r, args.tol)
+    for k, why in skipped.items():
+        print(f"{k}: skipped: {why}")
     print(f"wrote {os.path.join(args.out, 'tradeoff.json')} and tradeoff.png")
     return 0
 

@@ -62,6 +62,40 @@ def _comparison_row(name, fit, seed):
     }
 
 
+def _fit_and_row(job):
+    """One scene's fit and its comparison row; ``job`` is ``(likelihood, name, settings)``.
+
+    Runs where the executor puts it, whole (a fit's chain is seeded by ``settings``
+    alone, so it is the same chain wherever it runs)."""
+    lik, name, settings = job
+    fit = run_fit(lik, settings)
+    return _comparison_row(name, fit, settings.seed), fit
+
+
+def _ranked(rows):
+    """``rows`` with ``dAIC``, ``dBIC``, ``dWAIC``: each criterion minus the best (lowest)."""
+    for key in ("AIC", "BIC", "WAIC"):
+        best = min(r[key] for r in rows)
+        for r in rows:
+            r[f"d{key}"] = r[key] - best
+    return rows
+
+
+def _compare_groups(groups, settings, executor):
+    """:func:`compare_fits` of several ``(liks, names)`` groups with one map over all
+    their fits (so every worker has a fit to run), results regrouped in order."""
+    from .executors import SerialExecutor
+
+    jobs = [(lik, nm, settings) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
+    done = (executor or SerialExecutor()).map(_fit_and_row, jobs, tasks=len(jobs))
+    out, start = [], 0
+    for liks, _ in groups:
+        part = done[start : start + len(liks)]
+        start += len(liks)
+        out.append((_ranked([row for row, _ in part]), [fit for _, fit in part]))
+    return out
+
+
 def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor=None):
     """Fit every likelihood (same data, same used rows) and rank them.
 
@@ -74,7 +108,8 @@ def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor
         Every fit's chain (default ``ChainSettings()``); its seed also seeds the
         predictive draws and the WAIC.
     executor : optional
-        Maps each chain's log posterior over walkers.
+        Runs the fits, one task per fit (:mod:`validation.fitting.executors`;
+        default in-process); the rows are the same on any executor.
 
     Returns
     -------
@@ -84,12 +119,7 @@ def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor
     """
     settings = ChainSettings() if settings is None else settings
     check_comparable(liks, names)
-    fits = [run_fit(lik, settings, executor=executor) for lik in liks]
-    rows = [_comparison_row(nm, f, settings.seed) for nm, f in zip(names, fits, strict=True)]
-    for key in ("AIC", "BIC", "WAIC"):
-        best = min(r[key] for r in rows)
-        for r in rows:
-            r[f"d{key}"] = r[key] - best
+    ((rows, fits),) = _compare_groups([(liks, names)], settings, executor)
     return rows, fits
 
 
@@ -122,16 +152,26 @@ def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf")
 
     Returns a list of ``{"data", "generator", "terms", "rows", "fits"}``, one per data
     set and term choice, ``rows`` being :func:`compare_fits`' table (scene names are
-    the hypotheses) and ``fits`` its fit results.  Without an executor the result is
-    kept for the process, keyed by every argument (the fits are deterministic for a
-    seed), so the report and the tests that show the same pairing fit it once; treat
-    it as read-only.
+    the hypotheses) and ``fits`` its fit results.  All the fits (data sets x term
+    choices x scenes) go to ``executor`` in one map, one task each.  The result does
+    not depend on the executor, so it is kept for the process keyed by every other
+    argument (the fits are deterministic for a seed): the report and the tests that
+    show the same pairing fit it once; treat it as read-only.
     """
-    key = None
-    if executor is None:
-        key = (rows, tuple(terms), settings)
-        if key in _PAIRING_CACHE:
-            return _PAIRING_CACHE[key]
+    key = (rows, tuple(terms), settings)
+    if key in _PAIRING_CACHE:
+        return _PAIRING_CACHE[key]
+    cases, groups = _pairing_cases(rows, terms)
+    out = []
+    for case, (table, fits) in zip(cases, _compare_groups(groups, settings, executor), strict=True):
+        out.append({**case, "rows": table, "fits": fits})
+    _PAIRING_CACHE[key] = out
+    return out
+
+
+def _pairing_cases(rows, terms):
+    """The pairing's cases (``{"data", "generator", "terms"}``) and, for each, the
+    ``(likelihoods, hypothesis names)`` to compare."""
     import os
 
     import references
@@ -144,7 +184,7 @@ def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf")
 
     scene_dir = os.path.join(os.path.dirname(references.__file__), "scenes")
     scenes = {h: scene_mod.load(os.path.join(scene_dir, f)) for h, f in SEED003_PAIRING["scenes"].items()}
-    out = []
+    cases, groups = [], []
     for generator, fname in SEED003_PAIRING["data"].items():
         data = load_data(references.data_path(fname))
         if rows is not None:
@@ -152,11 +192,10 @@ def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf")
         for t in terms:
             noise = None if t == "all" else list(_POLARIZATION_OFF)
             liks = [Likelihood(sc, fitspec_from(sc, None, noise), data) for sc in scenes.values()]
-            table, fits = compare_fits(liks, list(scenes), settings, executor=executor)
-            out.append({"data": fname, "generator": generator, "terms": t, "rows": table, "fits": fits})
-    if key is not None:
-        _PAIRING_CACHE[key] = out
-    return out
+            check_comparable(liks, list(scenes))
+            cases.append({"data": fname, "generator": generator, "terms": t})
+            groups.append((liks, list(scenes)))
+    return cases, groups
 
 
 _PAIRING_CACHE: dict = {}

@@ -1,10 +1,16 @@
 """Executors: where likelihood evaluations and study members run.
 
-Every executor has ``map(fn, items) -> list`` (results in the order of
-``items``, as emcee's ``pool`` expects) and ``close()``.  Work is cut into one
-contiguous chunk per worker, so each call ships the function once per worker.
-Randomness never happens inside a mapped call (the sampler's random draws stay
-in the calling process), so results are identical whatever the executor.
+Every executor has ``map(fn, items, tasks=None) -> list`` (results in the
+order of ``items``, as emcee's ``pool`` expects) and ``close()``.  By default
+the work is cut into one contiguous chunk per worker, so each call ships the
+function once per worker: right for many cheap calls (a log posterior over
+walkers).  Long, uneven calls (a study's members, the fits of a model
+comparison, the stability sweep's models) pass ``tasks=len(items)``: one task
+per item, so a slow item does not hold a whole chunk back behind one worker.
+Randomness never happens inside a mapped call unless it is seeded from the
+item itself (the sampler's random draws stay in the calling process; a study
+member carries its own seed), so results are identical whatever the executor
+and however the items are grouped.
 
 * :class:`SerialExecutor`: in-process (``--workers 1``).
 * :class:`ProcessExecutor`: local processes (``--workers N``), ``concurrent.futures``.
@@ -24,6 +30,7 @@ __all__ = ["SerialExecutor", "ProcessExecutor", "DaskExecutor", "make_executor"]
 
 
 def _chunks(items, n):
+    """``items`` cut into at most ``n`` contiguous chunks of near-equal length, in order."""
     items = list(items)
     k, r = divmod(len(items), n)
     out, start = [], 0
@@ -87,7 +94,9 @@ class SerialExecutor:
     workers = 1
     kind = "serial"
 
-    def map(self, fn, items):
+    def map(self, fn, items, tasks=None):
+        """``[fn(x) for x in items]``; ``tasks`` (how many pieces the work is cut
+        into elsewhere) changes nothing in-process."""
         out = []
         with _sigint_between_calls() as pending:
             for x in items:
@@ -122,7 +131,8 @@ class ProcessExecutor(SerialExecutor):
             workers, mp_context=multiprocessing.get_context("spawn"), initializer=_ignore_sigint
         )
 
-    def map(self, fn, items):
+    def map(self, fn, items, tasks=None):
+        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker)."""
         # The function (e.g. a likelihood holding the data) is pickled once per
         # distinct function object, not once per call; workers unpickle it once.
         if self._fn is not fn:
@@ -130,7 +140,7 @@ class ProcessExecutor(SerialExecutor):
             self._fn, self._blob, self._key = fn, blob, hashlib.sha1(blob).hexdigest()
         futs = [
             self._pool.submit(_run_pickled_chunk, self._key, self._blob, c)
-            for c in _chunks(items, self.workers)
+            for c in _chunks(items, tasks or self.workers)
         ]
         return [y for f in futs for y in f.result()]
 
@@ -144,17 +154,25 @@ class ProcessExecutor(SerialExecutor):
 class DaskExecutor(SerialExecutor):
     kind = "dask"
 
-    def __init__(self, address_or_client):
+    def __init__(self, address_or_client, timeout=30):
         from dask.distributed import Client
 
         if isinstance(address_or_client, Client):
             self.client, self._own = address_or_client, False
         else:
-            self.client, self._own = Client(address_or_client), True
+            try:
+                self.client = Client(address_or_client, timeout=timeout)
+            except OSError as exc:  # refused, unreachable, timed out: the address is the user's input
+                raise ValueError(
+                    f"scheduler: no dask.distributed scheduler answered at {address_or_client!r} "
+                    f"within {timeout} s ({exc})"
+                ) from None
+            self._own = True
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
 
-    def map(self, fn, items):
-        chunks = _chunks(items, self.workers)
+    def map(self, fn, items, tasks=None):
+        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker)."""
+        chunks = _chunks(items, tasks or self.workers)
         # pure=False: every call runs (no result caching across identical inputs)
         futs = [self.client.submit(_run_chunk, fn, c, pure=False) for c in chunks]
         return [y for part in self.client.gather(futs) for y in part]
@@ -168,7 +186,10 @@ class DaskExecutor(SerialExecutor):
 
 
 def make_executor(workers: int = 1, scheduler: str | None = None):
-    """``--workers N`` / ``--scheduler ADDRESS`` -> an executor."""
+    """``--workers N`` / ``--scheduler ADDRESS`` -> an executor.
+
+    Raises ``ValueError`` for ``workers`` below 1 or a scheduler that does not answer.
+    """
     if scheduler:
         return DaskExecutor(scheduler)
     if workers == 1:

@@ -190,8 +190,10 @@ def _cell(scene, spec, data, level, n_geometries, noise_extra):
 
 
 def _run_members(executor, members, per_cell, progress):
-    """Every member's result, in order: one map per cell, so a progress bar moves
-    (members are independent: the results do not depend on the grouping)."""
+    """Every member's result, in order: one map per cell, so a progress bar moves,
+    one task per member, so a slow chain does not hold back a worker's whole share
+    (members are independent and seeded by their own ``seed``: the results do not
+    depend on the grouping or on where they run)."""
     bar = None
     if progress:
         from tqdm import tqdm
@@ -200,7 +202,8 @@ def _run_members(executor, members, per_cell, progress):
     results = []
     try:
         for start in range(0, len(members), per_cell):
-            results.extend(executor.map(run_member, members[start : start + per_cell]))
+            cell = members[start : start + per_cell]
+            results.extend(executor.map(run_member, cell, tasks=len(cell)))
             if bar is not None:
                 bar.update(per_cell)
     finally:

@@ -23,8 +23,14 @@ from validation.atomic import atomic_savefig, atomic_write_text
 __all__ = ["scan", "scene_csv", "write_scene_outputs"]
 
 
-def scan(scene, n_inplane=357, n_azimuth=181, model=None):
+def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
+    """The in-plane curve and the out-of-plane scan of ``model`` (default the scene's),
+    evaluated at ``precision`` (``"float32"`` only through the model's precision option,
+    :func:`validation.studies.tradeoff.at_precision`).  Returns ``(model, rows)``."""
+    from .tradeoff import at_precision
+
     model = scene.build() if model is None else model
+    mueller = model.mueller if precision == "float64" else at_precision(model, precision)
     s_in = np.asarray(scene.polarization, dtype=float)
     ti = scene.theta_i
     x = np.radians(np.linspace(-89.0, 89.0, n_inplane))
@@ -34,7 +40,7 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None):
         ("in-plane", *signed_inplane(x), np.degrees(x)),
         ("out-of-plane", np.full_like(phi, ti), phi, np.degrees(phi)),
     ):
-        S = model.mueller(ti, tr, pr) @ s_in
+        S = np.asarray(mueller(ti, tr, pr), dtype=np.float64) @ s_in
         i, eta, pc, p = ellipsometric(S)
         rows[label] = {
             "coord": coord,
@@ -48,44 +54,62 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None):
     return model, rows
 
 
+def _pick(knob, tol, notes):
+    """The cheapest measured setting of ``knob`` meeting ``tol`` (the most accurate when
+    none does, said so in ``notes``); ``None``, said so, when the knob cannot be measured."""
+    from .tradeoff import KNOBS, KnobUnavailable, choose
+
+    try:
+        r = KNOBS[knob](quick=True)
+    except KnobUnavailable as exc:
+        notes.append(f"{knob}: not measured ({exc})")
+        return None
+    p = choose(r, tol)
+    if p is None:
+        p = min(r.points, key=lambda q: q.error)
+        notes.append(
+            f"{knob}: no measured setting reaches {tol:g}; using the most accurate, {p.setting:g} (error {p.error:.2g})"
+        )
+    else:
+        notes.append(f"{knob}: chose {p.setting:g} (measured error {p.error:.2g} <= {tol:g})")
+    return p.setting
+
+
+def _choose_precision(model, tol, notes):
+    """``"float32"`` when the model has a precision option and the measured float32 error
+    meets ``tol`` at a lower cost, else ``"float64"``."""
+    from .tradeoff import precision_option
+
+    if precision_option(model) is None:
+        notes.append(f"precision: float64 ({type(model).__name__} has no precision option)")
+        return "float64"
+    bits = _pick("precision", tol, notes)
+    return "float32" if bits == 32 else "float64"
+
+
 def choose_settings(scene, tol):
     """Settings for ``tol`` from the measured speed/accuracy curves (validation.studies.tradeoff).
 
-    Returns ``(model, n_inplane, notes)``: the cheapest in-plane grid, Monte Carlo
-    pair count and point-source resolution whose *measured* error meets ``tol``
-    (on the representative configurations of the tradeoff study), or the most
-    accurate measured setting, said so, when none does.
+    Returns ``(model, n_inplane, precision, notes)``: the cheapest in-plane grid, Monte
+    Carlo pair count, point-source resolution and evaluation precision whose *measured*
+    error meets ``tol`` (on the representative configurations of the tradeoff study),
+    or the most accurate measured setting, said so, when none does.
     """
     import dataclasses
 
     from models import PointSourceBRDF, RoughDiffuseBRDF
 
-    from .tradeoff import KNOBS, choose
-
     notes = []
-
-    def pick(knob):
-        r = KNOBS[knob](quick=True)
-        p = choose(r, tol)
-        if p is None:
-            p = min(r.points, key=lambda q: q.error)
-            notes.append(
-                f"{knob}: no measured setting reaches {tol:g}; using the most accurate, {p.setting:g} (error {p.error:.2g})"
-            )
-        else:
-            notes.append(f"{knob}: chose {p.setting:g} (measured error {p.error:.2g} <= {tol:g})")
-        return p.setting
-
-    n_inplane = int(pick("in-plane grid"))
+    n_inplane = int(_pick("in-plane grid", tol, notes))
     model = scene.build()
     inner = model.model if isinstance(model, PointSourceBRDF) else model
     if isinstance(inner, RoughDiffuseBRDF):
-        pairs = int(pick("Monte Carlo pairs"))
+        pairs = int(_pick("Monte Carlo pairs", tol, notes))
         inner = dataclasses.replace(inner, pairs=pairs)
         model = dataclasses.replace(model, model=inner) if isinstance(model, PointSourceBRDF) else inner
     if isinstance(model, PointSourceBRDF):
-        model = dataclasses.replace(model, resolution=int(pick("point-source resolution")))
-    return model, n_inplane, notes
+        model = dataclasses.replace(model, resolution=int(_pick("point-source resolution", tol, notes)))
+    return model, n_inplane, _choose_precision(model, tol, notes), notes
 
 
 def scene_csv(scene, model, rows) -> str:
@@ -166,8 +190,8 @@ def write_scene_outputs(scene, out_dir, tol=None):
     if tol is None:
         model, rows = scan(scene)
     else:
-        chosen, n_inplane, notes = choose_settings(scene, tol)
-        model, rows = scan(scene, n_inplane=max(n_inplane, 3), model=chosen)
+        chosen, n_inplane, precision, notes = choose_settings(scene, tol)
+        model, rows = scan(scene, n_inplane=max(n_inplane, 3), model=chosen, precision=precision)
     stem = os.path.splitext(os.path.basename(scene.path))[0]
     csv_path = os.path.join(out_dir, f"{stem}.csv")
     atomic_write_text(csv_path, scene_csv(scene, model, rows))

@@ -28,8 +28,10 @@ Findings that physics explains are listed, each with its reason, in
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
+import threading
 import tomllib
 import warnings
 from dataclasses import dataclass, field
@@ -363,29 +365,55 @@ def _check_energy(model, found, name, params):
             )
 
 
+#: The sweep records warnings with :func:`warnings.catch_warnings`, which swaps process-wide
+#: state: two instances swept at once in one process (threads of a Dask worker) would
+#: record each other's warnings, so within a process they take turns.
+_SWEEP_LOCK = threading.Lock()
+
+
 def sweep_model(inst, energy=True, name=None):
-    """The findings of one model instance at its edge geometries (``name``: the model's
-    name in them, default its class name)."""
+    """The findings of one model instance at its edge geometries, its reciprocity and
+    (with ``energy``) its integrated reflectance (``name``: the model's name in them,
+    default its class name); one task of :func:`sweep`."""
     found = []
     name, params = name or type(inst).__name__, repr(inst)
-    ti, tr, pr = edge_geometries(inst)
-    _evaluate(inst, ti, tr, pr, found, name, params)
-    _check_reciprocity(inst, ti, tr, pr, found, name, params)
-    if energy:
-        _check_energy(inst, found, name, params)
+    with _SWEEP_LOCK:
+        ti, tr, pr = edge_geometries(inst)
+        _evaluate(inst, ti, tr, pr, found, name, params)
+        _check_reciprocity(inst, ti, tr, pr, found, name, params)
+        if energy:
+            _check_energy(inst, found, name, params)
     return found
 
 
-def sweep(classes=None, energy=True):
-    """Run the sweep; returns every finding (accepted or not).  By default: every model
-    class, then the models other packages contribute (``scatterbench.models`` entry
-    points, under their entry-point names)."""
-    found = []
+def _sweep_task(task, energy):
+    name, inst = task
+    return sweep_model(inst, energy, name)
+
+
+def sweep(classes=None, energy=True, executor=None):
+    """Run the sweep; returns every finding (accepted or not).
+
+    Parameters
+    ----------
+    classes : list of type, optional
+        Model classes (default every registered model class but :class:`models.Sum`,
+        then the models other packages contribute, ``scatterbench.models`` entry
+        points, under their entry-point names).
+    energy : bool
+        Integrate each instance's reflectance (the slow part).
+    executor : optional
+        Runs the instances, one task each (:mod:`validation.fitting.executors`;
+        default in-process).  The findings, and their order, are the same on any
+        executor: each instance is swept alone and they are collected in order.
+    """
+    from validation.fitting.executors import SerialExecutor
+
     targets = [(None, c) for c in classes] if classes is not None else _default_targets()
-    for name, cls in targets:
-        for inst in edge_instances(cls):
-            found += sweep_model(inst, energy, name)
-    return found
+    tasks = [(name, inst) for name, cls in targets for inst in edge_instances(cls)]
+    work = functools.partial(_sweep_task, energy=energy)
+    per_instance = (executor or SerialExecutor()).map(work, tasks, tasks=len(tasks))
+    return [f for found in per_instance for f in found]
 
 
 def _default_targets():

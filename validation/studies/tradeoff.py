@@ -1,4 +1,4 @@
-"""The speed/accuracy trade, measured (issue 5 item 3).
+"""The speed/accuracy trade, measured (issue 5 item 3, issue 12 item 5).
 
 A *knob* is a setting that trades cost for accuracy.  For each knob the study
 evaluates a quantity at every setting, times it, and measures its error against
@@ -11,8 +11,19 @@ an independent higher-accuracy reference (never an extrapolation):
 * ``in-plane grid``: an in-plane BRDF curve sampled on ``k`` points and linearly
   interpolated, against the model evaluated on a 20001-point grid (max relative
   error over the curve);
+* ``precision``: the Mueller matrix evaluated in float32 against float64, where the
+  model has a precision option (:func:`precision_option`); skipped, saying why, where
+  it has none;
 * knobs that other modules register with :func:`register_knob` (Monte Carlo
   pairs, point-source resolution, ...).
+
+Costs are per call, the best over repeated short batches (:func:`time_call`): a
+setting is called in batches of about :data:`BATCH` seconds until at least
+:data:`MIN_WORK` seconds of work have accumulated over at least :data:`MIN_BATCHES`
+batches, after one untimed warm-up call.  A single timing of a sub-millisecond call
+measures the machine's noise, not the setting (the grid curve ran backwards that
+way: 91 points "cost" more than 361).  Each point keeps the spread of its batches
+beside the best.
 
 ``pareto`` keeps the settings no other setting beats on both cost and error;
 ``choose(knob, tol)`` returns the cheapest setting whose *measured* error meets
@@ -21,6 +32,9 @@ an independent higher-accuracy reference (never an extrapolation):
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import inspect
 import math
 import time
 from dataclasses import asdict, dataclass, field
@@ -32,15 +46,50 @@ from models.geometry import signed_inplane
 from validation.numerics.energy import exposed_reflectance
 from validation.numerics.integrate import integrated_reflectance
 
-__all__ = ["Point", "KnobResult", "register_knob", "KNOBS", "study", "pareto", "choose"]
+__all__ = [
+    "Point",
+    "KnobResult",
+    "KnobUnavailable",
+    "register_knob",
+    "KNOBS",
+    "MIN_WORK",
+    "MIN_BATCHES",
+    "BATCH",
+    "Timing",
+    "time_call",
+    "precision_option",
+    "at_precision",
+    "study",
+    "pareto",
+    "choose",
+]
+
+#: Seconds of work accumulated per setting before its cost is taken.
+MIN_WORK = 0.2
+#: The fewest timed batches per setting.
+MIN_BATCHES = 3
+#: Target length of one timed batch (s): ~1e4 times perf_counter's resolution, and short
+#: enough that on a busy machine some batches run undisturbed (with 40 ms batches at load 16
+#: on 2 cores every batch was preempted and a 130 us call measured 1.7 ms).
+BATCH = 2e-3
 
 
 @dataclass(frozen=True)
 class Point:
+    """One setting of a knob: its error against the reference and its cost.
+
+    ``seconds`` is the best CPU time per call over ``calls`` timed calls in batches
+    (:func:`time_call`); ``spread`` is ``(median - best) / best`` over those batches;
+    ``wall_seconds`` the best wall-clock time per call (``nan``: not measured).
+    """
+
     setting: float
     error: float
     seconds: float
     evaluations: int
+    spread: float = 0.0
+    calls: int = 1
+    wall_seconds: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -54,6 +103,10 @@ class KnobResult:
         return {**asdict(self), "pareto": [asdict(p) for p in pareto(self.points)]}
 
 
+class KnobUnavailable(Exception):
+    """A knob that cannot be measured here; the message says why."""
+
+
 KNOBS = {}
 
 
@@ -65,14 +118,48 @@ def register_knob(name):
     return deco
 
 
-def _timed(fn, repeat=3):
-    best = math.inf
-    out = None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t)
-    return out, best
+@dataclass(frozen=True)
+class Timing:
+    """The cost of a call (:func:`time_call`): best CPU seconds per call, spread of the
+    batches, calls timed, best wall-clock seconds per call."""
+
+    seconds: float
+    spread: float
+    calls: int
+    wall_seconds: float
+
+
+def time_call(fn, min_work=MIN_WORK, min_batches=MIN_BATCHES, batch=BATCH):
+    """``(output, Timing)`` of ``fn()``.
+
+    One untimed warm-up call (first-call set-up, caches) gives the output and the
+    batch size, ``ceil(batch / warm-up time)`` calls (one for calls longer than
+    ``batch``).  Batches repeat until ``min_work`` seconds of CPU time have
+    accumulated and at least ``min_batches`` ran.  Each batch is timed on two clocks:
+    the process's CPU time (every thread of this process, and only this process: the
+    cost, which other work on the machine does not inflate) and the wall clock (what a
+    user waits, on this machine as loaded).  The cost is the best batch's CPU time per
+    call; the spread is ``(median - best) / best`` over the batches.
+    """
+    t = time.perf_counter()
+    out = fn()
+    first = time.perf_counter() - t
+    number = max(1, math.ceil(batch / max(first, 1e-9)))
+    cpu, wall = [], []
+    while len(cpu) < min_batches or sum(cpu) * number < min_work:
+        t, c = time.perf_counter(), time.process_time()
+        for _ in range(number):
+            fn()
+        cpu.append((time.process_time() - c) / number)
+        wall.append((time.perf_counter() - t) / number)
+    best = min(cpu)
+    spread = float(np.median(cpu)) / best - 1.0 if best > 0 else 0.0
+    return out, Timing(best, spread, number * len(cpu), min(wall))
+
+
+def _point(setting, error, timing: Timing, evaluations):
+    t = timing
+    return Point(setting, float(error), t.seconds, int(evaluations), t.spread, t.calls, t.wall_seconds)
 
 
 @register_knob("integration tolerance")
@@ -85,8 +172,8 @@ def knob_integration(quick=False):
     points = []
     tols = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6) if quick else (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
     for tol in tols:
-        r, sec = _timed(lambda tol=tol: integrated_reflectance(model, theta_i, tol=tol))
-        points.append(Point(tol, abs(r.value - truth), sec, r.evaluations))
+        r, cost = time_call(functools.partial(integrated_reflectance, model, theta_i, tol=tol))
+        points.append(_point(tol, abs(r.value - truth), cost, r.evaluations))
     return KnobResult(
         "integration tolerance",
         "integrated reflectance, FacetBRDF(exponential sigma 0.1, aluminium), 60 deg",
@@ -112,10 +199,9 @@ def knob_grid(quick=False):
     ks = (19, 37, 91, 181, 361) if quick else (19, 37, 91, 181, 361, 721, 1441, 2881)
     for k in ks:
         x = np.linspace(fine[0], fine[-1], k)
-        vals, sec = _timed(lambda x=x: curve(x))
-        interp = np.interp(fine, x, vals)
-        err = float(np.max(np.abs(interp - ref)) / np.max(ref))
-        points.append(Point(k, err, sec, k))
+        vals, cost = time_call(functools.partial(curve, x))
+        err = np.max(np.abs(np.interp(fine, x, vals) - ref)) / np.max(ref)
+        points.append(_point(k, err, cost, k))
     return KnobResult(
         "in-plane grid",
         "in-plane BRDF curve of SubsurfaceFacetBRDF at 60 deg (linear interpolation)",
@@ -147,14 +233,12 @@ def knob_mc_pairs(quick=False):
     points = []
     seeds = (7, 8, 9)  # the error of one run is one random draw: average its square over seeds
     for pairs in (50, 200, 1000) if quick else (50, 200, 1000, 5000):
-        errs, secs = [], []
-        for seed in seeds:
-            m = mc(pairs, seed)
-            m.brdf(theta_i, tr[:1], 0.0)  # exclude one-time set-up (the rough-interface R-bar) from the cost
-            vals, sec = _timed(lambda m=m: m.brdf(theta_i, tr, 0.0), repeat=1)
-            errs.append(np.mean(((vals - ref) / ref) ** 2))
-            secs.append(sec)
-        points.append(Point(pairs, float(np.sqrt(np.mean(errs))), float(np.median(secs)), pairs * tr.size))
+        # the cost does not depend on the seed: one seed's calls are timed (the untimed
+        # warm-up call takes the one-time set-up, the rough interface's R-bar, out of it)
+        first, cost = time_call(functools.partial(mc(pairs, seeds[0]).brdf, theta_i, tr, 0.0))
+        vals = [first] + [mc(pairs, seed).brdf(theta_i, tr, 0.0) for seed in seeds[1:]]
+        err = math.sqrt(np.mean([np.mean(((v - ref) / ref) ** 2) for v in vals]))
+        points.append(_point(pairs, err, cost, pairs * tr.size))
     return KnobResult(
         "Monte Carlo pairs",
         "RoughDiffuseBRDF (surface off, exponential rms slope 0.5, n 1.5, g 0.3, rho 0.3), 17 in-plane angles at 45 deg",
@@ -179,14 +263,75 @@ def knob_point_source(quick=False):
     points = []
     for res in (2, 4, 8, 16) if quick else (2, 4, 8, 16, 24, 32, 48):
         m = models.PointSourceBRDF(model=inner, distance=10.0, sample_radius=1.0, resolution=res)
-        vals, sec = _timed(lambda m=m: m.brdf(theta_i, tr, 0.0))
-        points.append(
-            Point(res, float(np.max(np.abs(vals - ref)) / np.max(ref)), sec, res * 2 * res * tr.size)
-        )
+        vals, cost = time_call(functools.partial(m.brdf, theta_i, tr, 0.0))
+        err = np.max(np.abs(vals - ref)) / np.max(ref)
+        points.append(_point(res, err, cost, res * 2 * res * tr.size))
     return KnobResult(
         "point-source resolution",
         "PointSourceBRDF(exact) around CookTorranceBRDF(m 0.03, iron), d/R = 10, in-plane 30-60 deg at 45 deg",
         "the same superposition at resolution 96; max |f - f_ref| / max f_ref",
+        points,
+    )
+
+
+def precision_option(model):
+    """How ``model`` takes an evaluation precision: ``"keyword"`` (its ``mueller``
+    accepts ``precision="float64"|"float32"``), ``"parameter"`` (a declared
+    ``precision`` parameter), or ``None`` (no option: the numpy reference path
+    promotes float32 inputs and evaluates in float64)."""
+    if "precision" in inspect.signature(model.mueller).parameters:
+        return "keyword"
+    if any(info.name == "precision" for info in type(model).parameters()):
+        return "parameter"
+    return None
+
+
+def at_precision(model, precision):
+    """``model.mueller`` evaluating at ``precision`` (``"float64"`` or ``"float32"``)
+    through the model's own option; ``ValueError`` if it has none."""
+    if precision not in ("float64", "float32"):
+        raise ValueError(f"precision must be 'float64' or 'float32'; got {precision!r}")
+    kind = precision_option(model)
+    if kind == "keyword":
+        return functools.partial(model.mueller, precision=precision)
+    if kind == "parameter":
+        return dataclasses.replace(model, precision=precision).mueller
+    raise ValueError(f"precision: {type(model).__name__} has no precision option")
+
+
+@register_knob("precision")
+def knob_precision(quick=False, model=None):
+    """The Mueller matrix in float32 and float64 on 4096 random geometries, against the
+    float64 evaluation (so the float64 point has error 0 by construction); ``model``
+    defaults to seed 000's coated flake model.  :class:`KnobUnavailable` when the model
+    has no precision option."""
+    if model is None:
+        model = models.SubsurfaceFacetBRDF(
+            slopes=models.ExponentialSlopes(0.1), coating=1.5, substrate=1.37 + 7.62j
+        )
+    if precision_option(model) is None:
+        raise KnobUnavailable(
+            f"{type(model).__name__} has no precision option (float32 kernels not present); "
+            "its numpy path promotes float32 inputs to float64, so there is no float32 cost to measure"
+        )
+    rng = np.random.default_rng(12)
+    ti, tr = rng.uniform(0, math.radians(85), (2, 4096))
+    pr = rng.uniform(-math.pi, math.pi, 4096)
+    measured = {
+        bits: time_call(functools.partial(at_precision(model, f"float{bits}"), ti, tr, pr))
+        for bits in (64, 32)
+    }
+    ref = measured[64][0]
+    scale = np.max(ref[..., 0, 0])
+    points = [
+        _point(bits, np.max(np.abs(M.astype(np.float64) - ref)) / scale, cost, ti.size)
+        for bits, (M, cost) in measured.items()
+    ]
+    return KnobResult(
+        "precision",
+        f"Mueller matrix of {model!r} on 4096 random geometries (theta < 85 deg); "
+        "setting = bits of the evaluation (64: float64, 32: float32)",
+        "the float64 evaluation; error = max |M - M_ref| (every element) / max M00_ref",
         points,
     )
 
@@ -210,5 +355,17 @@ def choose(result: KnobResult, tol: float):
     return min(ok, key=lambda p: p.seconds) if ok else None
 
 
-def study(names=None, quick=False):
-    return [KNOBS[n](quick=quick) for n in (names or KNOBS)]
+def study(names=None, quick=False, skipped=None):
+    """Every knob's :class:`KnobResult` (``names``: these knobs only; ``quick``: fewer settings).
+
+    A knob that cannot be measured here (:class:`KnobUnavailable`) is left out; its
+    reason goes into the dict ``skipped`` when one is given.
+    """
+    out = []
+    for n in names or KNOBS:
+        try:
+            out.append(KNOBS[n](quick=quick))
+        except KnobUnavailable as exc:
+            if skipped is not None:
+                skipped[n] = str(exc)
+    return out

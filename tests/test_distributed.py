@@ -1,0 +1,126 @@
+"""Distributed studies: the recovery study's members, the model-comparison fits and the
+stability sweep give the same results, in the same order, on a dask.distributed cluster
+(two worker processes, so everything crosses a process boundary pickled), on local
+processes and in-process."""
+
+import json
+import os
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+import models
+import references
+from models import scene
+from models.base import Model
+from models.params import param
+from validation.cli import main
+from validation.fitting.compare import compare_fits
+from validation.fitting.datafile import load_data
+from validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor, _chunks
+from validation.fitting.fitspec import fitspec_from
+from validation.fitting.likelihood import Likelihood
+from validation.fitting.recovery import recovery_study, subsample
+from validation.fitting.settings import ChainSettings
+from validation.studies.stability import classify, sweep
+
+COATED = os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
+DATA = references.data_path("scatmech_flake_measurement.csv")
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """Two single-threaded worker processes; the executor the ``--scheduler`` path builds."""
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as lc:
+        with DaskExecutor(lc.scheduler_address) as ex:
+            assert ex.workers == 2
+            yield ex
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return scene.load(COATED), load_data(DATA)
+
+
+def test_chunks_keep_order_and_cover_every_item():
+    items = list(range(7))
+    for n in (1, 2, 3, 7, 10):
+        parts = _chunks(items, n)
+        assert [x for p in parts for x in p] == items and len(parts) == min(n, 7)
+        assert max(map(len, parts)) - min(map(len, parts)) <= 1
+
+
+def test_map_one_task_per_item_keeps_order(cluster):
+    assert cluster.map(abs, [-3, 1, -2, 5, -8], tasks=5) == [3, 1, 2, 5, 8]
+    assert SerialExecutor().map(abs, [-1, 2], tasks=2) == [1, 2]
+
+
+def test_recovery_members_identical_on_a_cluster(setup, cluster):
+    sc, data = setup
+    spec = fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0.1"])
+    st = ChainSettings(walkers=4, seed=2, max_steps=30, check_every=30, starts=1)
+    kw = dict(noise_levels=(0.05, 0.2), n_geometries=(6,), injections=3)
+    serial = recovery_study(sc, spec, data, st, **kw)
+    dist = recovery_study(sc, spec, data, st, executor=cluster, **kw)
+    assert json.dumps(serial, sort_keys=True) == json.dumps(dist, sort_keys=True)
+    # members differ from one another (seeded per member), so a reordering would show
+    medians = [m["params"]["substrate.sigma"]["median"] for c in serial for m in c["members"]]
+    assert len(set(medians)) == len(medians)
+
+
+def test_comparison_fits_identical_on_a_cluster(setup, cluster):
+    sc, data = setup
+    d = subsample(data, 20)
+    gauss = sc.with_values({"substrate.distribution": "gaussian"})
+    liks = [Likelihood(s, fitspec_from(s, ["sigma:0.01:1:log"], ["brdf=0.1"]), d) for s in (sc, gauss)]
+    st = ChainSettings(walkers=4, seed=5, max_steps=30, check_every=30, starts=1)
+    rows, fits = compare_fits(liks, ["exponential", "gaussian"], st)
+    rows_d, fits_d = compare_fits(liks, ["exponential", "gaussian"], st, executor=cluster)
+    assert json.dumps(rows, sort_keys=True) == json.dumps(rows_d, sort_keys=True)
+    assert [r["scene"] for r in rows_d] == ["exponential", "gaussian"]
+    for a, b in zip(fits, fits_d, strict=True):
+        assert np.array_equal(a.chain.chain, b.chain.chain)
+        assert np.array_equal(a.chain.log_prob, b.chain.log_prob)
+    assert not np.array_equal(fits[0].chain.chain, fits[1].chain.chain)
+
+
+@dataclass(frozen=True)
+class Brittle(Model):
+    """Deliberately broken where ``k`` > 1.5: a division by zero at phi = 1e-12 (a warning
+    and an inf), negative below it; a finding of each kind."""
+
+    depolarizing = True
+    k: float = param(1.0, "breakage", low=0.0, high=2.0)
+
+    def _mueller16(self, ti, tr, pr):
+        out = np.zeros((16, ti.size))
+        out[0] = 1.0 / (pr - 1e-12) if self.k > 1.5 else 1.0
+        return out
+
+
+def _as_tuples(findings):
+    return [(f.model, f.params, f.kind, repr(f.value), f.where, repr(f.fields)) for f in findings]
+
+
+def test_stability_sweep_identical_on_a_cluster_and_processes(cluster):
+    classes = [Brittle, models.DiffuseSubsurfaceBRDF, models.FacetBTDF]
+    serial = sweep(classes=classes, energy=False)
+    assert {"non-finite", "negative-M00", "fp-warning"} <= {f.kind for f in serial}
+    assert {f.params for f in serial} == {"Brittle(k=2.0)"}  # only the broken instance
+    dist = sweep(classes=classes, energy=False, executor=cluster)
+    assert _as_tuples(dist) == _as_tuples(serial)
+    with ProcessExecutor(2) as ex:
+        assert _as_tuples(sweep(classes=classes, energy=False, executor=ex)) == _as_tuples(serial)
+    # the energy check too, on a class that passes it quickly
+    energy = sweep(classes=[models.DiffuseSubsurfaceBRDF], executor=cluster)
+    assert _as_tuples(energy) == _as_tuples(sweep(classes=[models.DiffuseSubsurfaceBRDF]))
+    assert classify(energy)[1] == []
+
+
+def test_stability_command_rejects_a_bad_worker_count(capsys):
+    assert main(["stability", "--no-energy", "--workers", "0"]) == 2
+    # refused by the flag's type, before anything runs
+    assert "error: argument --workers: must be an integer >= 1; got 0" in capsys.readouterr().err
