@@ -68,7 +68,7 @@ _NAMED_EDGES = {
     "sigma_y": (1e-4, 10.0),
     # GGX widths (no rms slope: alpha is the median slope magnitude)
     "alpha": (1e-4, 1e-2, 1.0, 10.0),
-    # anisotropic GGX to 1e4:1 (from the 0.05 x 0.2 base).  At 2e3:1 (1e-4 x 0.2) the
+    # anisotropic GGX to 200:1 (from the 0.05 x 0.2 base).  At 2e3:1 (1e-4 x 0.2) the
     # unshadowed albedo at 89.99 deg is ~148 and the integrator does not reach the sweep's
     # absolute 1e-3 within its 2e6-evaluation budget (148.39 +- 0.02; at 1e-3 x 0.2 it
     # converges to 148.396): a limit of the energy check at large albedos, not of the model
