@@ -23,6 +23,7 @@ from . import (
     stability,
     summary,
     table1,
+    thin_film,
     uncertainty,
 )
 from .summary import report_checks
@@ -45,6 +46,7 @@ SECTIONS = (
     _spec("seed003_fig1", "Seed 003 Fig. 1 reproduced: Snell shift of facet transmission", seed003_fig1),
     _spec("seed003_presets", "Seed 003 Fig. 2-3: preset model curves beside Maxwell-Beard", seed003_presets),
     _spec("seed001", "Seed 001: published vs energy Cook-Torrance, varnish, point source", seed001),
+    _spec("thin_film", "Beyond the seeds: thin-film interference flakes and their colour travel", thin_film),
     _spec("uncertainty", "Uncertainty: an example posterior and the recovery coverage", uncertainty),
     _spec(
         "model_comparison", "Model comparison: seed 003's combination against Maxwell-Beard", model_comparison

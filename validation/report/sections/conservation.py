@@ -1,4 +1,6 @@
-"""Conservation: reciprocity error maps and albedo of every deterministic reciprocal model."""
+"""Conservation: reciprocity error maps, albedo of every deterministic reciprocal model, and a
+perfect conductor's albedo with and without Smith shadowing (the curves the check
+``check_smith_albedo`` judges, computed once per run)."""
 
 from __future__ import annotations
 
@@ -6,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from validation.checks.shadowing import ANGLES_DEG, QUICK_ANGLES_DEG, conductor_albedo_curves
 from validation.numerics.integrate import integrated_reflectance
 from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 
@@ -21,13 +24,17 @@ GRID_DEG = (0.5, 88.5)
 @dataclass(frozen=True)
 class ConservationData:
     """``maps``: per model, (name, relative reciprocity error over theta_i x theta_r);
-    ``albedo``: per reflecting model, (name, theta_i in deg, albedo)."""
+    ``albedo``: per reflecting model, (name, theta_i in deg, albedo); ``smith``: the
+    perfect-conductor :class:`~validation.checks.shadowing.AlbedoCurve` s, with and without
+    Smith shadowing."""
 
     skipped: tuple[str, ...]
     maps: tuple
     reciprocity_rows: tuple
     albedo: tuple
     albedo_rows: tuple
+    smith: tuple
+    smith_rows: tuple
 
 
 def _reciprocity(m, t):
@@ -52,6 +59,23 @@ def _albedo(ms, tis):
     return tuple(curves), tuple(rows)
 
 
+def _smith(ctx):
+    # the same call as the check's, so the run integrates these curves once
+    angles = QUICK_ANGLES_DEG if ctx.quick else ANGLES_DEG
+    curves = tuple(ctx.compute(conductor_albedo_curves, angles_deg=angles))
+    rows = tuple(
+        {
+            "slopes": c.label.split(", shadowing")[0],
+            "shadowing": c.shadowing,
+            "max albedo": max(c.albedo),
+            "at theta_i (deg)": c.theta_i_deg[c.albedo.index(max(c.albedo))],
+            "its error": c.error[c.albedo.index(max(c.albedo))],
+        }
+        for c in curves
+    )
+    return curves, rows
+
+
 def compute(ctx):
     every = default_models()
     ms = [m for m in every if not is_heavy(m) and m.reciprocal]
@@ -63,7 +87,8 @@ def compute(ctx):
         rows.append(row)
     albedo, albedo_rows = _albedo(ms, np.radians(np.linspace(0, 85, 6 if ctx.quick else 18)))
     skipped = tuple(type(m).__name__ for m in every if m not in ms)
-    return ConservationData(skipped, tuple(maps), tuple(rows), albedo, albedo_rows)
+    smith, smith_rows = _smith(ctx)
+    return ConservationData(skipped, tuple(maps), tuple(rows), albedo, albedo_rows, smith, smith_rows)
 
 
 def _draw_maps(d):
@@ -93,6 +118,19 @@ def _draw_albedo(d):
     return finish(fig, ax, "theta_i (deg)", "integrated reflectance", 8)
 
 
+def _draw_smith(d):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+    for ax, family in zip(axes, ("gaussian", "ggx"), strict=True):
+        for c in d.smith:
+            if c.family == family:
+                style = "o-" if c.shadowing == "smith" else "s--"
+                ax.semilogy(c.theta_i_deg, c.albedo, style, label=c.label.split(family + " ")[1], ms=4)
+        ax.axhline(1.0, color="k", lw=0.6)
+        ax.set_title("Gaussian (Beckmann) slopes" if family == "gaussian" else "GGX slopes", fontsize=9)
+        finish(fig, ax, "theta_i (deg)", "perfect-conductor albedo", 7)
+    return fig
+
+
 def render(s, d: ConservationData):
     s.blocks.append(
         text_block(
@@ -120,3 +158,19 @@ def render(s, d: ConservationData):
         )
     )
     s.blocks.append(table_block(s, "albedo", ["model", "theta_i (deg)", "albedo"], d.albedo_rows))
+    s.blocks.append(
+        figure_block(
+            _draw_smith(d),
+            "Perfect-conductor albedo of FacetBRDF versus incidence, without shadowing (dashed; bounded "
+            "by the hit fraction, above 1 near grazing) and with Smith shadowing-masking (solid; <= 1)",
+        )
+    )
+    s.blocks.append(
+        table_block(
+            s,
+            "smith_albedo",
+            ["slopes", "shadowing", "max albedo", "at theta_i (deg)", "its error"],
+            d.smith_rows,
+            fmt={"max albedo": ".6g", "its error": ".1e"},
+        )
+    )
