@@ -46,7 +46,8 @@ from . import kernel_specs
 from .base import Model
 from .fresnel import fresnel_reflectance
 from .params import Alias, check_real, choice_alias, convention_param, param
-from .slopes import GaussianSlopes
+from .shadowing import smith_g
+from .slopes import AnisotropicGaussianSlopes, GaussianSlopes
 from .stroke_slopes import StrokeSlopes, stroke_d
 
 __all__ = [
@@ -55,9 +56,12 @@ __all__ = [
     "fresnel_real_printed",
     "fresnel_average",
     "ct_kernel",
+    "smith_slopes",
 ]
 
 _INV_4PI = 1.0 / (4.0 * math.pi)
+#: the ``shadowing`` choices of the Cook-Torrance models
+SHADOWING_CT = ("blinn", "none", "smith")
 
 
 def fresnel_real(cos_i, n, k=0.0):
@@ -152,12 +156,14 @@ def _grazing_safe(ti, tr):
     return np.where(live, ci, 1.0), np.where(live, cr, 1.0), live
 
 
-def ct_kernel(ci, cr, cp, sp, d_fn, index, shadowing):
+def ct_kernel(ci, cr, cp, sp, d_fn, index, shadowing, smith=None):
     """``D G F`` of Eq. 7 (published D, Eq. 8) for cosines of the two polar
     angles ``ci``, ``cr`` (both > 0) and the azimuth's ``cp``, ``sp``.
 
     ``d_fn(hx, hy, hz2)`` returns ``exp(-tan^2 alpha / m^2) / m^2`` for the
     (unnormalized) bisector ``h = L + E``; the ``1/cos^4 alpha`` is applied here.
+    ``shadowing``: ``"blinn"`` (Eq. 18), ``"none"`` or ``"smith"``, the separable Smith
+    ``G1(L) G1(E)`` of the slope distribution ``smith`` (:func:`smith_slopes`).
     """
     si = np.sqrt(1.0 - ci * ci)
     sr = np.sqrt(1.0 - cr * cr)
@@ -175,7 +181,30 @@ def ct_kernel(ci, cr, cp, sp, d_fn, index, shadowing):
         # Eq. 18: 2 cos(alpha) cos(theta) / cos(psi') = 4 hz cos(theta) / |h|^2
         t = (4.0 / g) * hz
         val *= np.minimum(1.0, t * np.minimum(ci, cr))
+    elif shadowing == "smith":
+        # L points toward the source (azimuth pi), E toward the viewer; both see the
+        # bisector facet from its front, so no back-facing test is needed
+        val *= smith_g("smith", smith, (ci, si, -1.0, 0.0), (cr, sr, cp, sp))
     return val
+
+
+def smith_slopes(slopes):
+    """The slopes whose Smith ``Lambda`` (:mod:`models.shadowing`) the ``"smith"`` option uses:
+    ``GaussianSlopes(sigma=m)`` itself (Beckmann ``alpha = m``, the erf form); for
+    :class:`models.StrokeSlopes` the anisotropic Gaussian with the same exponent,
+    ``AnisotropicGaussianSlopes(m_par, m_perp, stroke_angle)``, whose ``Lambda`` is the
+    Beckmann one at the projected roughness ``m(phi)^2 = (m_par cos phi')^2 + (m_perp
+    sin phi')^2`` (``phi'`` from the strokes).  For equal ``m`` values it is exact; for
+    brushed roughness it is an approximation, as Eq. 19's prefactor ``1 / m(beta)^2``
+    differs from the anisotropic Gaussian's ``1 / (m_par m_perp)`` (see
+    :mod:`models.stroke_slopes`)."""
+    if isinstance(slopes, StrokeSlopes):
+        if slopes.isotropic:
+            return GaussianSlopes(sigma=slopes.m_parallel)
+        return AnisotropicGaussianSlopes(
+            sigma_x=slopes.m_parallel, sigma_y=slopes.m_perpendicular, rotation=slopes.stroke_angle
+        )
+    return GaussianSlopes(sigma=slopes.sigma)
 
 
 def _slopes_from_m(given, current):
@@ -206,6 +235,9 @@ class _CookTorranceBase(Model):
         return stroke_d(s.m_parallel, s.m_perpendicular, s.stroke_angle)
 
     def _cook_spec(self, variant, coating):
+        """The Cook-Torrance kernel; numpy for Smith shadowing (the kernel has Blinn's G or none)."""
+        if self.shadowing == "smith":
+            return None
         s = self.slopes
         m = (
             [s.sigma, s.sigma, 0.0]
@@ -214,6 +246,9 @@ class _CookTorranceBase(Model):
         )
         rows = [coating, *kernel_specs.index_rows(self.substrate), *m]
         return "cook", rows, (variant, int(self.convention == "corrected"), int(self.shadowing == "blinn"))
+
+    def _smith(self):
+        return smith_slopes(self.slopes) if self.shadowing == "smith" else None
 
     @property
     def mirror_symmetric(self) -> bool:
@@ -260,8 +295,12 @@ class CookTorranceBRDF(_CookTorranceBase):
         ``4 pi``, the normalized microfacet BRDF.  Either way F is the corrected
         Eq. 13-16 (the complex Fresnel reflectance; see :func:`fresnel_real`).
         Old keyword ``normalization`` (``"published"``, ``"energy"``).
-    shadowing : "blinn" | "none"
-        Eq. 18 (Blinn's V-groove ``G``) or ``G = 1``.
+    shadowing : "blinn" | "none" | "smith"
+        Eq. 18 (Blinn's V-groove ``G``), ``G = 1``, or the separable Smith ``G1(i) G1(o)``
+        from the Beckmann ``Lambda`` of the model's ``m`` (:func:`smith_slopes`; not in
+        seed 001).  With ``"smith"`` and ``convention="corrected"`` the model is
+        :class:`models.FacetBRDF` with ``GaussianSlopes(sigma=m)`` and ``shadowing="smith"``
+        (M00).  Options a fused kernel does not cover run on this numpy path.
     """
 
     slopes: GaussianSlopes | StrokeSlopes = param(
@@ -271,7 +310,7 @@ class CookTorranceBRDF(_CookTorranceBase):
     )
     substrate: complex = param(2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", kind="index")
     convention: str = convention_param("Eq. 7-8 as printed (paper) or divided by 4 pi (corrected)")
-    shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=("blinn", "none"))
+    shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=SHADOWING_CT)
 
     aliases = {
         "m": Alias("slopes", _slopes_from_m),
@@ -285,7 +324,9 @@ class CookTorranceBRDF(_CookTorranceBase):
 
     def _brdf_flat(self, ti, tr, pr):
         ci, cr, live = _grazing_safe(ti, tr)
-        val = ct_kernel(ci, cr, np.cos(pr), np.sin(pr), self._d_fn(), self.substrate, self.shadowing)
+        val = ct_kernel(
+            ci, cr, np.cos(pr), np.sin(pr), self._d_fn(), self.substrate, self.shadowing, self._smith()
+        )
         scale = _INV_4PI if self.convention == "corrected" else 1.0
         val *= scale / (ci * cr)
         if live is not None:

@@ -46,7 +46,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .cook_torrance import _INV_4PI, _CookTorranceBase, _grazing_safe, ct_kernel, fresnel_average
+from .cook_torrance import (
+    _INV_4PI,
+    SHADOWING_CT,
+    _CookTorranceBase,
+    _grazing_safe,
+    ct_kernel,
+    fresnel_average,
+)
 from .params import Alias, check_real, convention_param, param
 from .slopes import GaussianSlopes
 from .stroke_slopes import StrokeSlopes
@@ -123,8 +130,11 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
         divided by ``4 pi`` and with the radiometrically consistent denominator
         ``n_v^2 cos Theta cos Psi`` (see module docstring).  Either way F is the
         corrected Eq. 13-16.  Old keywords ``normalization`` and ``solid_angle``.
-    shadowing : "blinn" | "none"
-        Eq. 18 with the internal angles (Eq. 24's ``G(Psi, Theta)``) or ``G = 1``.
+    shadowing : "blinn" | "none" | "smith"
+        Eq. 18 with the internal angles (Eq. 24's ``G(Psi, Theta)``), ``G = 1``, or the
+        separable Smith ``G1 G1`` of the internal directions from the Beckmann ``Lambda``
+        of the model's roughness (:func:`models.cook_torrance.smith_slopes`; not in seed
+        001).  Options a fused kernel does not cover run on this numpy path.
     """
 
     slopes: StrokeSlopes | GaussianSlopes = param(
@@ -135,7 +145,7 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
     convention: str = convention_param(
         "Eq. 24 as printed (paper) or divided by 4 pi with the refraction Jacobian (corrected)"
     )
-    shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=("blinn", "none"))
+    shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=SHADOWING_CT)
 
     aliases = {
         "varnish": "coating",
@@ -159,7 +169,9 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
         # cancellation of sqrt(1 - sin^2/n_v^2) at grazing incidence.
         c_int = np.sqrt(nv * nv - 1.0 + ext * ext) * (1.0 / nv)
         index = self.substrate if self.substrate == math.inf else complex(self.substrate) / nv  # Eq. 22
-        val = ct_kernel(c_int[0], c_int[1], np.cos(pr), np.sin(pr), self._d_fn(), index, self.shadowing)
+        val = ct_kernel(
+            c_int[0], c_int[1], np.cos(pr), np.sin(pr), self._d_fn(), index, self.shadowing, self._smith()
+        )
         if nv != 1.0:
             t = 1.0 - fresnel_average(ext, nv)  # 1 - F_in(psi), 1 - F_out(Theta) = 1 - F(theta)
             val *= t[0] * t[1]  # Eq. 23

@@ -172,7 +172,7 @@ def scatmech_flake_measurement_path() -> str:
     return data_path("scatmech_flake_measurement.csv")
 
 
-# --- issue 15: peer references (Mitsuba 3, tmm) -------------------------------------
+# Peer references (Mitsuba 3, tmm): committed evaluations the tests read; the peers are never imported here
 __all__ += ["mitsuba_roughconductor", "tmm_reference"]
 
 

@@ -266,13 +266,14 @@ def test_validate_command_exit_codes_and_strict_json(monkeypatch, tmp_path, caps
 def test_report_section_that_raises_is_a_failed_machinery_entry(monkeypatch):
     import validation.report.build as build
     from validation.report import build_report, sections
+    from validation.report.core import SectionSpec
 
     def broken(ctx):
         raise RuntimeError("drawing failed")
 
-    broken.__name__ = "section_scenes"
-    funcs = [sections.section_summary, broken, sections.section_provenance]
-    monkeypatch.setattr(build, "SECTION_FUNCS", funcs)
+    summary, provenance = sections.SECTIONS[0], sections.SECTIONS[-1]
+    specs = [summary, SectionSpec("scenes", "Scenes", broken, lambda s, d: None), provenance]
+    monkeypatch.setattr(build, "SECTIONS", specs)
     results, _ = build_report(quick=True, checks=[])
     (c,) = results["checks"]
     assert c["name"] == "report section 'scenes' computed" and c["status"] == "fail"

@@ -28,6 +28,7 @@ _scalars = st.one_of(
     st.text(max_size=12),
     st.sampled_from(
         ["inf", "gaussian", "exponential", "cook-torrance", "maxwell-beard", "point", "linear:45"]
+        + ["ggx", "anisotropic-ggx", "smith", "smith-correlated", "none", "blinn"]
     ),
 )
 _values = st.recursive(
@@ -56,6 +57,10 @@ _SCENE_KEYS = {
         "rotation_deg",
         "m",
         "rho_d",
+        "alpha",
+        "alpha_x",
+        "shadowing",
+        "film",
     ],
     "coating": ["index", "roughness"],
     "volume": ["rho", "g", "polarized", "pairs", "seed", "single", "single_weight", "interface"],

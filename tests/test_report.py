@@ -1,10 +1,15 @@
 """The HTML report and the nightly run: numbers equal results.json, escaping, regressions, kills."""
 
+import ast
+import dataclasses
 import html
 import json
 import os
+import pathlib
 import re
+import sys
 
+import markupsafe
 import pytest
 
 import models.facet
@@ -104,3 +109,118 @@ def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):
     assert reg and not any("passed before and now fails" in r for r in reg)
     code, reg, _, _ = nightly(hist, stamp="2026-01-05T000000Z", **kw)
     assert code == 0 and reg == []
+
+
+_DRAWING = {"plt", "figure_block", "table_block", "text_block", "store_rows", "checks_block", "Section"}
+
+
+def _reachable_names(tree, start):
+    """Every name used by module-level function ``start`` and the module's functions it uses."""
+    funcs = {n.name: n for n in tree.body if isinstance(n, ast.FunctionDef)}
+    seen, todo, names = set(), [start], set()
+    while todo:
+        f = todo.pop()
+        if f in seen:
+            continue
+        seen.add(f)
+        for n in ast.walk(funcs[f]):
+            if isinstance(n, ast.Name):
+                names.add(n.id)
+                if n.id in funcs:
+                    todo.append(n.id)
+    return names
+
+
+def test_sections_compute_without_drawing_and_functions_are_short():
+    """Each section module's compute (and every helper it uses) neither draws nor tabulates;
+    no function of the report package is longer than 80 lines."""
+    from validation.report import sections
+
+    root = pathlib.Path(sections.__file__).parent.parent
+    for spec in sections.SECTIONS:
+        module = sys.modules[spec.compute.__module__]
+        assert spec.render.__module__ == module.__name__, spec.id
+        tree = ast.parse(pathlib.Path(module.__file__).read_text())
+        drawn = _reachable_names(tree, "compute") & _DRAWING
+        assert not drawn, (spec.id, drawn)
+    for path in root.rglob("*.py"):
+        for n in ast.walk(ast.parse(path.read_text())):
+            if isinstance(n, ast.FunctionDef):
+                assert n.end_lineno - n.lineno + 1 <= 80, (str(path), n.name)
+
+
+def test_section_data_is_frozen_and_renders_the_reported_numbers(quick_report):
+    """compute returns a frozen dataclass without drawing; render, from it alone, gives the
+    numbers results.json holds (sections whose work the checks already did: cheap to redo)."""
+    import matplotlib.pyplot as plt
+
+    from validation.report import sections
+    from validation.report.core import Section
+
+    _, results, ctx = quick_report
+    specs = {s.id: s for s in sections.SECTIONS}
+    for sid in ("table1", "stability", "model_comparison", "scenes"):
+        plt.close("all")
+        data = specs[sid].compute(ctx)
+        assert plt.get_fignums() == [], sid  # compute draws nothing
+        assert dataclasses.is_dataclass(data) and type(data).__dataclass_params__.frozen, sid
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(data, dataclasses.fields(data)[0].name, None)
+        sec = Section(sid, specs[sid].title)
+        specs[sid].render(sec, data)
+        reported = results["sections"][sid]
+        assert json.loads(json.dumps(sec.numbers, default=float)) == reported["numbers"], sid
+        assert json.loads(json.dumps(sec.tracked, default=float)) == reported["tracked"], sid
+
+
+def test_stability_findings_grouped_by_model_kind_and_verdict():
+    """One row per model x kind x verdict: the counts add up to every finding, the worst is the
+    group's largest magnitude (with its parameters and geometry), each reason is shown once per
+    group, not once per finding, and every finding stays in results.json."""
+    from validation.report.core import Section, render_html
+    from validation.report.sections import stability
+    from validation.studies.stability import Finding
+
+    def finding(model, kind, value, k):
+        return Finding(model, f"{model}(sigma={k})", kind, value, f"theta_i = {k} deg", {"value": value})
+
+    findings = [finding("FacetBRDF", "energy", v, k) for k, v in enumerate((1.2, 3.5, 2.0, 1.1))]
+    findings += [finding("FacetBRDF", "energy", v, k) for k, v in enumerate((5.5, -12.0), start=10)]
+    findings += [finding("FacetBRDF", "nan", v, k) for k, v in enumerate((1.0, 2.0), start=20)]
+    findings += [finding("CookTorranceBRDF", "energy", v, k) for k, v in enumerate((7.4, 7.5, 6.0), 30)]
+    accepted = [
+        {
+            "model": "FacetBRDF",
+            "kind": "energy",
+            "condition": "0 < value < 5",
+            "reason": "bounded by <H> & 'why'",
+        },
+        {"model": "*", "kind": "energy", "condition": "value > 7", "reason": "the paper's 4 pi"},
+    ]
+    d = stability.summarize(findings, accepted)
+    sec = Section("stability", "Stability")
+    stability.render(sec, d)
+    page = render_html(
+        {"date": "", "git_commit": "", "quick": False, "seconds": 0.0},
+        [sec],
+        {"n_checks": 0, "n_pass": 0, "n_finding": 0, "n_fail": 0},
+    )
+    groups = {(g["model"], g["kind"], g["accepted"]): g for g in sec.numbers["stability_groups"]}
+    assert {k: (g["count"], g["worst value"], g["worst at"]) for k, g in groups.items()} == {
+        ("FacetBRDF", "energy", "yes"): (4, 3.5, "theta_i = 1 deg"),
+        ("FacetBRDF", "energy", "NO"): (2, -12.0, "theta_i = 11 deg"),
+        ("FacetBRDF", "nan", "NO"): (2, 2.0, "theta_i = 21 deg"),
+        ("CookTorranceBRDF", "energy", "yes"): (2, 7.5, "theta_i = 31 deg"),
+        ("CookTorranceBRDF", "energy", "NO"): (1, 6.0, "theta_i = 32 deg"),
+    }
+    assert list(groups)[:3] == [k for k in groups if k[2] == "NO"]  # unaccepted first
+    assert groups[("FacetBRDF", "energy", "yes")]["worst parameters"] == "FacetBRDF(sigma=1)"
+    assert len(_cells(page, "stability_groups")) == 5 * 8  # the page shows the groups
+    assert '<table data-key="stability">' not in page  # ... and not one row per finding
+    for reason in ("bounded by <H> & 'why'", "the paper's 4 pi"):
+        assert page.count(str(markupsafe.escape(reason))) == 1
+    assert "11 findings: 6 accepted (each with its reason), 5 unaccepted, in 5 groups" in html.unescape(page)
+    rows = sec.numbers["stability"]  # every finding, with its verdict and reason, in results.json
+    assert len(rows) == len(findings) and sorted(r["value"] for r in rows) == sorted(
+        f.value for f in findings
+    )

@@ -10,9 +10,14 @@ import models
 scm = pytest.importorskip("pySCATMECH.brdf")
 
 
-def test_fresh_random_cases_agree():
-    rng = np.random.default_rng()  # fresh cases every run
-    worst = 0.0
+@pytest.mark.parametrize("seed", range(5))
+def test_random_cases_agree(seed):
+    """400 random cases per seed, seeded so that a failure can be reproduced.  The error is
+    relative to SCATMECH's M00, floored at 1e-250 as the committed-reference checks do: far
+    in a Gaussian tail both sides underflow (SCATMECH's 1.5e-302 against our 0.0 at seed 58
+    of a search over 300), which says nothing about either model."""
+    rng = np.random.default_rng(seed)
+    worst, where = 0.0, None
     for _ in range(40):
         coat = float(rng.uniform(1.0, 2.2))
         sub = complex(rng.uniform(0.3, 4.0), rng.choice([0.0, rng.uniform(0.01, 8)]))
@@ -32,8 +37,10 @@ def test_fresh_random_cases_agree():
             pr = rng.uniform(-math.pi, math.pi)
             R = np.array(ref.MuellerBRDF(ti, tr, pr))
             M = ours.mueller(ti, tr, pr)
-            worst = max(worst, float(np.max(np.abs(M - R)) / max(R[0, 0], 1e-300)))
-    assert worst <= 1e-6
+            err = float(np.max(np.abs(M - R)) / max(R[0, 0], 1e-250))
+            if err > worst:
+                worst, where = err, (coat, sub, sigma, str(dist), ti, tr, pr)
+    assert worst <= 1e-6, where
 
 
 @pytest.mark.parametrize(

@@ -385,4 +385,6 @@ def test_distributions_table_keeps_its_form():
         "anisotropic-gaussian",
         "gaussian-angle",
         "exponential-angle",
+        "ggx",
+        "anisotropic-ggx",
     }

@@ -294,7 +294,7 @@ def test_extreme_values_are_sensible():
         (lambda: models.CookTorranceBRDF(m=float("nan")), "m"),
         (lambda: models.CookTorranceBRDF(substrate=2 - 1j), "substrate"),
         (lambda: models.CookTorranceBRDF(normalization="paper"), "normalization"),
-        (lambda: models.CookTorranceBRDF(shadowing="smith"), "shadowing"),
+        (lambda: models.CookTorranceBRDF(shadowing="smith-correlated"), "shadowing"),
         (lambda: models.VarnishedCookTorranceBRDF(varnish=0.9), "varnish"),
         (lambda: models.VarnishedCookTorranceBRDF(varnish=1.5 + 0.1j), "varnish"),
         (lambda: models.VarnishedCookTorranceBRDF(m_perpendicular=0), "m_perpendicular"),

@@ -62,3 +62,29 @@ def test_sweep_catches_a_broken_model():
     assert {"non-finite", "negative-M00", "unphysical"} <= kinds
     _, bad = classify(found)
     assert bad
+
+
+def test_sweep_reaches_ggx_edges_and_film_stacks():
+    for cls in (models.FacetBRDF, models.SubsurfaceFacetBRDF, models.FacetBTDF):
+        inst = edge_instances(cls)
+        alphas = {(m.slopes.alpha, m.shadowing) for m in inst if isinstance(m.slopes, models.GGXSlopes)}
+        assert {(a, s) for a in (1e-4, 1e-2, 1.0, 10.0) for s in ("none", "smith")} <= alphas
+        aniso = {m.slopes.alpha_y for m in inst if isinstance(m.slopes, models.AnisotropicGGXSlopes)}
+        assert {1e-3, 10.0} <= aniso
+        films = [m for m in inst if isinstance(m.substrate, models.FilmStack)]
+        if cls is not models.FacetBTDF:
+            thick = {m.substrate.layers[0][1] for m in films}
+            assert {0.0, 1e5, 10.0} <= thick and {m.shadowing for m in films} == {"none", "smith"}
+
+
+def test_smith_shadowed_models_have_no_energy_findings(findings):
+    # the issue-15 acceptance: with Smith shadowing the energy findings are gone (the paper's
+    # printed Cook-Torrance normalizations excepted: they are 4 pi times a BRDF)
+    shadowed = [
+        f
+        for f in findings
+        if f.kind.startswith("energy")
+        and "shadowing='smith'" in f.params
+        and "convention='paper'" not in f.params
+    ]
+    assert not shadowed, [(f.model, f.params, f.where, f.value) for f in shadowed]

@@ -31,12 +31,26 @@ Schema (angles in degrees in files, as everywhere outside the Python API)::
     [coating.roughness]            # optional: rough top surface (its own facet reflection)
     distribution = "gaussian"
     sigma = 0.02
+    shadowing = "smith"            # none (default) | smith | smith-correlated (not with a
+                                   # Monte Carlo [volume] under it: interface = "rough")
 
     [substrate]                    # the flakes or the substrate under the coating
     index = [1.37, 7.62]           # [n, k], a number, or "inf" (perfect conductor)
-    distribution = "exponential"   # omit for a flat (specular) substrate
+    distribution = "exponential"   # omit for a flat (specular) substrate; any of
+                                   # exponential | gaussian (sigma: rms slope),
+                                   # anisotropic-exponential | anisotropic-gaussian
+                                   # (sigma_x, sigma_y, rotation_deg), gaussian-angle |
+                                   # exponential-angle (sigma_deg), ggx (alpha: a width;
+                                   # GGX's rms slope is infinite), anisotropic-ggx
+                                   # (alpha_x, alpha_y, rotation_deg); each with coverage
     sigma = 0.1
     coverage = 1.0
+    shadowing = "none"             # none (default, seed 000) | smith | smith-correlated
+
+    [substrate.film]               # optional: thin films on the facets/flakes (models.FilmStack),
+                                   # from the incident side down, over the substrate index,
+                                   # at [illumination] wavelength_nm (then required)
+    layers = [{index = [2.6, 0.0], thickness_nm = 130.0}]
 
     [volume]                       # optional volume scatterer (pigment) in the coating
     ...
@@ -48,7 +62,7 @@ Schema (angles in degrees in files, as everywhere outside the Python API)::
     index = [2.29, 3.37]
     m = 0.03                       # or m_parallel, m_perpendicular and stroke_angle_deg (Eq. 19)
     convention = "corrected"       # corrected (default) | paper; old keys: normalization, solid_angle
-    shadowing = "blinn"            # blinn | none
+    shadowing = "blinn"            # blinn | none | smith
 
     # or an empirical model with no interface
     [substrate]

@@ -20,6 +20,7 @@ from ..rough_diffuse import RoughDiffuseBRDF
 from ..single_scatter import SingleScatterBRDF
 from ..slopes import GaussianSlopes
 from ..subsurface_facet import SubsurfaceFacetBRDF
+from ..thin_film import FilmStack
 from ..varnished import VarnishedCookTorranceBRDF
 
 __all__ = [
@@ -49,7 +50,7 @@ def mechanisms(substrate: dict | None, coating: dict | None, volume: dict | None
         out.append(
             Mechanism(
                 "rough coating surface",
-                FacetBRDF(slopes=rough_top, substrate=coat_n),
+                FacetBRDF(slopes=rough_top, substrate=coat_n, shadowing=coating.get("shadowing", "none")),
                 "the coating's top surface is rough: facet reflection by the exposed interface",
             )
         )
@@ -62,12 +63,19 @@ def facet_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
     """Facets (flakes or a rough substrate), under the coating when there is one."""
     if sub["slopes"] is None:
         return []  # a flat substrate only reflects specularly
+    kw = {
+        "slopes": sub["slopes"],
+        "substrate": sub["index"],
+        "shadowing": sub["params"].get("shadowing", "none"),
+    }
+    films = " with thin films on them" if isinstance(sub["index"], FilmStack) else ""
     if coat_n is not None:
-        model = SubsurfaceFacetBRDF(slopes=sub["slopes"], coating=coat_n, substrate=sub["index"])
-        why = "facets (flakes or a rough substrate) under the coating: seed 000's subsurface facet model"
+        model = SubsurfaceFacetBRDF(coating=coat_n, **kw)
+        why = f"facets (flakes or a rough substrate){films} under the coating: seed 000's subsurface facet model"
         return [Mechanism("subsurface facets", model, why)]
-    model = FacetBRDF(slopes=sub["slopes"], substrate=sub["index"])
-    return [Mechanism("exposed facets", model, "a rough substrate with no coating: the exposed facet model")]
+    model = FacetBRDF(**kw)
+    why = f"a rough substrate{films} with no coating: the exposed facet model"
+    return [Mechanism("exposed facets", model, why)]
 
 
 def cook_torrance_mechanisms(sub: dict, coat_n) -> list[Mechanism]:

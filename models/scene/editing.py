@@ -1,7 +1,8 @@
 """Dotted-key editing of a scene file's data (for fits and sweeps).
 
 A dotted key names a value of the file: ``substrate.sigma``, ``coating.index``,
-``coating.roughness.sigma``, ``substrate.index[1]`` (k of an ``[n, k]`` index).  These
+``coating.roughness.sigma``, ``substrate.index[1]`` (k of an ``[n, k]`` index),
+``substrate.film.layers[0].thickness_nm`` (a key of a table in an array of tables).  These
 functions work on the parsed TOML dict; the scene validates the edited dict again.
 """
 
@@ -40,8 +41,8 @@ def _locate(data, key, path):
     """``(table, name, index)`` of a dotted key: the table holding it, its name there, and the
     list index of a ``key[i]`` form (None otherwise)."""
     idx = None
-    if key.endswith("]") and "[" in key:
-        key, _, rest = key.partition("[")
+    if key.endswith("]") and "[" in key.rpartition(".")[2]:
+        key, _, rest = key.rpartition("[")
         try:
             idx = int(rest[:-1])
         except ValueError as exc:
@@ -49,9 +50,17 @@ def _locate(data, key, path):
     parts = key.split(".")
     node = data
     for p in parts[:-1]:
-        if not isinstance(node.get(p), dict):
+        name, _, pos = p.partition("[")
+        if pos:  # a table in an array of tables: substrate.film.layers[0].thickness_nm
+            items = node.get(name)
+            try:
+                node = items[int(pos.removesuffix("]"))] if isinstance(items, list) else None
+            except (ValueError, IndexError):
+                node = None
+        else:
+            node = node.get(p)
+        if not isinstance(node, dict):
             raise SceneError(f"{path}: {key}: no table [{p}] in the scene")
-        node = node[p]
     if parts[-1] not in node:
         raise SceneError(f"{path}: {key}: not set in the scene")
     return node, parts[-1], idx

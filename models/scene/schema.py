@@ -12,9 +12,12 @@ from __future__ import annotations
 import math
 
 from ..aperture import DetectorAperture
+from ..facet import FacetBRDF
+from ..params import check_index
 from ..point_source import PointSourceBRDF
 from ..polarization import stokes
 from ..subsurface_facet import SubsurfaceFacetBRDF
+from ..thin_film import FilmStack
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
 __all__ = ["SceneError", "parse", "check_structure", "polarization_state", "utf8_text", "MAX_DEPTH"]
@@ -25,7 +28,7 @@ MAX_DEPTH = 16
 
 _TOP = {"name", "description", "illumination", "coating", "substrate", "volume", "detector", "fit"}
 _ILLUM = {"theta_i_deg", "polarization", "wavelength_nm", "source", "distance_mm", "sample_radius_mm"}
-_SUBSTRATE_KEYS = {"index", "distribution", "model"} | {k for e in TABLE.values() for k in e.keys}
+_SUBSTRATE_KEYS = {"index", "distribution", "model", "film"} | {k for e in TABLE.values() for k in e.keys}
 #: the keys of the slope distributions (sigma, sigma_x, ..., coverage)
 _SLOPE_KEYS = {k for e in TABLE.values() if e.kind == "distribution" for k in e.keys}
 
@@ -94,7 +97,9 @@ def parse(data: dict, path: str) -> dict:
         raise _err(path, "[fit]", f"must be a table (free, noise, mask); got {_shown(data['fit'])}")
     out = {"name": name, **_illumination(path, data.get("illumination"))}
     out["coating"] = _coating(path, data["coating"]) if "coating" in data else None
-    out["substrate"] = _substrate(path, data["substrate"], data) if "substrate" in data else None
+    out["substrate"] = (
+        _substrate(path, data["substrate"], data, out["wavelength_nm"]) if "substrate" in data else None
+    )
     out["volume"] = _volume(path, data["volume"], out["coating"]) if "volume" in data else None
     out["detector"] = _detector(path, data["detector"]) if "detector" in data else None
     out["fit"] = data.get("fit")
@@ -213,7 +218,19 @@ def _coating(path, c):
         raise _err(path, "[coating] index", "required: a real index >= 1")
     out = {"index": _declared(path, "[coating] index", SubsurfaceFacetBRDF, "coating", c["index"])}
     if "roughness" in c:
-        out["roughness"] = _distribution(path, "[coating.roughness] ", c["roughness"])
+        rough = c["roughness"]
+        if not isinstance(rough, dict):
+            raise _err(path, "[coating.roughness]", "must be a table")
+        table = {k: v for k, v in rough.items() if k != "shadowing"}
+        out["roughness"] = _distribution(path, "[coating.roughness] ", table)
+        out["shadowing"] = "none"
+        if "shadowing" in rough:
+            key = "[coating.roughness] shadowing"
+            out["shadowing"] = _declared(path, key, FacetBRDF, "shadowing", rough["shadowing"])
+            try:  # the choice with these slopes (Smith needs isotropic or elliptical ones)
+                FacetBRDF(slopes=out["roughness"], substrate=out["index"], shadowing=out["shadowing"])
+            except ValueError as exc:
+                raise _err(path, key, str(exc)) from exc
     return out
 
 
@@ -257,16 +274,18 @@ def _index(path, key, value):
     raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {_shown(value)}')
 
 
-def _substrate(path, s, data):
+def _substrate(path, s, data, wavelength_nm):
     _unknown(path, "[substrate] ", s, _SUBSTRATE_KEYS)
     kind = s.get("model", "facet")
     if kind not in SUBSTRATE_MODELS:
         raise _err(path, "[substrate] model", f"must be one of {', '.join(SUBSTRATE_MODELS)}; got {kind!r}")
     entry = TABLE[kind]
-    for other in SUBSTRATE_MODELS:
-        for k in TABLE[other].keys:
-            if k in s and k not in entry.keys:
-                raise _err(path, f"[substrate] {k}", f"only for model = {other!r}")
+    for k in sorted(set(s) - set(entry.keys)):
+        owners = [repr(m) for m in SUBSTRATE_MODELS if k in TABLE[m].keys]
+        if owners:
+            raise _err(path, f"[substrate] {k}", f"only for model = {' or '.join(owners)}")
+    if "film" in s and kind != "facet":
+        raise _err(path, "[substrate.film]", f"only for model = 'facet' (films on facets); not for {kind!r}")
     if "index" not in s:
         raise _err(path, "[substrate] index", 'required: n, [n, k] or "inf"')
     index = _declared(
@@ -286,9 +305,11 @@ def _substrate(path, s, data):
             path, "[substrate] distribution", f"required for model = {kind!r} (the specular facet term)"
         )
     _slope_keys_apply(path, s, kind, entry)
+    if "film" in s:
+        index = _film(path, s["film"], index, wavelength_nm)
     out = {"index": index, "model": kind, "entry": entry, "slopes": None, "params": {}}
     if entry.slopes != "ignored" and "distribution" in s:
-        dist = {k: v for k, v in s.items() if k not in entry.keys and k not in ("index", "model")}
+        dist = {k: v for k, v in s.items() if k not in entry.keys and k not in ("index", "model", "film")}
         out["slopes"] = _distribution(path, "[substrate] ", dist)
     if entry.keys:
         given = {"slopes": out["slopes"]} if out["slopes"] is not None else {}
@@ -297,8 +318,54 @@ def _substrate(path, s, data):
     return out
 
 
+def _film(path, film, substrate, wavelength_nm):
+    """``[substrate.film]``: thin films on the substrate/flakes (:class:`models.FilmStack`),
+    ``layers = [{index = [n, k], thickness_nm = d}, ...]`` from the incident side down, at
+    ``[illumination] wavelength_nm``."""
+    _unknown(path, "[substrate.film] ", film, {"layers"})
+    if wavelength_nm is None:
+        raise _err(
+            path,
+            "[illumination] wavelength_nm",
+            "required with [substrate.film]: the films' phase thicknesses depend on the wavelength",
+        )
+    layers = film.get("layers")
+    if not isinstance(layers, list) or not layers:
+        raise _err(
+            path,
+            "[substrate.film] layers",
+            f"required: a non-empty array of tables {{index = [n, k], thickness_nm = d}}; got {_shown(layers)}",
+        )
+    out = []
+    for j, layer in enumerate(layers):
+        key = f"[substrate.film] layers[{j}]"
+        if not isinstance(layer, dict):
+            raise _err(
+                path, key, f"must be a table {{index = [n, k], thickness_nm = d}}; got {_shown(layer)}"
+            )
+        _unknown(path, f"{key}.", layer, {"index", "thickness_nm"})
+        for k, what in (("index", "n or [n, k] (finite)"), ("thickness_nm", "a number >= 0")):
+            if k not in layer:
+                raise _err(path, f"{key}.{k}", f"required: {what}")
+        n = _index(path, f"{key}.index", layer["index"])
+        try:
+            n = check_index("index", n)
+        except ValueError as exc:
+            raise _err(path, f"{key}.index", str(exc)) from exc
+        if n == math.inf:
+            raise _err(path, f"{key}.index", 'a film has a finite index n or [n, k], not "inf"')
+        out.append((n, _number(path, f"{key}.thickness_nm", layer["thickness_nm"], 0.0)))
+    return FilmStack(layers=tuple(out), substrate=substrate, wavelength_nm=wavelength_nm)
+
+
 def _slope_keys_apply(path, s, kind, entry):
     """A slope key (or ``distribution``) in ``[substrate]`` only where it sets the slopes."""
+    if kind == "facet" and "shadowing" in s and "distribution" not in s:
+        raise _err(
+            path,
+            "[substrate] shadowing",
+            "only with a slope distribution (distribution = ...); a flat substrate casts no shadows",
+        )
     for k in sorted(set(s) & (_SLOPE_KEYS | {"distribution"})):
         if entry.slopes == "ignored":
             raise _err(
@@ -335,6 +402,13 @@ def _volume(path, v, coating):
     if out["rho"] == 0 and not out["single"]:
         raise _err(path, "[volume]", "declares no scattering: set rho > 0 or single = true")
     monte_carlo = coating.get("roughness") is not None and interface == "rough"
+    if monte_carlo and coating.get("shadowing", "none") != "none":
+        raise _err(
+            path,
+            "[coating.roughness] shadowing",
+            "not with a [volume] under the rough coating (interface = 'rough'): its Monte Carlo model "
+            "carries the rough surface's reflection and has no shadowing; use interface = 'smooth' or omit it",
+        )
     for key in ("pairs", "seed"):
         if key in v and not monte_carlo:
             raise _err(

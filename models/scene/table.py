@@ -23,10 +23,12 @@ from ..rough_diffuse import RoughDiffuseBRDF
 from ..slopes import (
     AnisotropicExponentialSlopes,
     AnisotropicGaussianSlopes,
+    AnisotropicGGXSlopes,
     ExponentialAngles,
     ExponentialSlopes,
     GaussianAngles,
     GaussianSlopes,
+    GGXSlopes,
 )
 from ..varnished import VarnishedCookTorranceBRDF
 from .assembly import cook_torrance_mechanisms, facet_mechanisms, maxwell_beard_mechanisms
@@ -93,10 +95,16 @@ TABLE = {
     "anisotropic-gaussian": _slopes(AnisotropicGaussianSlopes, *_ANISOTROPIC, required=_ANISOTROPIC[:2]),
     "gaussian-angle": _slopes(GaussianAngles, "sigma_deg", required=("sigma_deg",)),
     "exponential-angle": _slopes(ExponentialAngles, "sigma_deg", required=("sigma_deg",)),
+    # GGX (Trowbridge-Reitz): a width alpha, not an rms slope (GGX's is infinite)
+    "ggx": _slopes(GGXSlopes, "alpha", required=("alpha",)),
+    "anisotropic-ggx": _slopes(
+        AnisotropicGGXSlopes, "alpha_x", "alpha_y", "rotation_deg", required=("alpha_x", "alpha_y")
+    ),
     # [substrate] model = ...: "facet" takes its slopes from `distribution` (none: a flat
     # substrate); Cook-Torrance its own roughness, m (both m values) or m_parallel and
     # m_perpendicular (Eq. 19); Maxwell-Beard its specular facets' from `distribution`.
-    "facet": Entry("model", FacetBRDF, mechanisms=facet_mechanisms),
+    # "facet" also takes `shadowing` (none | smith | smith-correlated, the facet models')
+    "facet": Entry("model", FacetBRDF, ("shadowing",), mechanisms=facet_mechanisms),
     "cook-torrance": Entry(
         "model",
         VarnishedCookTorranceBRDF,
@@ -159,7 +167,7 @@ def build(name: str, table: dict, **given):
     for key in entry.keys:
         if key in table:
             if isinstance(table[key], bool) and key not in entry.flags:
-                raise KeyProblem(key, f"must be a number, not {str(table[key]).lower()}")
+                raise KeyProblem(key, _bool_refused(entry.cls, key, table[key]))
             kwargs[parameter(key)] = _file_value(key, table[key])
     for key, value in entry.defaults.items():
         if key not in kwargs and _target(entry.cls, key) not in kwargs:
@@ -170,6 +178,18 @@ def build(name: str, table: dict, **given):
         raise KeyProblem(_key_named(str(exc), entry), str(exc) + _degrees_note(exc, entry, table)) from exc
     targets = dict.fromkeys(_target(entry.cls, parameter(k)) for k in entry.keys)
     return instance, {t: getattr(instance, t) for t in targets}
+
+
+def _bool_refused(cls, key, value):
+    """Why ``true``/``false`` is no value for ``key``: its declared range (a choice says which
+    names it takes), else that it must be a number."""
+    info = next((i for i in cls.parameters() if i.name == parameter(key)), None)
+    if info is not None and info.kind == "choice":
+        try:
+            cls.check_parameter(info.name, value)
+        except ValueError as exc:
+            return str(exc)
+    return f"must be a number, not {str(value).lower()}"
 
 
 def _file_value(key, value):

@@ -5,7 +5,7 @@ Importing the package registers every check; the import order below is the run o
 
 # isort: off
 from . import registry
-from . import seed000, fitting, seed001, seed003, stability
+from . import seed000, fitting, seed001, seed003, shadowing, stability
 # isort: on
 
-__all__ = ["registry", "seed000", "fitting", "seed001", "seed003", "stability"]
+__all__ = ["registry", "seed000", "fitting", "seed001", "seed003", "shadowing", "stability"]

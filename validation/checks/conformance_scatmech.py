@@ -24,7 +24,7 @@ from .conformance import claims, model_check, skipped, verdict, where
 
 __all__ = ["SCATMECH_TOL", "committed_cases", "matching_cases", "normalized"]
 
-#: max |M - M_scatmech| / M00, as the registry's SCATMECH checks
+#: max ``|M - M_scatmech| / M00``, as the registry's SCATMECH checks
 SCATMECH_TOL = 1e-6
 #: below this SCATMECH M00 a case is compared absolutely (as validation.checks.seed003)
 _FLOOR = 1e-250

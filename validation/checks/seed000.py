@@ -90,7 +90,7 @@ def check_slope_conversions(ctx):
 
 # ----------------------------------------------------------------------------- SCATMECH
 def scatmech_facet_errors():
-    """Per-case max |M - M_scatmech| / M00 over the committed references, by model."""
+    """Per-case max ``|M - M_scatmech| / M00`` over the committed references, by model."""
     ref = references.scatmech_facet()
     errs = {"facet": [], "subsurface": []}
     for i in range(len(ref["model"])):

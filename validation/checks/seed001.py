@@ -58,7 +58,7 @@ def _rel_where_both(a, b):
 
 # ------------------------------------------------------------------ model vs model
 def ct_vs_facet_error(n=20000, seed=0):
-    """Max relative |CT(energy, no G) - FacetBRDF(Gaussian sigma=m).M00| where both
+    """Max relative ``|CT(energy, no G) - FacetBRDF(Gaussian sigma=m).M00|`` where both
     are non-zero, and the number of geometries where exactly one is zero."""
     ti, tr, pr = _geoms(n, seed)
     worst, mism, live = 0.0, 0, 0
@@ -74,7 +74,7 @@ def ct_vs_facet_error(n=20000, seed=0):
 
 
 def published_over_energy_error(n=20000):
-    """Max relative |paper / corrected / (4 pi) - 1|; for the varnished model the corrected
+    """Max relative ``|paper / corrected / (4 pi) - 1|``; for the varnished model the corrected
     form also carries the refraction Jacobian, divided out here."""
     ti, tr, pr = _geoms(n, 1)
     worst = 0.0
@@ -92,7 +92,7 @@ def published_over_energy_error(n=20000):
 
 
 def stroke_vs_facet_error(n=20000, seed=2):
-    """Max relative |Varnished(n_v = 1, energy, G = 1) - FacetBRDF(StrokeSlopes)| where both
+    """Max relative ``|Varnished(n_v = 1, energy, G = 1) - FacetBRDF(StrokeSlopes)|`` where both
     are non-zero (``inf`` if one model alone is zero somewhere): the Eq. 19 slope density."""
     ti, tr, pr = _geoms(n, seed)
     worst = 0.0
@@ -138,7 +138,7 @@ def check_ct_vs_facet(ctx):
 
 # ------------------------------------------------------------------ Fresnel
 def fresnel_real_error():
-    """Max |Eq. 13-16 (corrected) - complex Fresnel| for F_s and F_p, all angles."""
+    """Max ``|Eq. 13-16 (corrected) - complex Fresnel|`` for F_s and F_p, all angles."""
     c = np.linspace(0.0, 1.0, 20001)
     worst = 0.0
     for N in (IRON, IRON / 1.5, 1.37 + 7.62j, 0.2 + 3.0j, 3.88 + 0.02j, 1.5, 1.0 / 1.5, 1.0001, 1.0, 4.0):
@@ -569,7 +569,7 @@ def check_extremes(ctx):
 
 # ------------------------------------------------------------------ point source
 def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_deg=17.0, resolution=8):
-    """Max |f_g - f| / max f over an in-plane section, per source distance (R = 1)."""
+    """Max ``|f_g - f| / max f`` over an in-plane section, per source distance (R = 1)."""
     base = _energy_published(models.VarnishedCookTorranceBRDF())
     tr = np.radians(np.linspace(0, 60, 241))
     ti = math.radians(ti_deg)

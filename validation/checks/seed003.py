@@ -296,7 +296,7 @@ _GEOM = (
 
 
 def mc_convergence_z(sigma=0.001, pairs=2000, seed=0, polarized=True):
-    """max |M_MC - (Single + Diffuse)| / SE over elements with SE > 0 (surface=False)."""
+    """max ``|M_MC - (Single + Diffuse)| / SE`` over elements with SE > 0 (surface=False)."""
     ph = models.HenyeyGreenstein(0.3, polarized=polarized)
     ref = models.SingleScatterBRDF(coating=1.5, phase=ph) + models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.3)
     m = models.RoughDiffuseBRDF(

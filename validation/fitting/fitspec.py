@@ -25,7 +25,8 @@ BRDF-only fit of polarimetric data: ``--noise eta_deg=off --noise P=off
 A free entry is ``KEY:LOW:HIGH[:PRIOR]`` with ``PRIOR`` ``uniform`` (default)
 or ``log`` (log-uniform, ``LOW > 0``).  ``KEY`` is a dotted key of the scene
 file (``substrate.index[1]`` is k of an ``[n, k]`` index) or, for the
-coated-flake scenes, a short alias: ``sigma`` = ``substrate.sigma``,
+coated-flake scenes, a short alias: ``sigma`` = ``substrate.sigma`` (``alpha`` =
+``substrate.alpha`` for GGX slopes),
 ``coating`` = ``coating.index``, ``n`` = ``substrate.index[0]``, ``k`` =
 ``substrate.index[1]``.  Free noise terms are named ``noise.brdf``,
 ``noise.eta_deg``, ``noise.P``, ``noise.P_C``.
@@ -56,6 +57,7 @@ __all__ = [
 
 ALIASES = {
     "sigma": "substrate.sigma",
+    "alpha": "substrate.alpha",
     "coating": "coating.index",
     "n": "substrate.index[0]",
     "k": "substrate.index[1]",

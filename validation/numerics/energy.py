@@ -18,6 +18,21 @@ The model's integrated reflectance is bounded by ``H``, not by 1, and can exceed
 1 near grazing incidence on rough exposed surfaces.  This is a property of the
 model (SCATMECH's ``Facet_BRDF_Model`` behaves identically), reported as such.
 
+Since ``integral P3 zeta_x d^2 zeta = 0``, ``H = C (1 + Lambda(cot theta_i'))`` with
+``Lambda`` Smith's function of the slopes along the beam's azimuth
+(:mod:`models.shadowing`): the separable Smith ``G1 = 1 / (1 + Lambda)`` is exactly the
+factor that brings ``H`` back to ``C``.  The tests hold the quadrature here to that
+identity; nothing here uses it.
+
+Truncation of the slope plane.  The radial integrals stop at ``60 scale`` for the
+light-tailed families (exponential, Gaussian, angle distributions: their mass beyond
+is below ``exp(-60 sqrt 6)``).  GGX slopes have no rms slope and a power-law tail,
+``P3 <= C b^2 / (pi zeta^4)`` with ``b^2 = max(ax, ay)^4 / (ax ay)`` (``b = alpha``
+isotropic), so the hit-fraction integrand beyond a radius ``R`` holds at most
+``C b^2 (1 / R^2 + 4 tan / (pi R))`` (the ``1`` and the ``tan |zeta_x|`` parts of
+``(1 - tan zeta_x)_+``).  The radius is derived from that bound, not typed: the
+smallest geometric panel edge where it is below :data:`TAIL_TOL`.
+
 For an exposed surface (coating 1) and unpolarized light the integrated
 reflectance has a closed slope-space form, since unpolarized light stays
 unpolarized in the facet's own s/p frame:
@@ -32,13 +47,36 @@ import math
 import numpy as np
 
 from models.fresnel import fresnel_reflectance
+from models.slopes import AnisotropicGGXSlopes, GGXSlopes
 
-__all__ = ["hit_fraction", "exposed_reflectance"]
+__all__ = ["hit_fraction", "exposed_reflectance", "tail_radius", "TAIL_TOL"]
+
+#: bound on the part of a power-law (GGX) slope density's integrals left beyond the
+#: truncation radius (module docstring)
+TAIL_TOL = 1e-12
 
 
-def _radial_nodes(scale, rho_max, n=64):
-    """Gauss-Legendre nodes on [0, rho_max] split at geometric breakpoints of ``scale``."""
+def tail_radius(slopes, tan=0.0):
+    """The radius beyond which the hit-fraction integrand of power-law (GGX) slopes holds
+    at most :data:`TAIL_TOL` (module docstring), for a beam at ``tan(theta_i')``; None for
+    the light-tailed families (their integrals stop at ``60 scale``)."""
+    if isinstance(slopes, GGXSlopes):
+        b2 = slopes.alpha**2
+    elif isinstance(slopes, AnisotropicGGXSlopes):
+        b2 = max(slopes.alpha_x, slopes.alpha_y) ** 4 / (slopes.alpha_x * slopes.alpha_y)
+    else:
+        return None
+    c = slopes.coverage * b2
+    # C b^2 / R^2 <= TAIL_TOL / 2 and 4 C b^2 tan / (pi R) <= TAIL_TOL / 2
+    return max(math.sqrt(2.0 * c / TAIL_TOL), 8.0 * c * tan / (math.pi * TAIL_TOL))
+
+
+def _radial_nodes(scale, rho_max, n=64, outer=None):
+    """Gauss-Legendre nodes on [0, rho_max] split at geometric breakpoints of ``scale``
+    (continued by factors of 2.5 up to ``outer`` when given: :func:`tail_radius`)."""
     edges = [0.0] + [scale * f for f in (0.1, 0.5, 1.5, 4.0, 10.0, 25.0, 60.0)]
+    while outer is not None and edges[-1] < outer:
+        edges.append(edges[-1] * 2.5)
     x, w = np.polynomial.legendre.leggauss(n)
     nodes, weights = [], []
     for a, b in zip(edges[:-1], edges[1:], strict=True):
@@ -57,14 +95,31 @@ def _azimuths(n=256):
 
 
 def hit_fraction(slopes, theta_i, coating=1.0):
-    """``H(theta_i)``: mean illuminated facet area per unit beam footprint (see module doc)."""
+    """``H(theta_i)``: mean illuminated facet area per unit beam footprint (see module doc).
+
+    Elliptical slopes (an isotropic density stretched by ``sigma_x``, ``sigma_y`` along
+    axes rotated by ``rotation``) are integrated in the unstretched coordinates, where
+    ``zeta_x`` is ``alpha_b`` times one coordinate, ``alpha_b^2 = (sigma_x cos rotation)^2 +
+    (sigma_y sin rotation)^2``: ``H`` is ``C`` times the isotropic unit density's at
+    ``tan(theta_i') alpha_b`` (an exact change of variables, so a 1e5:1 anisotropy needs no
+    finer azimuthal grid).
+    """
     ti = math.asin(math.sin(theta_i) / coating)
     tan = math.tan(ti)
+    if hasattr(slopes, "_isotropic_unit"):
+        alpha_b = math.hypot(
+            slopes.sigma_x * math.cos(slopes.rotation), slopes.sigma_y * math.sin(slopes.rotation)
+        )
+        return slopes.coverage * _hit_fraction(slopes._isotropic_unit(), tan * alpha_b)
+    return _hit_fraction(slopes, tan)
+
+
+def _hit_fraction(slopes, tan):
     psi, wp = _azimuths()
     c = np.cos(psi)
     with np.errstate(divide="ignore"):
         rho_hit = np.where(c * tan > 0, 1.0 / np.where(c * tan > 0, c * tan, 1.0), np.inf)
-    rho, wr = _radial_nodes(slopes.scale, rho_hit)
+    rho, wr = _radial_nodes(slopes.scale, rho_hit, outer=tail_radius(slopes, tan))
     zx = rho * c[:, None]
     zy = rho * np.sin(psi)[:, None]
     f = slopes.p3(zx, zy) * np.maximum(1.0 - tan * zx, 0.0) * rho
@@ -83,7 +138,7 @@ def exposed_reflectance(slopes, theta_i, substrate):
     # reflected ray upward: cos(ti) rho^2 + 2 sin(ti) cos(psi) rho - cos(ti) < 0
     b = si * c
     rho_up = (-b + np.sqrt(b * b + ci * ci)) / ci
-    rho, wr = _radial_nodes(slopes.scale, np.minimum(rho_hit, rho_up))
+    rho, wr = _radial_nodes(slopes.scale, np.minimum(rho_hit, rho_up), outer=tail_radius(slopes, tan))
     zx = rho * c[:, None]
     zy = rho * np.sin(psi)[:, None]
     norm = np.sqrt(1.0 + zx * zx + zy * zy)

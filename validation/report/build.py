@@ -13,7 +13,8 @@ from validation.atomic import atomic_write_json, atomic_write_text
 from validation.checks.registry import SEED, check_record, judge, select, tally
 
 from .core import Context, Section, render_html
-from .sections import SECTION_FUNCS, _git_commit, report_checks
+from .provenance import git_commit
+from .sections import SECTIONS, report_checks
 
 __all__ = ["build_report", "write_report", "read_results", "read_results_checked"]
 
@@ -48,31 +49,32 @@ def _context(context, quick, previous, seed):
     return context
 
 
-def _run_sections(ctx, funcs):
-    """Compute ``funcs`` (summary last: it shows every check and failure); a section
-    that raises is kept with its error and recorded in ``ctx.cache["section_failures"]``."""
-    order = [f for f in funcs if f.__name__ not in ("section_summary", "section_provenance")]
-    order += [f for f in funcs if f.__name__ == "section_provenance"]
-    order += [f for f in funcs if f.__name__ == "section_summary"]
+def _run_one(ctx, spec):
+    """``spec`` computed and rendered; if either raises, the section keeps its error and the
+    failure is recorded in ``ctx.cache["section_failures"]``."""
+    sec = Section(spec.id, spec.title)
+    t = time.perf_counter()
+    try:
+        spec.render(sec, spec.compute(ctx))
+    except Exception as exc:  # a broken section must not lose the rest of the report
+        sec = Section(spec.id, spec.title, error=f"{type(exc).__name__}: {exc}")
+        ctx.cache["section_failures"].append(_section_failure(spec.id))
+    sec.seconds = time.perf_counter() - t
+    ctx.cache["section_times"][spec.id] = sec.seconds
+    return sec
+
+
+def _run_sections(ctx, specs):
+    """Every section of ``specs`` by stage (page order within one); returns them in page order."""
+    ctx.cache.setdefault("section_times", {})
+    ctx.cache.setdefault("section_failures", [])
     done = {}
-    times = ctx.cache.setdefault("section_times", {})
-    failures = ctx.cache.setdefault("section_failures", [])
-    with _progress(len(order), "report") as bar:
-        for fn in order:
-            name = fn.__name__.removeprefix("section_")
-            bar.set_postfix_str(name)
-            t = time.perf_counter()
-            try:
-                sec = fn(ctx)
-            except Exception as exc:  # a broken section must not lose the rest of the report
-                sec = Section(name, name, error=f"{type(exc).__name__}: {exc}")
-                sec.blocks = []
-                failures.append(_section_failure(name))
-            sec.seconds = time.perf_counter() - t
-            times[name] = sec.seconds
-            done[fn.__name__] = sec
+    with _progress(len(specs), "report") as bar:
+        for spec in sorted(specs, key=lambda sp: sp.stage):
+            bar.set_postfix_str(spec.id)
+            done[spec.id] = _run_one(ctx, spec)
             bar.update(1)
-    return [done[f.__name__] for f in funcs]
+    return [done[spec.id] for spec in specs]
 
 
 def build_report(
@@ -81,7 +83,7 @@ def build_report(
     """Run every section; returns ``(results, html)``.  A section that raises is kept
     on the page with its error and counts as a failed check; the others still run.
 
-    ``only``: names of the sections to compute (summary and provenance always run);
+    ``only``: ids of the sections to compute (summary and provenance always run);
     ``extra_scenes``: scene files shown beside the built-in examples;
     ``checks``: ids of the registered checks the summary judges (default: every one,
     less the slow ones in a quick run: the set ``validate`` judges);
@@ -93,18 +95,14 @@ def build_report(
     if checks is not None:
         ctx.cache["check_specs"] = select(checks)
     t0 = time.perf_counter()
-    funcs = [
-        f
-        for f in SECTION_FUNCS
-        if only is None or f.__name__.removeprefix("section_") in set(only) | {"summary", "provenance"}
-    ]
-    sections = _run_sections(ctx, funcs)
+    wanted = None if only is None else set(only) | {"summary", "provenance"}
+    sections = _run_sections(ctx, [sp for sp in SECTIONS if wanted is None or sp.id in wanted])
     # every check is counted even if the summary section itself failed to draw them
     checks = report_checks(ctx) + ctx.cache["section_failures"]
     summary = tally(checks)
     meta = {
         "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
-        "git_commit": _git_commit(),
+        "git_commit": git_commit(),
         "quick": quick,
         "seed": seed,
         "seconds": time.perf_counter() - t0,

@@ -1,6 +1,8 @@
 """Report building blocks: sections, blocks, rendering, results.json.
 
-A section is computed by a function ``f(ctx) -> Section``.  Everything a page
+A section is declared by a :class:`SectionSpec`: ``compute(ctx)`` returns a small
+frozen dataclass of the numbers it shows (no figures, no HTML), and
+``render(section, data)`` draws and tabulates only from it.  Everything a page
 shows comes from the section's blocks, and every number in a table block is
 also stored in ``results.json`` (``numbers``), so the page and the JSON are
 one set of values.  ``tracked`` numbers carry a tolerance: ``nightly`` flags a
@@ -12,6 +14,7 @@ from __future__ import annotations
 import base64
 import io
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import jinja2
@@ -20,9 +23,11 @@ from validation.checks.registry import CheckContext
 
 __all__ = [
     "Section",
+    "SectionSpec",
     "Context",
     "figure_block",
     "table_block",
+    "store_rows",
     "text_block",
     "checks_block",
     "render_html",
@@ -61,6 +66,23 @@ class Section:
         }
 
 
+@dataclass(frozen=True)
+class SectionSpec:
+    """One section of the page: ``compute(ctx) -> data`` (a frozen dataclass of numbers)
+    and ``render(section, data)``, which fills the section's blocks, numbers and tracked
+    values from ``data`` alone.
+
+    ``stage``: sections run in increasing stage (page order within one); provenance
+    (stage 1) shows the others' run times, the summary (stage 2) their failures.
+    """
+
+    id: str
+    title: str
+    compute: Callable
+    render: Callable
+    stage: int = 0
+
+
 def _clean(v):
     if isinstance(v, float) and not math.isfinite(v):
         return None
@@ -81,11 +103,18 @@ def figure_block(fig, caption, dpi=90):
     }
 
 
+def store_rows(section, key, columns, rows):
+    """Store ``rows`` (their ``columns``, non-finite numbers as None) in ``section.numbers[key]``
+    and return them: results.json's list of row dicts, whether or not a table shows it."""
+    clean_rows = [{c: _clean(r.get(c)) for c in columns} for r in rows]
+    section.numbers[key] = clean_rows
+    return clean_rows
+
+
 def table_block(section, key, columns, rows, caption="", fmt=None):
     """A table whose cells are also stored in ``section.numbers[key]`` (list of row dicts)."""
     fmt = fmt or {}
-    clean_rows = [{c: _clean(r.get(c)) for c in columns} for r in rows]
-    section.numbers[key] = clean_rows
+    clean_rows = store_rows(section, key, columns, rows)
     shown = []
     for r in clean_rows:
         cells = []

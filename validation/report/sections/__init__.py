@@ -1,0 +1,58 @@
+"""The report's sections, one module each, and :data:`SECTIONS`, the page in order.
+
+Each module has ``compute(ctx)``, which returns a small frozen dataclass of the
+numbers the section shows (computed by the run, nothing typed in; shared with
+the checks through ``ctx.compute``), and ``render(section, data)``, which only
+draws and tabulates from it.
+"""
+
+from __future__ import annotations
+
+from ..core import SectionSpec
+from . import (
+    conservation,
+    model_comparison,
+    provenance,
+    scatmech,
+    scenes,
+    seed000,
+    seed001,
+    seed003_fig1,
+    seed003_presets,
+    speed,
+    stability,
+    summary,
+    table1,
+    thin_film,
+    uncertainty,
+)
+from .summary import report_checks
+
+__all__ = ["SECTIONS", "report_checks"]
+
+
+def _spec(sid, title, module, stage=0):
+    return SectionSpec(sid, title, module.compute, module.render, stage)
+
+
+#: the page, in order; the summary runs last (it shows every check and every section that
+#: raised), provenance just before it (it shows the others' run times)
+SECTIONS = (
+    _spec("summary", "Summary: every check", summary, stage=2),
+    _spec("table1", "Seed 000 Table I: paper, scatterbench, SCATMECH", table1),
+    _spec("seed000", "Seed 000 Fig. 2 and Fig. 3 reproduced", seed000),
+    _spec("conservation", "Conservation: reciprocity and albedo", conservation),
+    _spec("scatmech", "Agreement with SCATMECH", scatmech),
+    _spec("seed003_fig1", "Seed 003 Fig. 1 reproduced: Snell shift of facet transmission", seed003_fig1),
+    _spec("seed003_presets", "Seed 003 Fig. 2-3: preset model curves beside Maxwell-Beard", seed003_presets),
+    _spec("seed001", "Seed 001: published vs energy Cook-Torrance, varnish, point source", seed001),
+    _spec("thin_film", "Beyond the seeds: thin-film interference flakes and their colour travel", thin_film),
+    _spec("uncertainty", "Uncertainty: an example posterior and the recovery coverage", uncertainty),
+    _spec(
+        "model_comparison", "Model comparison: seed 003's combination against Maxwell-Beard", model_comparison
+    ),
+    _spec("speed", "Speed and accuracy", speed),
+    _spec("stability", "Stability sweep at the extremes", stability),
+    _spec("scenes", "Scenes and the mechanisms they build", scenes),
+    _spec("provenance", "Provenance", provenance, stage=1),
+)
