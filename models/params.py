@@ -140,7 +140,10 @@ def check_real(name, value, low=None, high=None, low_open=False, high_open=False
     rng = _range_text(low, high, low_open, high_open)
     if _is_array(value):
         return _check_real_array(name, value, rng, low, high, low_open, high_open)
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if isinstance(value, (bool, np.bool_)):
+        # bool is a numbers.Real subclass: True would silently become 1.0
+        raise ValueError(f"{name} must be {rng}; got {value!r} (a bool is not a number)")
+    if not isinstance(value, numbers.Real):
         if isinstance(value, numbers.Complex) and complex(value).imag == 0:
             value = complex(value).real
         else:
@@ -196,7 +199,7 @@ def check_index(name, value):
         if not np.all(ok | pec):
             _first_bad(name, rng, z, ~(ok | pec))
         return _frozen(z.real + 1j * np.abs(z.imag))
-    if isinstance(value, bool) or not isinstance(value, numbers.Complex):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Complex):
         raise ValueError(f"{name} must be {rng}; got {value!r}")
     z = complex(value)
     if z.real == math.inf and z.imag == 0:
@@ -418,7 +421,7 @@ def _checked(name, value, info):
     if kind == "real":
         return check_real(name, value, info["low"], info["high"], info["low_open"], info["high_open"])
     if kind == "int":
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
             raise ValueError(f"{name} must be an integer; got {value!r}")
         check_real(name, value, info["low"], info["high"], info["low_open"], info["high_open"])
         return int(value)
