@@ -33,6 +33,10 @@ import numpy as np
 #: algebra itself overflows near |n + ik| ~ 1e77, where |n|^4 leaves the float64 range.)
 INDEX_MAX = 4.0 / sys.float_info.epsilon
 
+#: Smallest index magnitude: r differs from its |n + ik| -> 0 limit by about 2 |n + ik|, below
+#: double precision under eps / 4 (the same argument; the algebra divides by n^2 there).
+INDEX_MIN = 1.0 / INDEX_MAX
+
 #: Narrowest declared slope width (rms slope, GGX alpha, angular width).  A slope computed
 #: from two directions (the half vector's x/z, y/z) carries a rounding error dz of a few eps
 #: (~1e-15).  Inside a lobe of width w (|z| <= 3 w) a Gaussian's logarithm moves by
@@ -48,6 +52,7 @@ SLOPE_WIDTH_MAX = 1e8
 
 __all__ = [
     "INDEX_MAX",
+    "INDEX_MIN",
     "SLOPE_WIDTH_MIN",
     "SLOPE_WIDTH_MAX",
     "width_param",
@@ -83,7 +88,8 @@ class ParamInfo:
     def range_text(self) -> str:
         if self.kind == "index":
             return (
-                f"n + ik with n > 0, k >= 0 and |n + ik| <= {INDEX_MAX:.3g}, or math.inf (perfect conductor)"
+                f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= |n + ik| <= {INDEX_MAX:.3g}, "
+                "or math.inf (perfect conductor)"
             )
         if self.kind == "real_index":
             return f"real, finite, in [{self.low:g}, {INDEX_MAX:.3g}]"
@@ -225,7 +231,7 @@ def check_index(name, value):
     conductor).
     """
     rng = (
-        f"n + ik with n > 0, k >= 0 and |n + ik| <= {INDEX_MAX:.3g} (beyond it the reflectance is "
+        f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= |n + ik| <= {INDEX_MAX:.3g} (above the upper bound the reflectance is "
         "a perfect conductor's to double precision), or math.inf for a perfect conductor"
     )
     if _is_array(value):
@@ -235,7 +241,7 @@ def check_index(name, value):
         pec = (z.real == math.inf) & (z.imag == 0)
         with np.errstate(invalid="ignore"):
             ok = np.isfinite(z.real) & np.isfinite(z.imag) & (z.real > 0) & (z.imag >= 0)
-            ok &= np.abs(z) <= INDEX_MAX
+            ok &= (np.abs(z) >= INDEX_MIN) & (np.abs(z) <= INDEX_MAX)
         if not np.all(ok | pec):
             _first_bad(name, rng, z, ~(ok | pec))
         return _frozen(z.real + 1j * np.abs(z.imag))
@@ -246,7 +252,7 @@ def check_index(name, value):
         return math.inf
     if not (math.isfinite(z.real) and math.isfinite(z.imag)):
         raise ValueError(f"{name} must be {rng}; got {value!r}")
-    if z.real <= 0 or z.imag < 0 or abs(z) > INDEX_MAX:
+    if z.real <= 0 or z.imag < 0 or not INDEX_MIN <= abs(z) <= INDEX_MAX:
         raise ValueError(f"{name} must be {rng}; got {value!r}")
     return complex(z.real, abs(z.imag))
 

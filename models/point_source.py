@@ -140,8 +140,19 @@ class PointSourceBRDF(_Wrapper):
         Phi = np.arctan2(Y, X)
         c = np.cos(psi)
         w = wa[None, :] * c * c * c  # irradiance cos^3(psi) / d^2 times dA
+        total = w.sum(axis=1, keepdims=True)
+        if not np.all(np.isfinite(total) & (total > 0)):
+            w = self._rescaled_weights(rho, d)
         w /= w.sum(axis=1, keepdims=True)
         return psi, Phi, w
+
+    def _rescaled_weights(self, rho, d):
+        """The weights ``dA cos^3(psi)`` up to a factor per row, for a disc whose area (R^2)
+        or cosine falloff (d / rho) leaves the float64 range: only their ratios matter."""
+        wa = disc_quadrature(self.resolution, 1.0)[2]
+        c = d / np.hypot(rho, d)
+        c = c / c.max(axis=1, keepdims=True)
+        return wa[None, :] * c * c * c
 
     def incidence_range(self, theta_i):
         """``(psi_min, psi_max)`` of the incidence over the sample (radians)."""
