@@ -88,7 +88,7 @@ class ParamInfo:
     def range_text(self) -> str:
         if self.kind == "index":
             return (
-                f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= |n + ik| <= {INDEX_MAX:.3g}, "
+                f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= abs(n + ik) <= {INDEX_MAX:.3g}, "
                 "or math.inf (perfect conductor)"
             )
         if self.kind == "real_index":
@@ -231,7 +231,7 @@ def check_index(name, value):
     conductor).
     """
     rng = (
-        f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= |n + ik| <= {INDEX_MAX:.3g} (above the upper bound the reflectance is "
+        f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= abs(n + ik) <= {INDEX_MAX:.3g} (above the upper bound the reflectance is "
         "a perfect conductor's to double precision), or math.inf for a perfect conductor"
     )
     if _is_array(value):
