@@ -131,7 +131,8 @@ class PointSourceBRDF(_Wrapper):
         """``(psi, Phi, w)``, each ``(n_geom, K)``: incidence polar angle and
         azimuth at each quadrature point of the disc and normalized weights."""
         ti = np.atleast_1d(np.asarray(theta_i, dtype=float))
-        px, py, wa = self._disc_nodes()
+        with np.errstate(over="ignore"):  # R^2 overflowing: rescaled below
+            px, py, wa = self._disc_nodes()
         d = self.distance
         X = px[None, :] + (d * np.tan(np.minimum(ti, 0.5 * math.pi - 1e-12)))[:, None]
         Y = np.broadcast_to(py[None, :], X.shape)

@@ -88,12 +88,12 @@ def _base(cls):
 
 
 def _problems(cls, backend):
-    """What went wrong for ``cls`` on ``backend``: non-finite values, other exceptions, or a
-    ValueError that does not name the parameter."""
+    """What went wrong for ``cls`` on ``backend``: non-finite values, warnings, other
+    exceptions, or a ValueError that does not name the parameter."""
     out = []
     base = _base(cls)
     with models.backend(backend), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+        warnings.simplefilter("error")  # an overflow warning is a silent-garbage symptom too
         for label, leaf, build in _variants(base):
             try:
                 M = build().mueller(_TI, _TR, _PR)
@@ -187,3 +187,21 @@ def test_stability_edges_lie_inside_the_declared_ranges():
             assert SLOPE_WIDTH_MIN <= v <= SLOPE_WIDTH_MAX
     for z in stability._INDEX_EDGES:
         assert z == math.inf or INDEX_MIN <= abs(z) <= INDEX_MAX
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_computed_limits_equal_the_limit_models(backend):
+    """Where the limit is cheap it is computed, and it is the right one: a point source over a
+    vanishing disc is the collimated model, a vanishing aperture the model itself, and
+    Maxwell-Beard's SO at the smallest Omega the same as at a small one."""
+    ct = models.CookTorranceBRDF(convention="corrected")
+    sub = models.SubsurfaceFacetBRDF(slopes=models.ExponentialSlopes(0.02))
+    with models.backend(backend):
+        pairs = [
+            (models.PointSourceBRDF(model=ct, distance=100.0, sample_radius=1e-300), ct),
+            (models.DetectorAperture(model=sub, aperture=1e-300), sub),
+            (models.MaxwellBeardBRDF(omega=5e-324), models.MaxwellBeardBRDF(omega=1e-300)),
+        ]
+        for limit, reference in pairs:
+            got, want = limit.mueller(_TI, _TR, _PR), reference.mueller(_TI, _TR, _PR)
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13 * np.max(np.abs(want)))
