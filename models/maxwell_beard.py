@@ -51,8 +51,12 @@ def maxwell_beard_shadow(ti, tr, pr, tau, omega):
     theta_n = np.arctan(slope)
     cos_beta = np.sqrt(np.clip(0.5 * (1.0 - si * sr * cp + ci * cr), 0.0, 1.0))
     beta = np.arccos(np.minimum(cos_beta, 1.0))
-    x = theta_n / omega
-    return (1.0 + x * np.exp(-2.0 * beta / tau)) / (1.0 + x)
+    with np.errstate(over="ignore", invalid="ignore"):
+        e = np.exp(-2.0 * beta / tau)  # a tiny tau: -inf, e = 0, the limit
+        x = theta_n / omega
+        so = (1.0 + x * e) / (1.0 + x)
+    # theta_N / Omega overflows for a tiny Omega: SO is then its limit exp(-2 beta / tau)
+    return np.where(np.isinf(x), e, so)
 
 
 @dataclass(frozen=True)

@@ -19,13 +19,43 @@ import contextlib
 import dataclasses
 import math
 import numbers
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+#: Largest finite index magnitude |n + ik|.  A mirror's reflection coefficient differs from
+#: the perfect conductor's r = -1 by about 2 cos(theta) / (n + ik), so 1 - |r|^2 <= 4 / |n + ik|:
+#: above 4 / eps (eps the float64 machine epsilon; ~1.8e16) that difference is below double
+#: precision and the only exact answer is the perfect conductor, math.inf.  (The Fresnel
+#: algebra itself overflows near |n + ik| ~ 1e77, where |n|^4 leaves the float64 range.)
+INDEX_MAX = 4.0 / sys.float_info.epsilon
+
+#: Smallest index magnitude: r differs from its |n + ik| -> 0 limit by about 2 |n + ik|, below
+#: double precision under eps / 4 (the same argument; the algebra divides by n^2 there).
+INDEX_MIN = 1.0 / INDEX_MAX
+
+#: Narrowest declared slope width (rms slope, GGX alpha, angular width).  A slope computed
+#: from two directions (the half vector's x/z, y/z) carries a rounding error dz of a few eps
+#: (~1e-15).  Inside a lobe of width w (|z| <= 3 w) a Gaussian's logarithm moves by
+#: 6 dz / w, so w >= 1e-8 keeps that relative error of the lobe's value below ~1e-6; a
+#: narrower lobe is narrower than double precision resolves directions (and below ~1e-154
+#: its 1 / w^2 normalisation overflows).
+SLOPE_WIDTH_MIN = 1e-8
+
+#: Widest declared slope width: at w = 1e8 the typical facet is tilted within 1 / w = 1e-8 rad
+#: of vertical, the same resolution limit as :data:`SLOPE_WIDTH_MIN` from the other side
+#: (and above ~1e154 the w^2 of the lobe's normalisation overflows).
+SLOPE_WIDTH_MAX = 1e8
+
 __all__ = [
+    "INDEX_MAX",
+    "INDEX_MIN",
+    "SLOPE_WIDTH_MIN",
+    "SLOPE_WIDTH_MAX",
+    "width_param",
     "Alias",
     "choice_alias",
     "convention_param",
@@ -57,9 +87,12 @@ class ParamInfo:
 
     def range_text(self) -> str:
         if self.kind == "index":
-            return "n + ik with n > 0 and k >= 0, or math.inf (perfect conductor)"
+            return (
+                f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= abs(n + ik) <= {INDEX_MAX:.3g}, "
+                "or math.inf (perfect conductor)"
+            )
         if self.kind == "real_index":
-            return f"real, finite, >= {self.low:g}"
+            return f"real, finite, in [{self.low:g}, {INDEX_MAX:.3g}]"
         if self.kind in ("real", "int"):
             lo = "-inf" if self.low is None else f"{self.low:g}"
             hi = "inf" if self.high is None else f"{self.high:g}"
@@ -106,6 +139,15 @@ def param(
     return field(default=default, metadata={"scatterbench": info})
 
 
+def width_param(default: float, doc: str, *, high: float = SLOPE_WIDTH_MAX):
+    """Declare a slope-distribution width (rms slope, GGX alpha, angular width) in
+    [:data:`SLOPE_WIDTH_MIN`, ``high``]: narrower or wider lobes are not resolved in float64."""
+    why = f"; >= {SLOPE_WIDTH_MIN:g} (a narrower lobe is below float64's resolution of directions)"
+    if high == SLOPE_WIDTH_MAX:
+        why += f", <= {SLOPE_WIDTH_MAX:g} (facets within 1/{SLOPE_WIDTH_MAX:g} rad of vertical)"
+    return param(default, doc + why, low=SLOPE_WIDTH_MIN, high=high)
+
+
 def _range_text(low, high, low_open, high_open) -> str:
     lo = "-inf" if low is None else f"{low:g}"
     hi = "inf" if high is None else f"{high:g}"
@@ -140,7 +182,10 @@ def check_real(name, value, low=None, high=None, low_open=False, high_open=False
     rng = _range_text(low, high, low_open, high_open)
     if _is_array(value):
         return _check_real_array(name, value, rng, low, high, low_open, high_open)
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if isinstance(value, (bool, np.bool_)):
+        # bool is a numbers.Real subclass: True would silently become 1.0
+        raise ValueError(f"{name} must be {rng}; got {value!r} (a bool is not a number)")
+    if not isinstance(value, numbers.Real):
         if isinstance(value, numbers.Complex) and complex(value).imag == 0:
             value = complex(value).real
         else:
@@ -185,7 +230,10 @@ def check_index(name, value):
     element and returned as a read-only complex128 array (``inf + 0j``: a perfect
     conductor).
     """
-    rng = "n + ik with n > 0 and k >= 0 (both finite), or math.inf for a perfect conductor"
+    rng = (
+        f"n + ik with n > 0, k >= 0 and {INDEX_MIN:.3g} <= abs(n + ik) <= {INDEX_MAX:.3g} (above the upper bound the reflectance is "
+        "a perfect conductor's to double precision), or math.inf for a perfect conductor"
+    )
     if _is_array(value):
         if value.dtype.kind not in "iufc":
             raise ValueError(f"{name} must be {rng} (an array of them); got an array of {value.dtype}")
@@ -193,17 +241,18 @@ def check_index(name, value):
         pec = (z.real == math.inf) & (z.imag == 0)
         with np.errstate(invalid="ignore"):
             ok = np.isfinite(z.real) & np.isfinite(z.imag) & (z.real > 0) & (z.imag >= 0)
+            ok &= (np.abs(z) >= INDEX_MIN) & (np.abs(z) <= INDEX_MAX)
         if not np.all(ok | pec):
             _first_bad(name, rng, z, ~(ok | pec))
         return _frozen(z.real + 1j * np.abs(z.imag))
-    if isinstance(value, bool) or not isinstance(value, numbers.Complex):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Complex):
         raise ValueError(f"{name} must be {rng}; got {value!r}")
     z = complex(value)
     if z.real == math.inf and z.imag == 0:
         return math.inf
     if not (math.isfinite(z.real) and math.isfinite(z.imag)):
         raise ValueError(f"{name} must be {rng}; got {value!r}")
-    if z.real <= 0 or z.imag < 0:
+    if z.real <= 0 or z.imag < 0 or not INDEX_MIN <= abs(z) <= INDEX_MAX:
         raise ValueError(f"{name} must be {rng}; got {value!r}")
     return complex(z.real, abs(z.imag))
 
@@ -418,7 +467,7 @@ def _checked(name, value, info):
     if kind == "real":
         return check_real(name, value, info["low"], info["high"], info["low_open"], info["high_open"])
     if kind == "int":
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
             raise ValueError(f"{name} must be an integer; got {value!r}")
         check_real(name, value, info["low"], info["high"], info["low_open"], info["high_open"])
         return int(value)
@@ -427,14 +476,14 @@ def _checked(name, value, info):
     if kind == "real_index":
         z = value
         if _is_array(z):
-            return check_real(name, z, info["low"], None)
+            return check_real(name, z, info["low"], INDEX_MAX)
         if isinstance(z, numbers.Complex) and not isinstance(z, numbers.Real):
             if complex(z).imag != 0:
                 raise ValueError(
                     f"{name} must be a real (non-absorbing) index >= {info['low']:g}; got {value!r}"
                 )
             z = complex(z).real
-        return check_real(name, z, info["low"], None)
+        return check_real(name, z, info["low"], INDEX_MAX)
     if kind == "choice":
         choices = info["low"]
         flags = all(isinstance(c, bool) for c in choices)

@@ -70,6 +70,9 @@ from .smooth_interface import internal_hemispherical_reflectance
 
 __all__ = ["RoughDiffuseBRDF", "sample_normals_seen_by", "projected_area"]
 
+# Largest sample magnitude whose square, summed over the most pairs (1e7), stays finite.
+_SUM_SAFE = 1e150
+
 #: (geometry, pair) entries evaluated per block: keeps the temporaries in cache-sized arrays
 BLOCK = 1 << 15
 
@@ -372,8 +375,16 @@ class RoughDiffuseBRDF(Model):
         for start in range(0, n, per):
             sl = slice(start, min(start + per, n))
             x = self._block(ti[sl], tr[sl], pr[sl], self._z1, self._z2)
-            mean[:, sl] = x.mean(axis=-1)
-            err[:, sl] = x.std(axis=-1, ddof=1) / math.sqrt(self.pairs)
+            scale = np.max(np.abs(x), axis=-1, keepdims=True)
+            if not np.all(scale < _SUM_SAFE):
+                # huge weights (e.g. single ~ 1e300): sums and squares would overflow;
+                # the same statistics of x / scale, scaled back
+                scale = np.where(scale > 0, scale, 1.0)
+                x = x / scale
+            else:
+                scale = np.ones_like(scale)
+            mean[:, sl] = x.mean(axis=-1) * scale[..., 0]
+            err[:, sl] = x.std(axis=-1, ddof=1) / math.sqrt(self.pairs) * scale[..., 0]
         return mean, err
 
     def _surface16(self, ti, tr, pr):

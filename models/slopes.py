@@ -28,7 +28,7 @@ from functools import cached_property
 import numpy as np
 from scipy import integrate
 
-from .params import Declared, param
+from .params import Declared, param, width_param
 
 __all__ = [
     "SlopeDistribution",
@@ -179,7 +179,7 @@ class ExponentialSlopes(SlopeDistribution):
     SCATMECH: ``Exponential_Slope_Distribution_Function`` (parameter ``s``).
     """
 
-    sigma: float = param(0.1, "rms slope, sqrt(<|zeta|^2>)", low=0.0, low_open=True)
+    sigma: float = width_param(0.1, "rms slope, sqrt(<|zeta|^2>)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _p3_unit(self, zx, zy):
@@ -196,7 +196,7 @@ class GaussianSlopes(SlopeDistribution):
     ``m`` (seed 001 Eq. 8).  SCATMECH: ``Gaussian_Slope_Distribution_Function``.
     """
 
-    sigma: float = param(0.1, "rms slope, sqrt(<|zeta|^2>)", low=0.0, low_open=True)
+    sigma: float = width_param(0.1, "rms slope, sqrt(<|zeta|^2>)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     def _p3_unit(self, zx, zy):
@@ -242,17 +242,11 @@ class _Elliptical(SlopeDistribution):
 class _Anisotropic(_Elliptical):
     """Shared parameters of the anisotropic exponential and Gaussian families."""
 
-    sigma_x: float = param(
-        0.1,
-        "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))",
-        low=0.0,
-        low_open=True,
+    sigma_x: float = width_param(
+        0.1, "slope scale along the rotated x axis (rms slope along it: sigma_x / sqrt(2))"
     )
-    sigma_y: float = param(
-        0.1,
-        "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))",
-        low=0.0,
-        low_open=True,
+    sigma_y: float = width_param(
+        0.1, "slope scale along the rotated y axis (rms slope along it: sigma_y / sqrt(2))"
     )
     rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
@@ -304,12 +298,8 @@ class _AngleDistribution(SlopeDistribution):
     with ``<sec> = 1 / <cos theta_n>_A``, both normalizations exact on the
     hemisphere of normals."""
 
-    sigma: float = param(
-        0.1,
-        "angular width (rad): the rms tilt in the small-angle limit",
-        low=0.0,
-        high=math.pi,
-        low_open=True,
+    sigma: float = width_param(
+        0.1, "angular width (rad): the rms tilt in the small-angle limit", high=math.pi
     )
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
@@ -478,7 +468,7 @@ class GGXSlopes(SlopeDistribution):
         Projected coverage ``C`` in (0, 1].
     """
 
-    alpha: float = param(0.1, "GGX width alpha (rms slope is infinite)", low=0.0, low_open=True)
+    alpha: float = width_param(0.1, "GGX width alpha (rms slope is infinite)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 
     @property
@@ -511,8 +501,8 @@ class AnisotropicGGXSlopes(_Elliptical):
     is infinite along every direction; :attr:`scale` is ``max(alpha_x, alpha_y)``.
     """
 
-    alpha_x: float = param(0.1, "GGX width along the rotated x axis", low=0.0, low_open=True)
-    alpha_y: float = param(0.1, "GGX width along the rotated y axis", low=0.0, low_open=True)
+    alpha_x: float = width_param(0.1, "GGX width along the rotated x axis")
+    alpha_y: float = width_param(0.1, "GGX width along the rotated y axis")
     rotation: float = param(0.0, "rotation of the x axis from the sample x axis (rad)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
 

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import param
+from .params import param, width_param
 from .slopes import SlopeDistribution, _exp_neg
 
 __all__ = ["StrokeSlopes", "stroke_d"]
@@ -85,17 +85,13 @@ class StrokeSlopes(SlopeDistribution):
     ``m_par = m_perp = m`` is :class:`models.GaussianSlopes` with ``sigma = m``.
     """
 
-    m_parallel: float = param(
+    m_parallel: float = width_param(
         0.03,
         "the paper's m along the strokes (Eq. 19); slope moment <u^2> = m_par^2 m_perp / (m_par + m_perp)",
-        low=0.0,
-        low_open=True,
     )
-    m_perpendicular: float = param(
+    m_perpendicular: float = width_param(
         0.03,
         "the paper's m across the strokes (Eq. 19); slope moment <v^2> = m_perp^2 m_par / (m_par + m_perp)",
-        low=0.0,
-        low_open=True,
     )
     stroke_angle: float = param(0.0, "azimuth of the strokes from the sample x axis (rad)")
     coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)

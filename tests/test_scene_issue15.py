@@ -131,7 +131,7 @@ NO_WL = 'name = "x"\n[illumination]\ntheta_i_deg = 30\n'
         (
             ILL + '[substrate]\nindex = 1.5\ndistribution = "ggx"\nalpha = 0\n',
             "[substrate] alpha",
-            "(0, inf)",
+            "[1e-08, 1e+08]",
         ),
         (ILL + '[substrate]\nindex = 1.5\ndistribution = "ggx"\nsigma = 0.1\n', "[substrate] sigma", "alpha"),
         (

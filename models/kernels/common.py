@@ -46,7 +46,10 @@ def csqrt(a, b):
     T = type(a)
     if a == T(0.0) and b == T(0.0):
         return T(0.0), T(0.0)
-    r = math.sqrt(a * a + b * b)  # no overflow here: |a|, |b| are index-sized
+    r2 = a * a + b * b  # no overflow here: |a|, |b| are index-sized (|n + ik| <= 1.8e16)
+    # below the smallest normal number the squares underflow (an index near INDEX_MIN):
+    # hypot keeps r, hence t, from rounding to zero
+    r = math.sqrt(r2) if r2 >= T(2.2250738585072014e-308) else math.hypot(a, b)
     if a >= T(0.0):
         t = math.sqrt((a + r) * T(0.5))
         return t, b / (T(2.0) * t)

@@ -28,7 +28,10 @@ def shadow(ti, tr, pr, tau, omega):
     cos_beta = math.sqrt(min(max(T(0.5) * (T(1.0) - si * sr * cp + ci * cr), T(0.0)), T(1.0)))
     beta = math.acos(min(cos_beta, T(1.0)))
     x = theta_n / omega
-    return (T(1.0) + x * math.exp(-T(2.0) * beta / tau)) / (T(1.0) + x)
+    e = math.exp(-T(2.0) * beta / tau)
+    if math.isinf(x):  # theta_N / Omega overflowed (a tiny Omega): SO's limit
+        return e
+    return (T(1.0) + x * e) / (T(1.0) + x)
 
 
 @njit(cache=True, inline="always")

@@ -1,0 +1,207 @@
+"""Issue 13 (models): every in-range parameter gives finite values, every out-of-range one
+a ValueError naming it; a bool is never a number.
+
+Each model class in ``models.Model.registry`` is built (as the stability sweep builds it) with
+each real or index parameter at its declared bounds and at 1e-300 / 1e300, and with each slope
+distribution's widths there, and evaluated on both backends at a few geometries (normal,
+in-plane, out-of-plane, near grazing)."""
+
+import dataclasses
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import models
+from models import slopes as S
+from models.params import INDEX_MAX, INDEX_MIN, SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN
+from models.stroke_slopes import StrokeSlopes
+from validation.studies import stability
+
+_TI = np.array([0.0, 0.3, 0.3, 1.2, math.pi / 2 - 1e-9])
+_TR = np.array([0.0, 0.3, 0.5, 1.2, 0.3])
+_PR = np.array([0.0, 0.0, 1.0, math.pi, 0.0])
+_EXTREMES = (1e-300, 1e300, -1e300, 1e-160, 5e-324)
+_INDICES = (
+    1e300,
+    1 + 1e300j,
+    1e-300 + 0j,
+    1e-300 + 1e300j,
+    INDEX_MIN + 0j,
+    INDEX_MAX + 0j,
+    INDEX_MAX * (1 + 1j) / math.sqrt(2),
+    1e-300 + 1j * INDEX_MAX,
+    1e-300 + 1j * INDEX_MIN,
+)
+_SLOPES = [StrokeSlopes] + [
+    c
+    for c in vars(S).values()
+    if isinstance(c, type)
+    and issubclass(c, S.SlopeDistribution)
+    and not c.__name__.startswith("_")
+    and c not in (S.SlopeDistribution, S.TabulatedSlopes, S.UnitSlopes)
+]
+
+
+def _values(info):
+    """The values one parameter is tried at: its bounds and the float64 extremes."""
+    if info.kind == "index":
+        return _INDICES
+    vals = list(_EXTREMES)
+    if info.low is not None:
+        vals.append(info.low * (1 + 1e-15) + (5e-324 if info.low == 0 else 0) if info.low_open else info.low)
+    if info.high is not None:
+        vals.append(info.high * (1 - 1e-15) if info.high_open else info.high)
+    if info.kind == "real_index":
+        vals += [INDEX_MAX, math.nextafter(INDEX_MAX, math.inf)]
+    return vals
+
+
+def _variants(base):
+    """``(label, leaf name, build)`` for each parameter of ``base`` (and of its slopes) at each value."""
+    for info in type(base).parameters():
+        if info.kind in ("real", "index", "real_index"):
+            for v in _values(info):
+                yield (
+                    f"{info.name}={v!r}",
+                    info.name,
+                    lambda n=info.name, v=v: dataclasses.replace(base, **{n: v}),
+                )
+        if isinstance(getattr(base, info.name), S.SlopeDistribution):
+            for sc in _SLOPES:
+                for si in sc.parameters():
+                    if si.kind != "real":
+                        continue
+                    for v in _values(si):
+
+                        def build(n=info.name, sc=sc, sn=si.name, v=v):
+                            return dataclasses.replace(base, **{n: sc(**{sn: v})})
+
+                        yield f"{info.name}={sc.__name__}({si.name}={v!r})", si.name, build
+
+
+def _base(cls):
+    if cls.__name__ in stability._BASES:
+        return stability._BASES[cls.__name__]()
+    return cls()
+
+
+def _problems(cls, backend):
+    """What went wrong for ``cls`` on ``backend``: non-finite values, warnings, other
+    exceptions, or a ValueError that does not name the parameter."""
+    out = []
+    base = _base(cls)
+    with models.backend(backend), warnings.catch_warnings():
+        warnings.simplefilter("error")  # an overflow warning is a silent-garbage symptom too
+        for label, leaf, build in _variants(base):
+            try:
+                M = build().mueller(_TI, _TR, _PR)
+            except ValueError as exc:
+                if leaf not in str(exc):
+                    out.append(f"{label}: ValueError not naming {leaf}: {exc}")
+                continue
+            except Exception as exc:  # noqa: BLE001 - any other exception is the failure looked for
+                out.append(f"{label}: {type(exc).__name__}: {exc}")
+                continue
+            if not np.all(np.isfinite(M)):
+                out.append(f"{label}: non-finite Mueller matrix")
+    return out
+
+
+_CLASSES = [c for c in models.Model.registry if c is not models.Sum]
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+@pytest.mark.parametrize("cls", _CLASSES, ids=lambda c: c.__name__)
+def test_in_range_parameters_give_finite_values(cls, backend):
+    assert _problems(cls, backend) == []
+
+
+@pytest.mark.parametrize(
+    "build",
+    [
+        lambda: models.FacetBRDF(substrate=1e300),
+        lambda: models.FacetBRDF(slopes=models.GaussianSlopes(1e-160)),
+        lambda: models.FacetBRDF(slopes=models.ExponentialSlopes(1e-300)),
+        lambda: models.CookTorranceBRDF(slopes=models.GaussianSlopes(1e-300)),
+    ],
+)
+def test_issue_examples_are_refused_with_the_reason(build):
+    with pytest.raises(ValueError, match=r"substrate|sigma") as info:
+        build()
+    assert "1e-08" in str(info.value) or "1.8e+16" in str(info.value)
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_the_new_bounds_themselves_are_finite(backend):
+    with models.backend(backend):
+        for sc in (models.GaussianSlopes, models.ExponentialSlopes, models.GGXSlopes):
+            for w in (SLOPE_WIDTH_MIN, SLOPE_WIDTH_MAX):
+                s = sc(w) if sc is not models.GGXSlopes else sc(alpha=w)
+                assert np.all(np.isfinite(models.FacetBRDF(slopes=s).mueller(_TI, _TR, _PR)))
+        for w in (SLOPE_WIDTH_MIN, SLOPE_WIDTH_MAX):
+            ct = models.CookTorranceBRDF(slopes=models.GaussianSlopes(w))
+            assert np.all(np.isfinite(ct.mueller(_TI, _TR, _PR)))
+
+
+def test_bounds_refuse_just_outside():
+    with pytest.raises(ValueError, match="sigma"):
+        models.GaussianSlopes(math.nextafter(SLOPE_WIDTH_MIN, 0))
+    with pytest.raises(ValueError, match="sigma"):
+        models.GaussianSlopes(math.nextafter(SLOPE_WIDTH_MAX, math.inf))
+    with pytest.raises(ValueError, match="math.inf for a perfect conductor"):
+        models.FacetBRDF(substrate=math.nextafter(INDEX_MAX, math.inf))
+    with pytest.raises(ValueError, match="substrate"):
+        models.FacetBRDF(substrate=np.array([1.5, 2 * INDEX_MAX]))
+
+
+def test_perfect_conductor_limit_matches_the_largest_index():
+    """At |n| = INDEX_MAX the reflection is the perfect conductor's to double precision: the
+    reason for refusing larger indices (use math.inf)."""
+    big = models.FacetBRDF(substrate=INDEX_MAX * (1 + 1j) / math.sqrt(2)).mueller(_TI, _TR, _PR)
+    pec = models.FacetBRDF(substrate=math.inf).mueller(_TI, _TR, _PR)
+    np.testing.assert_allclose(big, pec, rtol=1e-14, atol=1e-14 * np.max(np.abs(pec)))
+
+
+@pytest.mark.parametrize(
+    "build, name",
+    [
+        (lambda v: models.GaussianSlopes(v), "sigma"),
+        (lambda v: models.GaussianSlopes(coverage=v), "coverage"),
+        (lambda v: models.FacetBRDF(substrate=v), "substrate"),
+        (lambda v: models.SubsurfaceFacetBRDF(coating=v), "coating"),
+        (lambda v: models.PointSourceBRDF(model=models.FacetBRDF(), resolution=v), "resolution"),
+    ],
+)
+@pytest.mark.parametrize("flag", [True, False, np.True_, np.array([True, False])], ids=repr)
+def test_a_bool_is_not_a_number(build, name, flag):
+    with pytest.raises(ValueError, match=name):
+        build(flag)
+
+
+def test_stability_edges_lie_inside_the_declared_ranges():
+    widths = ("sigma", "sigma_x", "sigma_y", "alpha", "alpha_x", "alpha_y", "m_parallel", "m_perpendicular")
+    for name in widths:
+        for v in stability._NAMED_EDGES[name]:
+            assert SLOPE_WIDTH_MIN <= v <= SLOPE_WIDTH_MAX
+    for z in stability._INDEX_EDGES:
+        assert z == math.inf or INDEX_MIN <= abs(z) <= INDEX_MAX
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_computed_limits_equal_the_limit_models(backend):
+    """Where the limit is cheap it is computed, and it is the right one: a point source over a
+    vanishing disc is the collimated model, a vanishing aperture the model itself, and
+    Maxwell-Beard's SO at the smallest Omega the same as at a small one."""
+    ct = models.CookTorranceBRDF(convention="corrected")
+    sub = models.SubsurfaceFacetBRDF(slopes=models.ExponentialSlopes(0.02))
+    with models.backend(backend):
+        pairs = [
+            (models.PointSourceBRDF(model=ct, distance=100.0, sample_radius=1e-300), ct),
+            (models.DetectorAperture(model=sub, aperture=1e-300), sub),
+            (models.MaxwellBeardBRDF(omega=5e-324), models.MaxwellBeardBRDF(omega=1e-300)),
+        ]
+        for limit, reference in pairs:
+            got, want = limit.mueller(_TI, _TR, _PR), reference.mueller(_TI, _TR, _PR)
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13 * np.max(np.abs(want)))
