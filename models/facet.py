@@ -248,6 +248,22 @@ class FacetBRDF(_FacetModel):
     shadowing : str
         ``"none"`` (seed 000), ``"smith"`` (separable Smith ``G1(i) G1(o)``) or
         ``"smith-correlated"`` (height-correlated), :mod:`models.shadowing`.
+
+    Examples
+    --------
+    One geometry gives one 4 x 4 Mueller matrix (1/sr, psps basis); arrays of angles
+    broadcast, and so do array parameters (a model set):
+
+    >>> import math, numpy as np, models
+    >>> m = models.FacetBRDF(slopes=models.GaussianSlopes(0.2), substrate=math.inf, shadowing="smith")
+    >>> M = m.mueller(math.radians(30), math.radians(30), 0.0)  # specular, phi_r = 0
+    >>> M.shape, round(float(M[0, 0]), 6)
+    ((4, 4), 2.652582)
+    >>> m.mueller(np.radians([10.0, 20.0, 30.0]), 0.5, 0.0).shape
+    (3, 4, 4)
+    >>> sigmas = models.GaussianSlopes(np.array([[0.1], [0.2]]))
+    >>> models.FacetBRDF(slopes=sigmas).brdf(0.5, np.array([0.4, 0.5, 0.6]), 0.0).shape
+    (2, 3)
     """
 
     slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")

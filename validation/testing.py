@@ -137,6 +137,14 @@ def check_model(model, *, checks=None, quick=False, label=None, ctx=None) -> Mod
     Returns
     -------
     ModelReport
+
+    Examples
+    --------
+    >>> import models
+    >>> from validation.testing import check_model
+    >>> report = check_model(models.FacetBRDF(), checks=["reciprocity"])
+    >>> [(r.name, r.status) for r in report.results]
+    [('reciprocity: M00', 'pass'), ('reciprocity: Mueller', 'pass')]
     """
     if not callable(getattr(model, "mueller", None)):
         raise ValueError(f"model must have a mueller(theta_i, theta_r, phi_r) method; got {model!r}")

@@ -143,6 +143,17 @@ def integrated_reflectance(
     IntegralResult
         ``value``, ``error``, ``evaluations`` (model geometries evaluated) and
         ``converged``.
+
+    Examples
+    --------
+    Seed 003's diffuse subsurface model at unit albedo: what the interface's Fresnel
+    reflection (not part of the model) leaves, the model returns diffusely.
+
+    >>> import math, models, validation
+    >>> r = validation.integrated_reflectance(models.DiffuseSubsurfaceBRDF(rho=1.0), 0.5, tol=1e-6)
+    >>> rs, rp = models.fresnel_reflectance(math.cos(0.5), 1.0, 1.5)
+    >>> round(float(r.value + (rs + rp) / 2), 6), r.converged
+    (1.0, True)
     """
     if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
         raise ValueError(f"tol must be a finite number > 0; got {tol!r}")
