@@ -205,3 +205,20 @@ def test_computed_limits_equal_the_limit_models(backend):
         for limit, reference in pairs:
             got, want = limit.mueller(_TI, _TR, _PR), reference.mueller(_TI, _TR, _PR)
             np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13 * np.max(np.abs(want)))
+
+
+@pytest.mark.parametrize("dtype", [np.int64, np.float32, np.complex128, bool])
+def test_mueller_out_of_the_wrong_dtype_is_refused(dtype):
+    """An ``out`` array that would truncate or reinterpret the result (integers, the other
+    precision, complex, bools) is refused with its dtype named, and left unwritten."""
+    out = np.zeros((16, 3), dtype=dtype)
+    with pytest.raises(ValueError, match=f"dtype float64; got \\(16, 3\\) {np.dtype(dtype)}"):
+        models.FacetBRDF().mueller(0.5, np.array([0.3, 0.5, 0.7]), 0.0, out=out)
+    assert not out.any()
+
+
+def test_mueller_out_of_the_right_dtype_is_filled():
+    out = np.zeros((16, 3))
+    M = models.FacetBRDF().mueller(0.5, np.array([0.3, 0.5, 0.7]), 0.0, out=out)
+    np.testing.assert_array_equal(M, models.FacetBRDF().mueller(0.5, np.array([0.3, 0.5, 0.7]), 0.0))
+    assert np.shares_memory(M, out)
