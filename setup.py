@@ -6,35 +6,35 @@ commit written here (``validation/_build_commit.txt``) instead.  Everything else
 about the build is declared in pyproject.toml.
 """
 
+import importlib.util
 import os
-import subprocess
 
 from setuptools import setup
 from setuptools.command.build_py import build_py
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _provenance():
+    # the report's own module, loaded by path: the package itself (numpy, ...) need not be
+    # importable in an isolated build environment
+    spec = importlib.util.spec_from_file_location(
+        "_sb_provenance", os.path.join(HERE, "validation", "report", "provenance.py")
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 class BuildPyWithCommit(build_py):
     def run(self):
         super().run()
-        commit = _git_commit(os.path.dirname(os.path.abspath(__file__)))
+        commit = _provenance().describe(HERE)
         if commit and not self.dry_run:
             target = os.path.join(self.build_lib, "validation", "_build_commit.txt")
             os.makedirs(os.path.dirname(target), exist_ok=True)
             with open(target, "w") as fh:
                 fh.write(commit + "\n")
-
-
-def _git_commit(folder):
-    try:
-        r = subprocess.run(
-            ["git", "-C", folder, "describe", "--always", "--dirty", "--abbrev=12"],
-            capture_output=True,
-            text=True,
-            timeout=10,
-        )
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return r.stdout.strip() if r.returncode == 0 else None
 
 
 setup(cmdclass={"build_py": BuildPyWithCommit})

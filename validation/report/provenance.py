@@ -5,12 +5,14 @@ from __future__ import annotations
 import os
 import subprocess
 
-__all__ = ["git_commit"]
+__all__ = ["git_commit", "describe"]
 
 _PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def _describe(folder):
+def describe(folder):
+    """``git describe --always --dirty`` of ``folder``, or ``None`` outside a checkout.
+    Imports nothing from scatterbench: setup.py loads this file by path at build time."""
     try:
         r = subprocess.run(
             ["git", "-C", folder, "describe", "--always", "--dirty", "--abbrev=12"],
@@ -28,7 +30,7 @@ def git_commit() -> str:
     (source tree or editable install; ``-dirty`` marks uncommitted changes), else the
     commit recorded when the package was built from a checkout (setup.py), else
     "unknown"."""
-    here = _describe(_PACKAGE)
+    here = describe(_PACKAGE)
     if here:
         return here
     try:
