@@ -18,7 +18,7 @@ import numpy as np
 import models
 import references
 import validation
-from validation.checks.seed001 import point_source_collimated_error, published_albedos
+from validation.checks.seed001 import iron_plate_models, point_source_collimated_error, published_albedos
 
 published = published_albedos()
 energy = {
@@ -52,14 +52,8 @@ fig.tight_layout()
 # spans the printed incidence range (:func:`models.point_source_geometry`),
 # in-plane, beside the collimated BRDF (:class:`models.PointSourceBRDF`, the
 # exact superposition of Eq. 28).
-plate = references.IRON_PLATE
-varnished = models.VarnishedCookTorranceBRDF(
-    slopes=models.StrokeSlopes(plate["m"], plate["m"]),
-    coating=plate["varnish"],
-    substrate=plate["substrate"],
-    convention="paper",
-)
-lo, hi = plate["incidence_ranges_deg"][0]
+_, varnished = iron_plate_models()  # references.IRON_PLATE under its varnish, as printed
+lo, hi = references.IRON_PLATE["incidence_ranges_deg"][0]
 psi_c, d = models.point_source_geometry(lo, hi)
 point = models.PointSourceBRDF(model=varnished, distance=d, sample_radius=1.0, resolution=8)
 tr = np.radians(np.linspace(max(math.degrees(psi_c) - 10.0, 0.0), math.degrees(psi_c) + 10.0, 401))

@@ -699,18 +699,26 @@ def check_preset(ctx):
     return judge("seed001: iron-plate point-source geometry spans the printed ranges (deg)", worst, 1e-9)
 
 
-@text_section
-def preset_text(ctx):
+def iron_plate_models(convention="paper"):
+    """Seed 001's iron plate (``references.IRON_PLATE``) as ``(bare, varnished)``: the
+    Cook-Torrance metal and the same metal under its varnish (isotropic strokes), in the
+    published (``"paper"``) or corrected convention."""
     plate = references.IRON_PLATE
-    ct = models.CookTorranceBRDF(
-        slopes=models.GaussianSlopes(plate["m"]), substrate=plate["substrate"], convention="paper"
+    bare = models.CookTorranceBRDF(
+        slopes=models.GaussianSlopes(plate["m"]), substrate=plate["substrate"], convention=convention
     )
-    vn = models.VarnishedCookTorranceBRDF(
+    varnished = models.VarnishedCookTorranceBRDF(
         slopes=models.StrokeSlopes(plate["m"], plate["m"]),
         coating=plate["varnish"],
         substrate=plate["substrate"],
-        convention="paper",
+        convention=convention,
     )
+    return bare, varnished
+
+
+@text_section
+def preset_text(ctx):
+    ct, vn = iron_plate_models()
     lines = [
         "Iron plate of seed 001 (iron 2.29+3.37i at 650 nm, m = 0.03, n_v = 1.5), published normalization.",
         "Peak of the in-plane BRDF (1/sr) and its angle; point source sized to the printed incidence range:",

@@ -140,17 +140,12 @@ def _point_source_scan(vn, lo, hi):
 def _point_source():
     """The iron plate (references.IRON_PLATE) under each printed incidence range, and the
     point source's approach to the collimated beam as it recedes."""
-    from validation.checks.seed001 import point_source_collimated_error
+    from validation.checks.seed001 import iron_plate_models, point_source_collimated_error
 
-    plate = references.IRON_PLATE
-    vn = models.VarnishedCookTorranceBRDF(
-        slopes=models.StrokeSlopes(plate["m"], plate["m"]),
-        coating=plate["varnish"],
-        substrate=plate["substrate"],
-        convention="paper",
-    )
+    _, vn = iron_plate_models()
     scans, rows = zip(
-        *(_point_source_scan(vn, lo, hi) for lo, hi in plate["incidence_ranges_deg"]), strict=True
+        *(_point_source_scan(vn, lo, hi) for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]),
+        strict=True,
     )
     conv = point_source_collimated_error(distances=DISTANCES)
     crow = tuple({"d/R": d, "max |f_point - f_collimated| / max f": e} for d, e in conv.items())
