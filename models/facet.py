@@ -235,7 +235,7 @@ class FacetBRDF(_FacetModel):
     facet's Fresnel reflection in the s/p bases of the two rays.  SCATMECH:
     ``Facet_BRDF_Model`` (``type = 0``).  With ``shadowing="smith"`` and GGX or
     Gaussian slopes it is Mitsuba 3's ``roughconductor`` (divided by
-    ``cos theta``), polarized.
+    ``cos theta_i``), polarized.
 
     Parameters
     ----------

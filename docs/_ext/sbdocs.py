@@ -25,7 +25,7 @@ CORRESPONDENCE = {
     "FacetBRDF": (
         "seed 000 Eq. 48-49 with coating n = 1",
         "``Facet_BRDF_Model`` (type 0)",
-        "``roughconductor`` (``beckmann``/``ggx``) with ``shadowing='smith'``, divided by cos(theta_r)",
+        "``roughconductor`` (``beckmann``/``ggx``) with ``shadowing='smith'``, divided by cos(theta_i)",
     ),
     "SubsurfaceFacetBRDF": (
         "seed 000 Eq. 2-18, 49 (Table I)",
