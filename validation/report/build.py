@@ -16,7 +16,7 @@ from .core import Context, Section, render_html
 from .provenance import git_commit
 from .sections import SECTIONS, report_checks
 
-__all__ = ["build_report", "write_report", "read_results", "read_results_checked"]
+__all__ = ["build_report", "write_report", "read_results_checked"]
 
 
 def _progress(total, label):
@@ -135,11 +135,6 @@ def read_results_checked(path):
     if not isinstance(res, dict) or not isinstance(res.get("checks"), list):
         return None, f"{path}: not a report's results (an object with a list of checks)"
     return res, None
-
-
-def read_results(path):
-    """The results in ``path``, or ``None`` when there are none that can be used."""
-    return read_results_checked(path)[0]
 
 
 def write_report(out_dir, quick=False, previous=None, **kwargs):
