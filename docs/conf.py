@@ -7,6 +7,8 @@ generated from the docstrings (autosummary + numpydoc), so it follows the code.
 
 import os
 import sys
+import tomllib
+from importlib import metadata
 
 import matplotlib
 
@@ -20,7 +22,12 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "_ext"))
 project = "scatterbench"
 author = "scatterbench contributors"
 copyright = "scatterbench contributors"  # noqa: A001 - Sphinx's name
-release = version = "0.1.0"
+_PYPROJECT = os.path.join(ROOT, "pyproject.toml")
+if os.path.exists(_PYPROJECT):  # the checkout's version (it is the code documented)
+    with open(_PYPROJECT, "rb") as _fh:
+        release = version = tomllib.load(_fh)["project"]["version"]
+else:
+    release = version = metadata.version("scatterbench")
 
 extensions = [
     "sphinx.ext.autodoc",
