@@ -224,3 +224,41 @@ def test_stability_findings_grouped_by_model_kind_and_verdict():
     assert len(rows) == len(findings) and sorted(r["value"] for r in rows) == sorted(
         f.value for f in findings
     )
+
+
+def test_contributed_models_section(monkeypatch):
+    """Models registered under the scatterbench.models entry points (stubbed here: a plain
+    Lambertian, one that creates energy, one whose module is missing) get a section with
+    their conformance results; with none installed, the section says so in one line."""
+    import importlib.metadata
+
+    group = "scatterbench.models"
+    eps = [
+        importlib.metadata.EntryPoint("lambert", "kit_models:Lambertian", group),
+        importlib.metadata.EntryPoint("hot", "kit_models:CreatesEnergy", group),
+        importlib.metadata.EntryPoint("gone", "no_such_module_xyz:Model", group),
+    ]
+    monkeypatch.setattr(
+        importlib.metadata, "entry_points", lambda group=None: eps if group == "scatterbench.models" else []
+    )
+    results, page = build_report(quick=True, only=["contributed"], checks=[])
+    sec = results["sections"]["contributed"]
+    assert sec["error"] is None
+    rows = {r["entry point"]: r for r in sec["numbers"]["contributed"]}
+    assert list(rows) == ["gone", "hot", "lambert"]  # name order
+    assert rows["lambert"]["verdict"] == "passed" and rows["lambert"]["fail"] == 0
+    assert rows["hot"]["verdict"] == "FAILED" and rows["hot"]["fail"] >= 1
+    assert (
+        rows["gone"]["verdict"].startswith("not loaded: ") and "no_such_module_xyz" in rows["gone"]["verdict"]
+    )
+    checks = sec["numbers"]["contributed_checks"]
+    assert {c["check"] for c in checks if c["entry point"] == "hot" and c["status"] == "FAIL"} == {"energy"}
+    assert '<table data-key="contributed">' in page and "kit_models:CreatesEnergy" in _cells(
+        page, "contributed"
+    )
+    assert results["summary"]["n_fail"] == 0  # shown, not judged
+
+    monkeypatch.setattr(importlib.metadata, "entry_points", lambda group=None: [])
+    results, page = build_report(quick=True, only=["contributed"], checks=[])
+    assert results["sections"]["contributed"]["numbers"] == {"contributed": []}
+    assert f"no contributed models installed (entry-point group {group})" in page

@@ -11,6 +11,7 @@ from __future__ import annotations
 from ..core import SectionSpec
 from . import (
     conservation,
+    contributed,
     model_comparison,
     provenance,
     scatmech,
@@ -54,5 +55,6 @@ SECTIONS = (
     _spec("speed", "Speed and accuracy", speed),
     _spec("stability", "Stability sweep at the extremes", stability),
     _spec("scenes", "Scenes and the mechanisms they build", scenes),
+    _spec("contributed", "Contributed models (scatterbench.models entry points)", contributed),
     _spec("provenance", "Provenance", provenance, stage=1),
 )
