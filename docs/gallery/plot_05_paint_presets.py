@@ -9,45 +9,41 @@ diffuse term) and a green CARC coating (:class:`models.RoughDiffuseBRDF`, Monte
 Carlo under a rough interface). The presets are scene files listed by
 :func:`references.seed003_presets`; each is built with :mod:`models.scene`. Beside
 each, the empirical Maxwell-Beard BRDF (:class:`models.MaxwellBeardBRDF`) is
-fitted to the preset's in-plane BRDF by the report's least-squares fit
-(sigma, rho_d and rho_v free), at 60 deg incidence and 45 deg linear polarization.
-The red paint's parameters are not printed in the paper: its preset carries
-placeholders (the preset's provenance says which).
+fitted by least squares in log10 to the preset's in-plane BRDF for unpolarized
+light (M00) at its incidence, 60 deg (sigma, rho_d and rho_v free). The curves
+and the fits are the report section's
+(:func:`validation.report.sections.seed003_presets.compute`, quick: the green
+CARC at 200 facet pairs per geometry); as there, they are drawn for incident
+light polarized at 45 deg (seed 003 Sec. 3), which in the plane of incidence
+gives M00 where M02 vanishes (the printed max ``|M02|/M00`` says how nearly it
+does). The red paint's parameters are not
+printed in the paper: its preset carries placeholders (the preset's provenance
+says which).
 """
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-import models
-import references
-from models import scene
-from models.geometry import signed_inplane
-from validation.report.sections.seed003_presets import fit_maxwell_beard
+from validation.report.core import Context
+from validation.report.sections import seed003_presets
 
-x = np.linspace(-85.0, 85.0, 69)
-tr, pr = signed_inplane(np.radians(x))
-fig, axes = plt.subplots(1, 3, figsize=(12, 3.8), sharey=True)
-for ax, (name, preset) in zip(axes, references.seed003_presets().items(), strict=True):
-    sc = scene.load(preset["scene"])
-    model = sc.build()
-    if name == "green_carc":
-        model = model.replace(pairs=200, seed=0)  # quick: 200 facet pairs per geometry
-    M, E = models.mueller_with_error(model, sc.theta_i, tr, pr)
-    rough = sc.coating.get("roughness")
-    family = type(rough) if rough is not None else models.GaussianSlopes
-    mb, par = fit_maxwell_beard(x, M[..., 0, 0], sc.theta_i, family, sc.coating["index"])
+d = seed003_presets.compute(Context(quick=True))
+for row in d.fit_rows:
     print(
-        f"{name}: Maxwell-Beard sigma {par['sigma']:.3f}, rho_d {par['rho_d']:.4f}, "
-        f"rho_v {par['rho_v']:.4f}, rms log10 misfit {par['rms_log10']:.3f}"
+        f"{row['preset']}: Maxwell-Beard sigma {row['MB sigma']:.3f}, rho_d {row['MB rho_d (1/sr)']:.4f}, "
+        f"rho_v {row['MB rho_v (1/sr)']:.4f}, rms log10 misfit {row['rms log10 misfit']:.3f}, "
+        f"max |M02|/M00 in plane {row['max |M02|/M00 in plane']:.1e}"
     )
-    ax.semilogy(x, M[..., 0, 0], label=f"preset ({preset['model'].split(' (')[0]})")
-    if np.any(E[..., 0, 0] > 0):
-        se = E[..., 0, 0]
-        ax.fill_between(x, np.maximum(M[..., 0, 0] - 2 * se, 1e-12), M[..., 0, 0] + 2 * se, alpha=0.3, lw=0)
-    ax.semilogy(x, mb.brdf(sc.theta_i, tr, pr), "--", label="Maxwell-Beard (fitted)")
-    ax.set_title(preset["sample"], fontsize=9)
+
+fig, axes = plt.subplots(1, 3, figsize=(12, 3.8), sharey=True)
+for ax, c in zip(axes, d.curves, strict=True):
+    ax.semilogy(d.x, c.brdf, label=c.label)
+    if np.any(c.se > 0):
+        ax.fill_between(d.x, np.maximum(c.brdf - 2 * c.se, 1e-12), c.brdf + 2 * c.se, alpha=0.3, lw=0)
+    ax.semilogy(d.x, c.mb_brdf, "--", label="Maxwell-Beard (fitted)")
+    ax.set_title(c.title, fontsize=9)
     ax.set_xlabel("signed theta_r (deg)")
     ax.legend(fontsize=7)
-axes[0].set_ylabel("M00 (1/sr)")
+axes[0].set_ylabel("BRDF (1/sr), 45 deg in")
 fig.tight_layout()
 plt.show()
