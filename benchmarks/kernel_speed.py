@@ -5,7 +5,8 @@
 Prints, for every closed-form model: the per-geometry cost of the full float64 Mueller
 matrix from angles at ``--n`` geometries with the numpy path and with the kernels on one
 thread and on every core (best of ``--repeat``), and the ratios; the small calls (one
-geometry, 100 geometries); float32 against float64 (cost and error relative to M00); and
+geometry, 100 geometries); float32 against float64 (cost, and the error as the trade-off
+study's precision knob defines it: max |M32 - M64| over every element / max M64_00); and
 the import + first-call time of a fresh process with an empty kernel cache (cold: the
 kernels compile) and again with that cache filled (warm).  The machine's load is printed
 before and after: figures from a shared machine are noisy, the ratios within one run less so.
@@ -23,12 +24,12 @@ import argparse
 import math
 import subprocess
 import tempfile
-import time
 
 import numba
 import numpy as np
 
 import models
+from benchmarks.speed import best_of
 
 AL = 1.37 + 7.62j
 MODELS = {
@@ -47,16 +48,6 @@ FIRST_CALL = (
 )
 
 
-def best(fn, repeat):
-    """The best of ``repeat`` timings of ``fn()`` (seconds)."""
-    out = math.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        out = min(out, time.perf_counter() - t)
-    return out
-
-
 def geometries(n):
     rng = np.random.default_rng(0)
     return rng.uniform(0, 1.5, n), rng.uniform(0, 1.5, n), rng.uniform(-math.pi, math.pi, n)
@@ -70,11 +61,11 @@ def per_geometry(n, repeat):
         m = make()
         m.mueller(ti[:10], tr[:10], pr[:10])  # compiled (or loaded) before timing
         with models.backend("numpy"):
-            t_np = best(lambda m=m: m.mueller(ti, tr, pr), max(1, repeat // 2))
+            t_np = best_of(lambda m=m: m.mueller(ti, tr, pr), max(1, repeat // 2))[0]
         numba.set_num_threads(1)
-        t_1 = best(lambda m=m: m.mueller(ti, tr, pr), repeat)
+        t_1 = best_of(lambda m=m: m.mueller(ti, tr, pr), repeat)[0]
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-        t_all = best(lambda m=m: m.mueller(ti, tr, pr), repeat)
+        t_all = best_of(lambda m=m: m.mueller(ti, tr, pr), repeat)[0]
         out[name] = tuple(1e6 * t / n for t in (t_np, t_1, t_all))
     return out
 
@@ -90,22 +81,24 @@ def small_calls(repeat):
     for name, fn in cases.items():
         fn()
         with models.backend("numpy"):
-            t_np = best(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat) / k
-        t_k = best(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat) / k
+            t_np = best_of(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat)[0] / k
+        t_k = best_of(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat)[0] / k
         out[name] = (1e6 * t_np, 1e6 * t_k)
     return out
 
 
 def float32(n, repeat):
-    """``(float64 us, float32 us, max error relative to M00)`` per geometry, SubsurfaceFacetBRDF."""
+    """``(float64 us, float32 us, error)`` per geometry, SubsurfaceFacetBRDF; the error as
+    :func:`validation.studies.tradeoff.knob_precision` defines it: max |M32 - M64| over every
+    element and geometry, divided by max M64_00."""
     m = models.SubsurfaceFacetBRDF()
     ti, tr, pr = geometries(n)
     m.mueller(ti[:10], tr[:10], pr[:10], precision="float32")
-    t64 = best(lambda: m.mueller(ti, tr, pr), repeat)
-    t32 = best(lambda: m.mueller(ti, tr, pr, precision="float32"), repeat)
+    t64 = best_of(lambda: m.mueller(ti, tr, pr), repeat)[0]
+    t32 = best_of(lambda: m.mueller(ti, tr, pr, precision="float32"), repeat)[0]
     M64 = m.mueller(ti, tr, pr)
     M32 = m.mueller(ti, tr, pr, precision="float32").astype(float)
-    err = float(np.max(np.abs(M32 - M64) / np.abs(M64[..., :1, :1])))
+    err = float(np.max(np.abs(M32 - M64)) / np.max(M64[..., 0, 0]))
     return 1e6 * t64 / n, 1e6 * t32 / n, err
 
 
@@ -134,7 +127,9 @@ def main():
     for name, (t_np, t_k) in small_calls(args.repeat).items():
         print(f"small call, {name:<15} numpy {t_np:8.1f} us, kernel {t_k:6.1f} us ({t_np / t_k:.1f}x)")
     t64, t32, err = float32(args.n, args.repeat)
-    print(f"float32: {t32:.4f} us vs float64 {t64:.4f} us per geometry; max error {err:.1e} of M00")
+    print(
+        f"float32: {t32:.4f} us vs float64 {t64:.4f} us per geometry; error {err:.1e} (max |M32 - M64| / max M00)"
+    )
     cold, warm = first_call()
     print(f"import + first call, fresh process: cold cache {cold:.1f} s, warm cache {warm:.2f} s")
     print(f"load after: {os.getloadavg()}")
