@@ -14,8 +14,13 @@ Pairs (DESIGN.md's mapping):
   ``scalar_spectral_polarized`` against ``mueller``), and the LLVM JIT variants on
   arrays (``llvm_ad_rgb``, ``llvm_ad_mono_polarized``) on one thread, when Dr.Jit finds
   an LLVM it can use (``DRJIT_LIBLLVM_PATH``; set here to Debian's ``libLLVM-19.so``
-  when that exists and the variable is unset).  numpy's elementwise arithmetic runs on
-  one thread, as Dr.Jit is set to.
+  when that exists and the variable is unset).
+
+Every side runs on one thread: Dr.Jit is set to one (``dr.set_thread_count(1)``),
+scatterbench's compiled kernels (which run ``prange`` on every core above 8192
+geometries) are pinned to one around its timed calls (``numba.set_num_threads(1)``),
+and numpy's elementwise arithmetic is single-threaded; the JSON records the counts
+(``machine.threads``).
 
 For every pair two figures on each side: *per call*, one geometry per call
 (``m.mueller(0.5, 0.6, 0.1)``-style, what a ported SCATMECH loop pays), and *per
@@ -49,6 +54,7 @@ import platform
 from dataclasses import asdict, dataclass, field
 from importlib import metadata
 
+import numba
 import numpy as np
 
 import models
@@ -64,6 +70,8 @@ RBAR_NOTE = (
 )
 #: Debian's LLVM for Dr.Jit's JIT variants (the older default LLVM fails with "Cannot select fmaximum")
 LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+#: threads of every timed side (scatterbench's kernels, Dr.Jit's JIT variants)
+THREADS = 1
 
 
 @dataclass
@@ -105,8 +113,13 @@ def time_ours(evaluate, g, loop):
     """scatterbench: one geometry per call, and all of ``g`` in one call; the values
     at the first ``loop`` geometries (for the comparison)."""
     ti, tr, pr = g
-    _, call, call_wall = _us(lambda: evaluate(float(ti[0]), float(tr[0]), float(pr[0])))
-    out, geom, geom_wall = _us(lambda: evaluate(ti, tr, pr), per=ti.size)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(THREADS)  # the kernels' prange would use every core above 8192 geometries
+    try:
+        _, call, call_wall = _us(lambda: evaluate(float(ti[0]), float(tr[0]), float(pr[0])))
+        out, geom, geom_wall = _us(lambda: evaluate(ti, tr, pr), per=ti.size)
+    finally:
+        numba.set_num_threads(threads)
     return out[:loop], (call, call_wall, geom, geom_wall)
 
 
@@ -243,7 +256,7 @@ def mitsuba_rows(g, loop):
         polarized = variant.endswith("polarized")
         try:
             mi.set_variant(variant)
-            dr.set_thread_count(1)
+            dr.set_thread_count(THREADS)
             bsdf = mi.load_dict(
                 {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "eta": 1.37, "k": 7.62}
             )
@@ -261,7 +274,7 @@ def mitsuba_rows(g, loop):
         rows.append(
             Row("FacetBRDF(GGX 0.2, smith)", "Mitsuba 3", f"roughconductor ggx, {variant}", "float64", "float32",
                 *me, *peer, _rel_diff(m00, theirs, floor=1e-20), "BRDF (M00), relative; float32 on Mitsuba's side",
-                [] if variant.startswith("scalar") else ["Dr.Jit on 1 thread, from direction arrays"])
+                [] if variant.startswith("scalar") else [f"Dr.Jit on {THREADS} thread, from direction arrays"])
         )  # fmt: skip
     return rows, notes
 
@@ -289,6 +302,7 @@ def _machine():
         "cores": os.cpu_count(),
         "platform": platform.platform(),
         "load_average_at_start": os.getloadavg(),
+        "threads": {"scatterbench (numba kernels)": THREADS, "Dr.Jit (Mitsuba LLVM variants)": THREADS},
     }
 
 
@@ -303,7 +317,9 @@ def print_table(rows):
             f"{r.peer_call_us / r.ours_call_us:>6.2f} {r.ours_geometry_us:>7.3f} {r.peer_geometry_us:>8.4f} "
             f"{r.peer_geometry_us / r.ours_geometry_us:>7.2f} {r.max_rel_diff:>9.1e}"
         )
-    print("ratio = peer / scatterbench (> 1: scatterbench is faster); CPU time, best of batches, one thread")
+    print(
+        f"ratio = peer / scatterbench (> 1: scatterbench is faster); CPU time, best of batches, {THREADS} thread"
+    )
 
 
 def main(argv=None):
@@ -330,7 +346,7 @@ def main(argv=None):
         machine["load_average_at_end"] = os.getloadavg()
         atomic_write_json(args.out, {
             "what": "per-call and per-geometry times of scatterbench and its peers, measured in one run "
-                    "by benchmarks/peers.py (CPU time, best of batches, one thread; wall time beside it)",
+                    f"by benchmarks/peers.py (CPU time, best of batches, {THREADS} thread on every side; wall time beside it)",
             "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
             "machine": machine, "versions": _versions(), "geometries": {"array": args.n, "loop": args.loop},
             "rows": [asdict(r) for r in sc_rows + mi_rows], "skipped": skipped,

@@ -100,6 +100,27 @@ def test_main_writes_the_measured_table_with_provenance(peers, one_call, tmp_pat
     assert "ratio = peer / scatterbench" in capsys.readouterr().out
 
 
+def test_our_timed_calls_run_on_one_thread(peers, monkeypatch):
+    """The kernels' prange would use every core above 8192 geometries: pinned to one thread
+    while timed (as Dr.Jit is), the count restored after, and recorded in the table."""
+    numba = pytest.importorskip("numba")
+    seen = []
+
+    def record(fn):
+        seen.append(numba.get_num_threads())
+        return fn(), types.SimpleNamespace(seconds=1e-6, wall_seconds=2e-6)
+
+    monkeypatch.setattr(peers, "time_call", record)
+    before = numba.get_num_threads()
+    m = models.FacetBRDF(slopes=models.ExponentialSlopes(0.1), substrate=peers.AL)
+    peers.time_ours(m.mueller, peers.geometries(9000), 4)
+    assert seen == [1, 1] and numba.get_num_threads() == before
+    assert peers._machine()["threads"] == {
+        "scatterbench (numba kernels)": 1,
+        "Dr.Jit (Mitsuba LLVM variants)": 1,
+    }
+
+
 def test_bad_sizes_are_refused(peers):
     with pytest.raises(SystemExit):
         peers.main(["--n", "10", "--loop", "11", "--no-save"])
