@@ -8,6 +8,7 @@ and table, or the script and pySCATMECH version that generated them).
 from __future__ import annotations
 
 import csv
+import json
 import math
 import os
 import tomllib
@@ -173,7 +174,19 @@ def scatmech_flake_measurement_path() -> str:
 
 
 # Peer references (Mitsuba 3, tmm): committed evaluations the tests read; the peers are never imported here
-__all__ += ["mitsuba_roughconductor", "tmm_reference"]
+__all__ += ["mitsuba_roughconductor", "tmm_reference", "peer_timings"]
+
+
+def peer_timings() -> dict:
+    """scatterbench's and its peers' (pySCATMECH, Mitsuba 3) timings, measured in one run by
+    ``benchmarks/peers.py`` (``references/data/peer_timings.json``): ``what``, ``date``,
+    ``machine`` (``cpu``, ``cores``, ``platform``, ``load_average_at_start`` and ``_at_end``,
+    ``threads`` per side), ``versions``, ``geometries`` and ``rows``, one dict per pair with
+    ``model``, ``peer``, ``variant``, per-call and per-geometry microseconds on each side
+    (``ours_call_us``, ``peer_call_us``, ``ours_geometry_us``, ``peer_geometry_us``: CPU time;
+    ``*_wall_us``: wall clock) and ``max_rel_diff``; ``skipped``: peers not measured, why."""
+    with open(data_path("peer_timings.json"), encoding="utf-8") as fh:
+        return json.load(fh)
 
 
 def mitsuba_roughconductor() -> dict:

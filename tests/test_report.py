@@ -226,6 +226,36 @@ def test_stability_findings_grouped_by_model_kind_and_verdict():
     )
 
 
+def test_speed_section_shows_the_peer_timings_as_measured():
+    """The peers' table is references/data/peer_timings.json (benchmarks/peers.py), with the run
+    that measured it (date, machine, load, threads) and ratios from its own numbers; nothing
+    quoted from elsewhere, no per-call figure set against a per-geometry one."""
+    import references
+    from validation.report.core import Section
+    from validation.report.sections import speed
+    from validation.studies.tradeoff import KnobResult, Point
+
+    table = references.peer_timings()
+    rows, run = speed._peers()
+    assert [r["model"] for r in rows] == [t["model"] for t in table["rows"]]
+    for r, t in zip(rows, table["rows"], strict=True):
+        assert r["per call: peer / ours"] == t["peer_call_us"] / t["ours_call_us"]
+        assert r["per geometry: peer / ours"] == t["peer_geometry_us"] / t["ours_geometry_us"]
+    assert run["date"] == table["date"] and run["threads"] != "not recorded"
+    assert not hasattr(speed, "QUOTED_US")
+    knob = KnobResult("k", "q", "ref", [Point(1.0, 1e-3, 1e-3, 10), Point(2.0, 1e-4, 2e-3, 20)])
+    throughput = (
+        {"model": "M", "geometries per call": 5, "us per geometry (CPU)": 1.0, "us per geometry (wall)": 1.0},
+    )
+    data = speed.SpeedData((knob,), ((),), 5, throughput, rows, run)
+    sec = Section("speed", "Speed")
+    speed.render(sec, data)
+    assert sec.numbers["peers"][0]["per geometry: peer / ours"] == rows[0]["per geometry: peer / ours"]
+    assert sec.numbers["peer_run"][0]["date"] == table["date"]
+    shown = {b["key"]: b for b in sec.blocks if b["type"] == "table"}
+    assert table["date"] in shown["peer_run"]["rows"][0] and len(shown["peers"]["rows"]) == len(rows)
+
+
 def test_contributed_models_section(monkeypatch):
     """Models registered under the scatterbench.models entry points (stubbed here: a plain
     Lambertian, one that creates energy, one whose module is missing) get a section with

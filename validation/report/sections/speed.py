@@ -1,57 +1,105 @@
-"""Speed and accuracy: error against cost for each accuracy knob, and per-geometry throughput."""
+"""Speed and accuracy: error against cost for each accuracy knob, per-geometry throughput, and
+the peers' timings measured by ``benchmarks/peers.py`` (committed data, read here)."""
 
 from __future__ import annotations
 
+import functools
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
+
+import references
 
 from ..core import figure_block, table_block
 from ._common import default_models, is_heavy, plt
 
 __all__ = ["SpeedData", "compute", "render"]
 
-#: compiled SCATMECH microseconds per Mueller evaluation (DESIGN.md, one geometry per call)
-QUOTED_US = {"FacetBRDF": 0.5, "SubsurfaceFacetBRDF": 5.2}
-_THROUGHPUT = ["model", "us per geometry (mueller)", "compiled SCATMECH us (quoted, DESIGN.md)", "ratio"]
+_THROUGHPUT = ["model", "geometries per call", "us per geometry (CPU)", "us per geometry (wall)"]
+_PEERS = [
+    "model",
+    "peer",
+    "ours per call (us)",
+    "peer per call (us)",
+    "per call: peer / ours",
+    "ours per geometry (us)",
+    "peer per geometry (us)",
+    "per geometry: peer / ours",
+    "max rel diff",
+]
+_PEER_RUN = ["date", "machine", "load average (1 min, start / end)", "threads", "geometries (array / loop)"]
 
 
 @dataclass(frozen=True)
 class SpeedData:
     """``knobs``: the trade-off study's results (each with every measured point);
-    ``pareto``: per knob, its non-dominated points' rows; ``geometries``: throughput sample size."""
+    ``pareto``: per knob, its non-dominated points' rows; ``geometries``: throughput sample size;
+    ``peer_rows``, ``peer_run``: :func:`references.peer_timings`' pairs with their ratios, and
+    the run that measured them (date, machine, load, threads)."""
 
     knobs: tuple
     pareto: tuple
     geometries: int
     throughput_rows: tuple
+    peer_rows: tuple
+    peer_run: dict
 
 
 def _throughput(n, seed):
+    """Per model, the cost of one ``mueller`` call on ``n`` random geometries (200 for the
+    Monte Carlo and wrapper models), timed by the trade-off study's :func:`time_call`."""
+    from validation.studies.tradeoff import time_call
+
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.45, (2, n))
     pr = rng.uniform(-math.pi, math.pi, n)
     rows = []
     for m in default_models():
         k = 200 if is_heavy(m) else n  # per-geometry cost is what is compared
-        best = math.inf
-        for _ in range(3):
-            t0 = time.perf_counter()
-            m.mueller(ti[:k], tr[:k], pr[:k])
-            best = min(best, time.perf_counter() - t0)
-        us = best / k * 1e6
-        q = QUOTED_US.get(type(m).__name__)
+        _, t = time_call(functools.partial(m.mueller, ti[:k], tr[:k], pr[:k]))
         rows.append(
             {
                 "model": type(m).__name__,
-                "us per geometry (mueller)": us,
-                "compiled SCATMECH us (quoted, DESIGN.md)": q,
-                "ratio": (q / us) if q else None,
+                "geometries per call": k,
+                "us per geometry (CPU)": t.seconds / k * 1e6,
+                "us per geometry (wall)": t.wall_seconds / k * 1e6,
             }
         )
     return tuple(rows)
+
+
+def _peers():
+    """The committed peer timings: one row per pair with the ratios, and the run's description."""
+    table = references.peer_timings()
+    rows = tuple(
+        {
+            "model": r["model"],
+            "peer": f"{r['peer']} {r['variant']}",
+            "ours per call (us)": r["ours_call_us"],
+            "peer per call (us)": r["peer_call_us"],
+            "per call: peer / ours": r["peer_call_us"] / r["ours_call_us"],
+            "ours per geometry (us)": r["ours_geometry_us"],
+            "peer per geometry (us)": r["peer_geometry_us"],
+            "per geometry: peer / ours": r["peer_geometry_us"] / r["ours_geometry_us"],
+            "max rel diff": r["max_rel_diff"],
+        }
+        for r in table["rows"]
+    )
+    mach = table["machine"]
+    threads = mach.get("threads")
+    run = {
+        "date": table["date"],
+        "machine": f"{mach['cpu']}, {mach['cores']} cores, {mach['platform']}",
+        "load average (1 min, start / end)": (
+            f"{mach['load_average_at_start'][0]:.2f} / {mach['load_average_at_end'][0]:.2f}"
+        ),
+        "threads": ", ".join(f"{k}: {v}" for k, v in threads.items()) if threads else "not recorded",
+        "geometries (array / loop)": f"{table['geometries']['array']} / {table['geometries']['loop']}",
+        "what": table["what"],
+        "skipped": tuple(table["skipped"]),
+    }
+    return rows, run
 
 
 def compute(ctx):
@@ -66,7 +114,7 @@ def compute(ctx):
         for r in knobs
     )
     n = 20_000 if ctx.quick else 200_000
-    return SpeedData(knobs, fronts, n, _throughput(n, ctx.seed))
+    return SpeedData(knobs, fronts, n, _throughput(n, ctx.seed), *_peers())
 
 
 def _draw(d):
@@ -94,5 +142,16 @@ def render(s, d: SpeedData):
                 caption=f"Pareto front: {r.knob} ({r.reference})",
             )
         )
-    caption = f"throughput over {d.geometries} random geometries, best of 3, one process"
+    caption = (
+        f"throughput: one mueller call on {d.geometries} random geometries (200 for Monte Carlo and "
+        "wrapper models), this run; best batch of validation.studies.tradeoff.time_call, CPU time of "
+        "every thread of the process (the kernels run on every core above 8192 geometries) and wall time"
+    )
     s.blocks.append(table_block(s, "throughput", _THROUGHPUT, d.throughput_rows, caption=caption))
+    run = d.peer_run
+    caption = f"scatterbench beside its peers, not measured by this run: {run['what']}"
+    if run["skipped"]:
+        caption += "; skipped: " + "; ".join(run["skipped"])
+    s.blocks.append(table_block(s, "peer_run", _PEER_RUN, [run], caption="the run that measured the peers"))
+    fmt = {"max rel diff": ".1e"}
+    s.blocks.append(table_block(s, "peers", _PEERS, d.peer_rows, caption=caption, fmt=fmt))
