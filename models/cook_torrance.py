@@ -266,12 +266,13 @@ class _CookTorranceBase(Model):
         out[0] = self._brdf_flat(ti, tr, pr)
         return out
 
-    def mueller(self, theta_i, theta_r, phi_r=0.0):
+    def mueller(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
         """Mueller BRDF ``(..., 4, 4)``: the ideal depolarizer ``diag(f, 0, 0, 0)``
         with ``M00 = f`` the scalar BRDF.  The model is scalar (natural light,
         Eq. 17): it predicts no polarization, so only ``M00`` carries information.
+        ``out`` and ``precision`` as for :meth:`models.Model.mueller`.
         (Overridden for this docstring, which ``help(model.mueller)`` shows.)"""
-        return super().mueller(theta_i, theta_r, phi_r)
+        return super().mueller(theta_i, theta_r, phi_r, out=out, precision=precision)
 
 
 @dataclass(frozen=True)

@@ -46,10 +46,14 @@ def csqrt(a, b):
     T = type(a)
     if a == T(0.0) and b == T(0.0):
         return T(0.0), T(0.0)
-    r2 = a * a + b * b  # no overflow here: |a|, |b| are index-sized (|n + ik| <= 1.8e16)
-    # below the smallest normal number the squares underflow (an index near INDEX_MIN):
-    # hypot keeps r, hence t, from rounding to zero
-    r = math.sqrt(r2) if r2 >= T(2.2250738585072014e-308) else math.hypot(a, b)
+    # |a|, |b| are index-sized (up to |n + ik|^2 ~ 3.3e32): their squares overflow float32 from
+    # 1.8e19 and underflow below 1.1e-19 (float64 only near INDEX_MIN); hypot keeps r, hence
+    # t, finite and nonzero there
+    s = max(abs(a), abs(b))
+    if T(1.0e-19) < s < T(1.0e19):
+        r = math.sqrt(a * a + b * b)
+    else:
+        r = math.hypot(a, b)
     if a >= T(0.0):
         t = math.sqrt((a + r) * T(0.5))
         return t, b / (T(2.0) * t)
@@ -83,11 +87,10 @@ def rs_k(c, mr, mi, pec):
     wr, wi = csqrt(m2r - T(1.0) + c * c, m2i)
     cwr, cwi = c + wr, wi
     rsr, rsi = cdiv(c - wr, -wi, cwr, cwi)
-    # (m^2 c + w) (c + w)
-    pr_, pi_ = m2r * c + wr, m2i * c + wi
-    dr = cwr * pr_ - cwi * pi_
-    di = cwr * pi_ + cwi * pr_
-    kr, ki = cdiv(T(2.0) * (T(1.0) - m2r), -T(2.0) * m2i, dr, di)
+    # 2 (1 - m^2) / (m^2 c + w) / (c + w): two divisions, not one by the product, which
+    # overflows float32 from |m| ~ 1e10 (|m^2 c + w| |c + w| ~ |m|^3)
+    qr, qi = cdiv(T(2.0) * (T(1.0) - m2r), -T(2.0) * m2i, m2r * c + wr, m2i * c + wi)
+    kr, ki = cdiv(qr, qi, cwr, cwi)
     return rsr, rsi, kr, ki
 
 

@@ -19,12 +19,15 @@ DIFFUSE_ROWS = ("coating", "scale")
 def amplitudes(c, n):
     """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`."""
     T = type(c)
-    if c < T(1e-15):
+    double = T(1e-300) > T(0.0)
+    # a few ulps of pi/2 from grazing is grazing (as the numpy path); float32's pi/2 is 1.2e-7
+    # wide and rounds above pi/2 (a negative cosine)
+    if c < (T(1e-15) if double else T(2.4e-7)):
         c = T(0.0)
     s_int = math.sqrt(T(1.0) - c * c) * (T(1.0) / n)
-    c_int = math.sqrt(T(1.0) - s_int * s_int)
+    c_int = math.sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)  # why this form: the numpy path
     root = T(2.0) * math.sqrt(c * c_int)
-    tiny = T(1e-300) if T(1e-300) > T(0.0) else T(1e-38)
+    tiny = T(1e-300) if double else T(1e-38)
     return s_int, c_int, root / max(c + n * c_int, tiny), root / max(n * c + c_int, tiny)
 
 
@@ -58,8 +61,9 @@ def single(ti, tr, pr, prm, j, iopt, out, i):
     cos_scat = si * sr * cp - ci * cr
     base = T(1.0) + g * g - T(2.0) * g * cos_scat
     dens = (T(1.0) - g * g) / (T(4.0 * math.pi) * base * math.sqrt(base))
-    tiny = T(1e-300) if T(1e-300) > T(0.0) else T(1e-38)
-    K = dens / max(ci + cr, tiny)
+    # both internal cosines zero (grazing under n = 1): no projected flux and zero amplitudes;
+    # dens / tiny would overflow float32 and give inf * 0
+    K = dens / (ci + cr) if ci + cr > T(0.0) else T(0.0)
     if iopt[0] == 0:
         write_depolarized(out, i, asi, api, asr, apr, K)
         return
