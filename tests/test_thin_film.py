@@ -14,6 +14,7 @@ import models
 import references
 from models.fresnel import fresnel_coefficients
 from models.thin_film import FilmStack, TabulatedIndex
+from validation.checks.common import random_geometries
 
 TMM_TOL = 1e-10
 
@@ -176,9 +177,7 @@ def test_bad_input_names_the_parameter(kwargs, name):
 
 # ------------------------------------------------------------------ stacks in the facet models
 def _angles():
-    rng = np.random.default_rng(5)
-    ti, tr = rng.uniform(0, 1.45, (2, 4000))
-    pr = rng.uniform(-math.pi, math.pi, 4000)
+    ti, tr, pr = random_geometries(4000, seed=5, max_deg=math.degrees(1.45))
     # exact retroreflection and specular, where K = (r_s + r_p)/sin^2 is 0/0
     ti[:10], tr[:10], pr[:10] = 0.7, 0.7, math.pi
     ti[10:20], tr[10:20], pr[10:20] = 0.3, 0.3, 0.0
