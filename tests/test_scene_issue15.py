@@ -5,7 +5,6 @@ file and the key.
 """
 
 import math
-import os
 
 import numpy as np
 import pytest
@@ -21,7 +20,7 @@ from validation.fitting.fitspec import ALIASES
 ILL = 'name = "x"\n[illumination]\ntheta_i_deg = 30\nwavelength_nm = 550\n'
 GGX = '[substrate]\nindex = 1.5\ndistribution = "ggx"\nalpha = 0.1\n'
 FILM = "[substrate.film]\nlayers = [{index = [2.6, 0.0], thickness_nm = 120.0}]\n"
-PEARL = os.path.join(os.path.dirname(references.__file__), "scenes", "pearlescent_mica_tio2.toml")
+PEARL = references.scene_path("pearlescent_mica_tio2.toml")
 
 
 def _only(text):
@@ -50,9 +49,7 @@ def test_substrate_shadowing_reaches_the_exposed_and_the_coated_facet_models(cho
 
 def test_shadowing_defaults_to_none_and_keeps_existing_scenes_identical():
     assert _only(ILL + GGX).shadowing == "none"
-    sc = scene.load(
-        os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
-    )
+    sc = scene.load(references.scene_path("aluminium_flakes_clearcoat.toml"))
     m = sc.mechanisms()[0].model
     assert m == models.SubsurfaceFacetBRDF(
         slopes=models.ExponentialSlopes(0.1), coating=1.5, substrate=1.37 + 7.62j
