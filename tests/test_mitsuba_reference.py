@@ -44,7 +44,15 @@ import references
 from models.geometry import incident_direction, scattered_direction, sp_basis
 from models.shadowing import lambda_gaussian, smith_g
 
-GGX_TOL = 2e-5  # float32 precision of Mitsuba's scalar variants
+# GGX against Mitsuba's float32 variants: issue 15's acceptance, "to float32 precision (<= 2e-5
+# relative)", kept as the issue states it. Measured on the committed data (150 rows per variant:
+# each row's _ours against the stored value): unpolarized max 1.64e-6 (scalar_rgb; median 2.0e-7),
+# 1.58e-6 (polarized, also per Mueller element relative to M00 after the basis change); Beckmann
+# with Mitsuba's rational G1 substituted 4.3e-6. float32 eps is 1.19e-7: the worst is ~14 eps, the
+# accumulated rounding of Mitsuba's few dozen float32 operations (D, two G1, complex Fresnel,
+# cosines) on float32 directions; 2e-5 is ~170 eps, so it is the issue's figure, not a tight bound
+# (real errors are far above: no shadowing > 100x it, Beckmann's G1 approximation 5.7e-3).
+GGX_TOL = 2e-5
 
 
 def _mitsuba_g1_beckmann(a):
