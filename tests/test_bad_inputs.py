@@ -212,14 +212,19 @@ scene_case(
 scene_case("coverage above 1", FACETS + "coverage = 2\n", "coverage")
 scene_case("model unknown", FACETS + 'model = "phong"\n', "model")
 scene_case(
-    "cook-torrance without m", ILL + '[substrate]\nmodel = "cook-torrance"\nindex = [2.29, 3.37]\n', "m"
+    "cook-torrance without m",
+    ILL + '[substrate]\nmodel = "cook-torrance"\nindex = [2.29, 3.37]\n',
+    "[substrate] m_parallel: required",
+    "(or give m)",
 )
 CT = ILL + '[substrate]\nmodel = "cook-torrance"\nindex = [2.29, 3.37]\nm = 0.1\n'
 scene_case("cook-torrance with a distribution", CT + 'distribution = "gaussian"\n', "distribution")
 scene_case("cook-torrance with sigma", CT + "sigma = 0.1\n", "sigma")
 scene_case("cook-torrance convention unknown", CT + 'convention = "fancy"\n', "convention")
-scene_case("cook-torrance m huge integer", CT.replace("m = 0.1", f"m = {HUGE}"), "m")
-scene_case("m for the facet model", FACETS + "m = 0.1\n", "m")
+scene_case(
+    "cook-torrance m huge integer", CT.replace("m = 0.1", f"m = {HUGE}"), "[substrate] m: ", "too large"
+)
+scene_case("m for the facet model", FACETS + "m = 0.1\n", "[substrate] m: only for")
 MB = ILL + '[substrate]\nmodel = "maxwell-beard"\nindex = 1.5\ndistribution = "gaussian"\nsigma = 0.05\n'
 scene_case("maxwell-beard with a coating", MB + "[coating]\nindex = 1.5\n", "[coating]")
 scene_case(
@@ -243,7 +248,7 @@ scene_case("volume without a coating", FACETS + "[volume]\nrho = 0.5\n", "[volum
 COATED = FACETS + "[coating]\nindex = 1.5\n"
 scene_case("volume a number", top("volume = 5", COATED), "volume")
 scene_case("volume rho above 1", COATED + "[volume]\nrho = 2\n", "rho")
-scene_case("volume g = 1", COATED + "[volume]\ng = 1\n", "g")
+scene_case("volume g = 1", COATED + "[volume]\ng = 1\n", "[volume] g: ")
 scene_case("volume interface unknown", COATED + '[volume]\ninterface = "bumpy"\n', "interface")
 scene_case("volume single a string", COATED + '[volume]\nsingle = "yes"\n', "single")
 scene_case("volume pairs huge", COATED + f"[volume]\nrho = 0.5\npairs = {HUGE}\n", "pairs")
@@ -532,7 +537,7 @@ fit_case(
     "--scheduler",
 )
 fit_case("force and resume", ["--force", "--resume"], "--force", "--resume")
-fit_case("resume without a checkpoint", ["--resume"], "o", "checkpoint")
+fit_case("resume without a checkpoint", ["--resume"], "o/chain.npz: no checkpoint")
 fit_case("resume from garbage", ["--resume"], "chain.npz", files={"o/chain.npz": b"garbage"})
 fit_case(
     "resume from a truncated zip",
@@ -541,8 +546,10 @@ fit_case(
     files={"o/chain.npz": b"PK\x03\x04" + b"\x00" * 40},
 )
 fit_case("resume from a folder", ["--resume"], "chain.npz", files={"o/chain.npz": None})
-fit_case("out is a file", [], "o", files={"o": "a file"})
-fit_case("out under a file", ["--out", "f/o"], "f", files={"f": "a file"})
+fit_case("out is a file", [], "--out o: not a folder", files={"o": "a file"})
+fit_case(
+    "out under a file", ["--out", "f/o"], "--out f/o: not a folder", "f is a file", files={"f": "a file"}
+)
 fit_case(
     "truth holds a string (refused before sampling)",
     [],
@@ -605,24 +612,36 @@ cli_case("inversion seed negative", [*INV, "--seed", "-1"], "--seed")
 CMP = ["study", "compare", "d.csv", "--scene", "s.toml", "--out", "c", *STUDY[:-1]]  # nor --no-progress
 cli_case("compare noise unknown", [*CMP, "--noise", "foo=1"], "foo")
 cli_case("compare workers zero", [*CMP, "--workers", "0"], "--workers")
-cli_case("compare out is a file", CMP, "c", files={"c": "a file"})
+cli_case("compare out is a file", CMP, "--out c: not a folder", files={"c": "a file"})
 cli_case("table1 tol nan", ["table1", "--tol", "nan"], "--tol")
 cli_case("table1 tol zero", ["table1", "--tol", "0"], "--tol")
 cli_case("table1 tol negative", ["table1", "--tol", "-1"], "--tol")
 cli_case("table1 tol infinite", ["table1", "--tol", "inf"], "--tol")
 cli_case("scene tol nan", ["scene", "s.toml", "--out", "o", "--tol", "nan"], "--tol")
 cli_case("scene tol zero", ["scene", "s.toml", "--out", "o", "--tol", "0"], "--tol")
-cli_case("scene out is a file", ["scene", "s.toml", "--out", "o"], "o", files={"o": "a file"})
+cli_case(
+    "scene out is a file", ["scene", "s.toml", "--out", "o"], "--out o: not a folder", files={"o": "a file"}
+)
 cli_case("tradeoff tol negative", ["tradeoff", "--tol", "-1"], "--tol")
-cli_case("tradeoff out is a file", ["tradeoff", "--quick", "--out", "o"], "o", files={"o": "a file"})
+cli_case(
+    "tradeoff out is a file",
+    ["tradeoff", "--quick", "--out", "o"],
+    "--out o: not a folder",
+    files={"o": "a file"},
+)
 cli_case(
     "validate json into a file's folder",
     ["validate", "--quick", "--json", "f/x.json"],
-    "f",
+    "/f: not a folder",
     files={"f": "a file"},
 )
 cli_case("validate json is a folder", ["validate", "--quick", "--json", "sub"], "sub", files={"sub": None})
-cli_case("report out is a file", ["report", "--quick", "--out", "o"], "o", files={"o": "a file"})
+cli_case(
+    "report out is a file",
+    ["report", "--quick", "--out", "o"],
+    "--out o: not a folder",
+    files={"o": "a file"},
+)
 cli_case("check model without a colon", ["check", "models"], "MODULE:NAME")
 cli_case("check model module missing", ["check", "nosuch_module_x:Model"], "nosuch_module_x")
 cli_case("check model name missing", ["check", "models:NoSuchModel"], "NoSuchModel")
@@ -633,7 +652,7 @@ cli_case(
 cli_case(
     "check json in a file's folder",
     ["check", "models:FacetBRDF", "--json", "f/x.json"],
-    "f",
+    "/f: not a folder",
     files={"f": "a file"},
 )
 cli_case("stability workers zero", ["stability", "--workers", "0"], "--workers")
@@ -661,7 +680,7 @@ def _history_cli(*extra):
     return ["nightly", "--history", "h", "--quick", *extra]
 
 
-case("nightly", "history is a file", _history_cli(), {"h": "a file"}, ("h",))
+case("nightly", "history is a file", _history_cli(), {"h": "a file"}, ("h: not a folder",))
 case("nightly", "latest is a folder", _history_cli(), {"h/runs": None, "h/latest": None}, ("latest",))
 case("nightly", "latest is a file", _history_cli(), {"h/runs": None, "h/latest": "x"}, ("latest",))
 case("nightly", "runs is a file", _history_cli(), {"h/runs": "x"}, ("runs",))

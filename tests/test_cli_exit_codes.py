@@ -18,8 +18,7 @@ import pytest
 
 import references
 
-SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
-COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
+COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
 CLI = [sys.executable, "-m", "validation.cli"]
 

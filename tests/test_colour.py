@@ -41,9 +41,7 @@ def test_quarter_wave_tio2_at_550_nm_looks_green():
 
 
 def test_pearlescent_scene_colour_travel():
-    sc = scene.load(
-        os.path.join(os.path.dirname(references.__file__), "scenes", "pearlescent_mica_tio2.toml")
-    )
+    sc = scene.load(references.scene_path("pearlescent_mica_tio2.toml"))
     model = sc.mechanisms()[0].model
     t = C.colour_travel(model, sc.theta_i)
     assert t.reflectance.shape == (len(C.ASPECULAR_DEG), len(WL)) and t.srgb.shape == (

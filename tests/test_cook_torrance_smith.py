@@ -13,12 +13,12 @@ import pytest
 import models
 from models.cook_torrance import smith_slopes
 from models.shadowing import lambda_gaussian, smith_g1
+from validation.checks.common import random_geometries
 from validation.numerics.integrate import integrated_reflectance
 
 
 def _geometries(n=3000, seed=3):
-    rng = np.random.default_rng(seed)
-    return rng.uniform(0, 1.56, n), rng.uniform(0, 1.56, n), rng.uniform(-math.pi, math.pi, n)
+    return random_geometries(n, seed, max_deg=math.degrees(1.56))
 
 
 @pytest.mark.parametrize("m", [0.03, 0.3, 1.0])

@@ -4,7 +4,6 @@ stability sweep give the same results, in the same order, on a dask.distributed 
 processes and in-process."""
 
 import json
-import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +24,7 @@ from validation.fitting.recovery import recovery_study, subsample
 from validation.fitting.settings import ChainSettings
 from validation.studies.stability import classify, sweep
 
-COATED = os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
+COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
 
 

@@ -31,8 +31,9 @@ SLOPES = [
 def test_hit_fraction_is_coverage_times_one_plus_smith_lambda(slopes):
     # H = C (1 + Lambda(cot ti)) since the mean slope is zero (validation.numerics.energy):
     # the slope-space quadrature against models.shadowing's closed forms and tables.
-    # Measured: <= 4e-5 relative at 89.99 deg (the quadrature's azimuthal resolution, the
-    # same for the Gaussian and exponential families), <= 1e-7 up to 60 deg.
+    # Measured (worst relative error over SLOPES, hit_fraction against the line below):
+    # 0 deg 4.9e-13; 30 deg 1.8e-6, 60 deg 6.3e-6 and 85 deg 3.0e-5 (all GGX alpha 10);
+    # 89.99 deg 1.9e-5 (GGX alpha 0.1; Gaussian and exponential 1.7e-5).
     for deg, tol in ((0.0, 1e-12), (30.0, 1e-5), (60.0, 1e-5), (85.0, 1e-4), (89.99, 1e-4)):
         ti = math.radians(deg)
         lam = float(smith_lambda(slopes, math.cos(ti), math.sin(ti), -1.0, 0.0))

@@ -10,6 +10,7 @@ import pytest
 from scipy import integrate, stats
 
 import models
+from models.geometry import incident_direction, scattered_direction
 from validation.checks.seed000 import slope_conversion_errors, slope_normalization_errors
 
 DISTRIBUTIONS = [
@@ -113,8 +114,8 @@ def test_facet_model_with_ggx_matches_mitsubas_microfacet_form():
     a, n = 0.3, 1.37 + 7.62j
     m = models.FacetBRDF(slopes=models.GGXSlopes(alpha=a), substrate=n)
     ti, tr, pr = 0.4, 0.9, 0.8
-    ki = np.array([-math.sin(ti), 0, math.cos(ti)])
-    ko = np.array([math.sin(tr) * math.cos(pr), math.sin(tr) * math.sin(pr), math.cos(tr)])
+    ki = -incident_direction(ti)  # towards the source, as ko is towards the viewer
+    ko = scattered_direction(tr, pr)
     h = (ki + ko) / np.linalg.norm(ki + ko)
     t2 = (1 - h[2] ** 2) / h[2] ** 2
     d = a * a / (math.pi * h[2] ** 4 * (a * a + t2) ** 2)

@@ -9,6 +9,8 @@ import pytest
 import models
 from models import kernel_specs
 from models.evaluation import backend
+from validation.checks.common import extreme_geometries, random_geometries
+from validation.checks.conformance_checks import _relative as relative_per_geometry
 
 AL = 1.37 + 7.62j
 TOL = 1e-12
@@ -69,27 +71,19 @@ def _configs():
 CONFIGS = _configs()
 
 
-def _geometries(transmission=False):
-    rng = np.random.default_rng(12)
-    n = 400
-    ti = rng.uniform(0, math.pi / 2, n)
-    tr = rng.uniform(0, math.pi / 2, n)
-    pr = rng.uniform(-math.pi, math.pi, n)
-    half = math.pi / 2
-    grazing = math.radians(89.99)
-    ext_ti = [0.0, 0.0, 0.6, 0.6, 0.6, half, 0.3, grazing, 1.2, 1.2, 0.7, 0.0, half, 1.0]
-    ext_tr = [0.0, 0.5, 0.6, 0.6, 0.6, 0.4, half, grazing, 1.2, 1.2, 0.2, half, half, 0.0]
-    ext_pr = [0.0, 0.0, 0.0, math.pi, -math.pi, 0.0, 2.0, math.pi, math.pi, 0.0, 1e-9, math.pi, 0.0, -2.0]
-    return (np.concatenate([ti, ext_ti]), np.concatenate([tr, ext_tr]), np.concatenate([pr, ext_pr]))
+def _geometries():
+    """400 random geometries up to 90 deg, then the extremes (polar 0, 1e-9, 30, 60, 89.99, 90
+    deg in every pair; specular, retro at +-pi, out of plane, azimuth 1e-12)."""
+    return tuple(
+        np.concatenate(p)
+        for p in zip(random_geometries(400, seed=12, max_deg=90.0), extreme_geometries(), strict=True)
+    )
 
 
 def _relative(mk, mn):
-    """max |M_kernel - M_numpy| per geometry, relative to the numpy M00 (exact zeros stay zeros)."""
-    m00 = np.abs(mn[..., 0, 0])[..., None, None]
-    err = np.abs(mk - mn)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel = np.where(err == 0, 0.0, err / m00)
-    return float(np.max(rel))
+    """The worst geometry's max |M_kernel - M_numpy| relative to the numpy M00 (the conformance
+    checks' per-geometry error; exact zeros stay zeros)."""
+    return float(np.max(relative_per_geometry(mk, mn)))
 
 
 @pytest.mark.parametrize("model", CONFIGS, ids=lambda m: type(m).__name__)

@@ -41,10 +41,18 @@ import pytest
 
 import models
 import references
-from models.geometry import sp_basis
+from models.geometry import incident_direction, scattered_direction, sp_basis
 from models.shadowing import lambda_gaussian, smith_g
 
-GGX_TOL = 2e-5  # float32 precision of Mitsuba's scalar variants
+# GGX against Mitsuba's float32 variants: issue 15's acceptance, "to float32 precision (<= 2e-5
+# relative)", kept as the issue states it. Measured on the committed data (150 rows per variant:
+# each row's _ours against the stored value): unpolarized max 1.64e-6 (scalar_rgb; median 2.0e-7),
+# 1.58e-6 (polarized, also per Mueller element relative to M00 after the basis change); Beckmann
+# with Mitsuba's rational G1 substituted 4.3e-6. float32 eps is 1.19e-7: the worst is ~14 eps, the
+# accumulated rounding of Mitsuba's few dozen float32 operations (D, two G1, complex Fresnel,
+# cosines) on float32 directions; 2e-5 is ~170 eps, so it is the issue's figure, not a tight bound
+# (real errors are far above: no shadowing > 100x it, Beckmann's G1 approximation 5.7e-3).
+GGX_TOL = 2e-5
 
 
 def _mitsuba_g1_beckmann(a):
@@ -152,8 +160,7 @@ def _stokes_change(k, x):
 
 def _in_our_frames(data, j):
     ti, tr, pr = data["theta_i"][j], data["theta_r"][j], data["phi_r"][j]
-    k_in = np.array([math.sin(ti), 0.0, -math.cos(ti)])
-    k_out = np.array([math.sin(tr) * math.cos(pr), math.sin(tr) * math.sin(pr), math.cos(tr)])
+    k_in, k_out = incident_direction(ti), scattered_direction(tr, pr)
     l_in = _stokes_change(k_in, data["x_in"][j])
     l_out = _stokes_change(k_out, data["x_out"][j])
     return D @ np.linalg.inv(l_out) @ data["mueller"][j] @ l_in @ D
@@ -178,7 +185,7 @@ def test_polarized_frames_as_stated(data):
     rows = _rows(data, "scalar_spectral_polarized", "ggx")
     j = rows[np.argmax(np.abs(data["mueller"][rows, 2, 3]) + np.abs(data["mueller"][rows, 0, 1]))]
     ti = data["theta_i"][j]
-    _, p = sp_basis(np.array([math.sin(ti), 0.0, -math.cos(ti)]))
+    _, p = sp_basis(incident_direction(ti))
     assert abs(abs(data["x_in"][j] @ p) - 1.0) < 1e-6
     ours = _ours(data, j)
     assert np.max(np.abs(D @ _in_our_frames(data, j) @ D - ours)) > 1e3 * GGX_TOL * ours[0, 0]

@@ -24,8 +24,7 @@ from validation.fitting.fitspec import FitSpecError, check_against_data, fitspec
 from validation.report import nightly
 from validation.studies.scenes import P_FLOOR, _plot_scan, scan, scene_csv
 
-SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
-COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
+COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
 
 

@@ -114,8 +114,16 @@ def test_preset_ranges():
         assert math.degrees(a) == pytest.approx(lo, abs=1e-9) and math.degrees(b) == pytest.approx(
             hi, abs=1e-9
         )
-    assert references.IRON_PLATE["m"] == 0.03 and references.IRON_PLATE["varnish"] == 1.5
-    assert references.IRON_PLATE["substrate"] == 2.29 + 3.37j
+    # the models built from the preset: iron 2.29+3.37i at 650 nm, m = 0.03, varnish n_v = 1.5
+    bare, varnished = c.iron_plate_models()
+    iron = 2.29 + 3.37j
+    assert bare == models.CookTorranceBRDF(
+        slopes=models.GaussianSlopes(0.03), substrate=iron, convention="paper"
+    )
+    assert varnished == models.VarnishedCookTorranceBRDF(
+        slopes=models.StrokeSlopes(0.03, 0.03), coating=1.5, substrate=iron, convention="paper"
+    )
+    assert {m.convention for m in c.iron_plate_models("corrected")} == {"corrected"}
 
 
 @pytest.mark.parametrize(

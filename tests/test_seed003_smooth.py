@@ -100,8 +100,8 @@ def test_depolarizing_single_structure():
         (lambda: models.HenyeyGreenstein(g=-1.2), "g"),
         (lambda: models.HenyeyGreenstein(g=0.1, polarized="yes"), "polarized"),
         (lambda: models.DiffuseSubsurfaceBRDF(rho=1.01), "rho"),
-        (lambda: models.DiffuseSubsurfaceBRDF(coating=0.9), "n"),
-        (lambda: models.SingleScatterBRDF(coating=1.5 + 0.1j), "n"),
+        (lambda: models.DiffuseSubsurfaceBRDF(coating=0.9), "^coating"),
+        (lambda: models.SingleScatterBRDF(coating=1.5 + 0.1j), "^coating"),
         (lambda: models.SingleScatterBRDF(phase=0.3), "phase"),
     ],
 )

@@ -19,6 +19,7 @@ from models.shadowing import (
     smith_g1,
     smith_lambda,
 )
+from validation.checks.common import random_geometries
 
 TABLE_TOL = 1e-10
 
@@ -140,9 +141,7 @@ def test_back_facing_and_correlated_forms():
 
 
 def _geometries():
-    rng = np.random.default_rng(11)
-    ti, tr = rng.uniform(0, 1.5, (2, 3000))
-    return ti, tr, rng.uniform(-math.pi, math.pi, 3000)
+    return random_geometries(3000, seed=11, max_deg=math.degrees(1.5))
 
 
 @pytest.mark.parametrize(
