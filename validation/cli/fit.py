@@ -38,6 +38,16 @@ def _check_executor(args):
         raise UsageError("--workers and --scheduler: give one (local processes or a Dask cluster)")
 
 
+def _open_executor(args):
+    """The executor ``--workers``/``--scheduler`` ask for, its description printed.  A
+    scheduler that does not answer raises ``SchedulerError``, an input error (exit 2)."""
+    from validation.fitting.executors import make_executor
+
+    ex = make_executor(args.workers, args.scheduler)
+    print(f"executor: {ex.describe()}")
+    return ex
+
+
 def _executor_args(p):
     p.add_argument(
         "--workers",
@@ -176,15 +186,13 @@ def _run_fit(args, lik, settings):
     posterior summary, or the exit code 130 after Ctrl-C.  The running checkpoint is
     chain.partial.npz; it becomes chain.npz when the run ends, so a failed --force
     run never replaces a previous complete chain."""
-    from validation.fitting.executors import make_executor
     from validation.fitting.fit import run_fit, write_fit
 
     os.makedirs(args.out, exist_ok=True)
     ck = os.path.join(args.out, "chain.partial.npz")
     final = os.path.join(args.out, "chain.npz")
     try:
-        with make_executor(args.workers, args.scheduler) as ex:
-            print(f"executor: {ex.describe()}")
+        with _open_executor(args) as ex:
             res = run_fit(
                 lik,
                 settings,

@@ -25,29 +25,12 @@ from .fit import (
     _executor_args,
     _load_and_describe,
     _mcmc_args,
+    _open_executor,
     _require_walkers,
     _spec_args,
 )
 
 __all__ = ["register"]
-
-
-def _open_executor(args):
-    """The executor ``--workers``/``--scheduler`` ask for, its description printed.
-
-    Raises
-    ------
-    UsageError
-        A scheduler that does not answer (exit 2).
-    """
-    from validation.fitting.executors import make_executor
-
-    try:
-        ex = make_executor(args.workers, args.scheduler)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from exc
-    print(f"executor: {ex.describe()}")
-    return ex
 
 
 # ----------------------------------------------------------------------------- recovery
