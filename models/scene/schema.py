@@ -20,7 +20,7 @@ from ..subsurface_facet import SubsurfaceFacetBRDF
 from ..thin_film import FilmStack
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
-__all__ = ["SceneError", "parse", "check_structure", "polarization_state", "utf8_text", "MAX_DEPTH"]
+__all__ = ["SceneError", "parse", "check_structure", "polarization_state", "shown", "utf8_text", "MAX_DEPTH"]
 
 #: how deeply tables and arrays may nest in a scene file (the deepest schema entry,
 #: ``[fit.mask] exclude = [{theta_r_deg = [lo, hi]}]``, is 5 levels)
@@ -91,10 +91,10 @@ def parse(data: dict, path: str) -> dict:
         raise _err(
             path,
             "name",
-            f"a non-empty, one-line string of printable characters is required; got {_shown(name)}",
+            f"a non-empty, one-line string of printable characters is required; got {shown(name)}",
         )
     if "fit" in data and not isinstance(data["fit"], dict):
-        raise _err(path, "[fit]", f"must be a table (free, noise, mask); got {_shown(data['fit'])}")
+        raise _err(path, "[fit]", f"must be a table (free, noise, mask); got {shown(data['fit'])}")
     out = {"name": name, **_illumination(path, data.get("illumination"))}
     out["coating"] = _coating(path, data["coating"]) if "coating" in data else None
     out["substrate"] = (
@@ -110,10 +110,11 @@ def _err(path, key, msg):
     return SceneError(f"{path}: {key}: {msg}")
 
 
-def _shown(value):
-    """``repr(value)``, cut to a readable length."""
+def shown(value, width=60):
+    """``repr(value)`` cut to ``width`` characters (``...`` at the end when cut), for the
+    ``got ...`` part of an error message about a file's or a flag's value."""
     text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def _unknown(path, section, table, allowed):
@@ -127,11 +128,11 @@ def _unknown(path, section, table, allowed):
 def _number(path, key, value, low=None, high=None, low_open=False):
     """A quantity of the scene itself (not a model parameter): a finite number in range."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise _err(path, key, f"must be a finite number; got {_shown(value)}")
+        raise _err(path, key, f"must be a finite number; got {shown(value)}")
     if low is not None and (value < low or (low_open and value == low)):
-        raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {_shown(value)}")
+        raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {shown(value)}")
     if high is not None and value > high:
-        raise _err(path, key, f"must be <= {high:g}; got {_shown(value)}")
+        raise _err(path, key, f"must be <= {high:g}; got {shown(value)}")
     return float(value)
 
 
@@ -200,14 +201,14 @@ def polarization_state(value):
             except ValueError:
                 angle = math.nan
             if not math.isfinite(angle):
-                raise ValueError(f"linear:<deg> needs a finite angle in degrees; got {_shown(value)}")
+                raise ValueError(f"linear:<deg> needs a finite angle in degrees; got {shown(value)}")
         return stokes(value)
     if not isinstance(value, list) or not all(
         isinstance(x, (int, float)) and not isinstance(x, bool) for x in value
     ):
         raise ValueError(
             "must be a name (unpolarized, s, p, +45, -45, left, right, linear:<deg>) or "
-            f"[I, Q, U, V] numbers; got {_shown(value)}"
+            f"[I, Q, U, V] numbers; got {shown(value)}"
         )
     return stokes(value)
 
@@ -240,7 +241,7 @@ def _distribution(path, section, table):
     kind = table.get("distribution")
     names = [n for n, e in TABLE.items() if e.kind == "distribution"]
     if kind not in names:
-        raise _err(path, f"{section}distribution", f"must be one of {', '.join(names)}; got {_shown(kind)}")
+        raise _err(path, f"{section}distribution", f"must be one of {', '.join(names)}; got {shown(kind)}")
     for k in table:
         if k != "distribution" and k not in TABLE[kind].keys:
             raise _err(
@@ -271,7 +272,7 @@ def _index(path, key, value):
         return complex(float(value), 0.0)
     if isinstance(value, list) and len(value) == 2 and all(real(v) for v in value):
         return complex(float(value[0]), float(value[1]))
-    raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {_shown(value)}')
+    raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {shown(value)}')
 
 
 def _substrate(path, s, data, wavelength_nm):
@@ -334,15 +335,13 @@ def _film(path, film, substrate, wavelength_nm):
         raise _err(
             path,
             "[substrate.film] layers",
-            f"required: a non-empty array of tables {{index = [n, k], thickness_nm = d}}; got {_shown(layers)}",
+            f"required: a non-empty array of tables {{index = [n, k], thickness_nm = d}}; got {shown(layers)}",
         )
     out = []
     for j, layer in enumerate(layers):
         key = f"[substrate.film] layers[{j}]"
         if not isinstance(layer, dict):
-            raise _err(
-                path, key, f"must be a table {{index = [n, k], thickness_nm = d}}; got {_shown(layer)}"
-            )
+            raise _err(path, key, f"must be a table {{index = [n, k], thickness_nm = d}}; got {shown(layer)}")
         _unknown(path, f"{key}.", layer, {"index", "thickness_nm"})
         for k, what in (("index", "n or [n, k] (finite)"), ("thickness_nm", "a number >= 0")):
             if k not in layer:

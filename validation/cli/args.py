@@ -13,6 +13,8 @@ import os
 import re
 import tempfile
 
+from models.scene.schema import shown
+
 __all__ = [
     "UsageError",
     "MAX_WORKERS",
@@ -37,10 +39,6 @@ class UsageError(ValueError):
     message names the flag (the command line turns it into ``error: ...``, exit 2)."""
 
 
-def _shown(text):
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
 def int_at_least(low):
     """An argparse type: an integer >= ``low``."""
 
@@ -48,7 +46,7 @@ def int_at_least(low):
         try:
             v = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"must be an integer >= {low}; got {_shown(text)!r}") from None
+            raise argparse.ArgumentTypeError(f"must be an integer >= {low}; got {shown(text, 40)}") from None
         if v < low:
             raise argparse.ArgumentTypeError(f"must be an integer >= {low}; got {v}")
         return v
@@ -74,9 +72,9 @@ def _finite(text):
     try:
         v = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a finite number; got {_shown(text)!r}") from None
+        raise argparse.ArgumentTypeError(f"must be a finite number; got {shown(text, 40)}") from None
     if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"must be a finite number; got {_shown(text)!r}")
+        raise argparse.ArgumentTypeError(f"must be a finite number; got {shown(text, 40)}")
     return v
 
 
@@ -84,7 +82,7 @@ def positive_float(text):
     """An argparse type: a finite number > 0 (a tolerance, a noise level)."""
     v = _finite(text)
     if v <= 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number > 0; got {_shown(text)!r}")
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0; got {shown(text, 40)}")
     return v
 
 
@@ -92,7 +90,7 @@ def nonneg_float(text):
     """An argparse type: a finite number >= 0 (a time to wait)."""
     v = _finite(text)
     if v < 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0; got {_shown(text)!r}")
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0; got {shown(text, 40)}")
     return v
 
 
@@ -124,7 +122,7 @@ def scheduler_address(text):
     """An argparse type: a Dask scheduler address, ``[PROTOCOL://]HOST:PORT``."""
     if not _ADDRESS.match(text):
         raise argparse.ArgumentTypeError(
-            f"must be a scheduler address [PROTOCOL://]HOST:PORT, e.g. tcp://10.0.0.5:8786; got {_shown(text)!r}"
+            f"must be a scheduler address [PROTOCOL://]HOST:PORT, e.g. tcp://10.0.0.5:8786; got {shown(text, 40)}"
         )
     return text
 

@@ -61,7 +61,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from models.polarization import ellipsometric
-from models.scene.schema import polarization_state, utf8_text
+from models.scene.schema import polarization_state, shown, utf8_text
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -245,13 +245,13 @@ def _sidecar_problem(key, value):
     if key not in SIDECAR_KEYS:
         return f"unknown key {key!r}; allowed: {', '.join(sorted(SIDECAR_KEYS))}"
     if key == "format" and value != FORMAT:
-        return f"format must be {FORMAT!r}; got {_shown(value)}"
+        return f"format must be {FORMAT!r}; got {shown(value)}"
     if key in ("sample", "instrument", "description") and not isinstance(value, str):
-        return f"{key} must be a string; got {_shown(value)}"
+        return f"{key} must be a string; got {shown(value)}"
     if key == "wavelength_nm" and not (_is_num(value) and value > 0):
-        return f"wavelength_nm must be a finite number > 0; got {_shown(value)}"
+        return f"wavelength_nm must be a finite number > 0; got {shown(value)}"
     if key == "aperture_deg" and not (_is_num(value) and 0 <= value <= 90):
-        return f"aperture_deg must be a number in [0, 90]; got {_shown(value)}"
+        return f"aperture_deg must be a number in [0, 90]; got {shown(value)}"
     if key == "incident_polarization":
         try:
             polarization_state(value)
@@ -262,13 +262,8 @@ def _sidecar_problem(key, value):
             return "truth must be an object {scene key: value}"
         for k, v in value.items():
             if not _is_num(v):
-                return f"truth: {k}: must be a finite number (the true value); got {_shown(v)}"
+                return f"truth: {k}: must be a finite number (the true value); got {shown(v)}"
     return None
-
-
-def _shown(value):
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _is_num(v):

@@ -43,6 +43,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from models.scene.schema import shown
+
 __all__ = [
     "FreeParam",
     "FitSpec",
@@ -190,21 +192,16 @@ def specular_distance(ti, tr, pr):
     return np.arccos(np.clip(c, -1.0, 1.0))
 
 
-def _shown(value):
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _num(where, text):
     """A number given as a number or as text (``"0.5"`` on the command line); not a bool."""
     if isinstance(text, bool) or not isinstance(text, (int, float, str)):
-        raise FitSpecError(f"{where}: {_shown(text)} is not a number")
+        raise FitSpecError(f"{where}: {shown(text)} is not a number")
     try:
         v = float(text)
     except (ValueError, OverflowError):
-        raise FitSpecError(f"{where}: {_shown(text)} is not a number") from None
+        raise FitSpecError(f"{where}: {shown(text)} is not a number") from None
     if not math.isfinite(v):
-        raise FitSpecError(f"{where}: {_shown(text)} is not a finite number")
+        raise FitSpecError(f"{where}: {shown(text)} is not a finite number")
     return v
 
 
@@ -299,16 +296,16 @@ def _free_table(where, e):
     """A free entry given as a table ``{key, low, high[, prior]}``."""
     missing = {"key", "low", "high"} - set(e)
     if missing:
-        raise FitSpecError(f"{where}: table entry {_shown(e)} lacks {sorted(missing)}")
+        raise FitSpecError(f"{where}: table entry {shown(e)} lacks {sorted(missing)}")
     extra = set(e) - {"key", "low", "high", "prior"}
     if extra:
         raise FitSpecError(
-            f"{where}: unknown key(s) {sorted(extra)} in {_shown(e)}; allowed: key, low, high, prior"
+            f"{where}: unknown key(s) {sorted(extra)} in {shown(e)}; allowed: key, low, high, prior"
         )
     if not isinstance(e["key"], str):
-        raise FitSpecError(f"{where}: key must be a dotted scene key (a string); got {_shown(e['key'])}")
+        raise FitSpecError(f"{where}: key must be a dotted scene key (a string); got {shown(e['key'])}")
     if not isinstance(e.get("prior", "uniform"), str):
-        raise FitSpecError(f"{where} {e['key']}: prior must be 'uniform' or 'log'; got {_shown(e['prior'])}")
+        raise FitSpecError(f"{where} {e['key']}: prior must be 'uniform' or 'log'; got {shown(e['prior'])}")
     key = ALIASES.get(e["key"], e["key"])
     low, high = _num(f"{where} {key} low", e["low"]), _num(f"{where} {key} high", e["high"])
     return _free(where, key, low, high, e.get("prior", "uniform"))
@@ -387,7 +384,7 @@ def _mask_entries(where, table, near_specular_deg, exclude):
     table_boxes = mask.get("exclude", [])
     if not isinstance(table_boxes, list):
         raise FitSpecError(
-            f"{where} mask exclude: expected a list of tables {{axis = [lo, hi]}}; got {_shown(table_boxes)}"
+            f"{where} mask exclude: expected a list of tables {{axis = [lo, hi]}}; got {shown(table_boxes)}"
         )
     boxes = [_exclude_box(f"{where} mask exclude", b) for b in table_boxes]
     if exclude:
