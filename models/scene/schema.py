@@ -20,7 +20,7 @@ from ..subsurface_facet import SubsurfaceFacetBRDF
 from ..thin_film import FilmStack
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
-__all__ = ["SceneError", "parse", "check_structure", "polarization_state", "shown", "utf8_text", "MAX_DEPTH"]
+__all__ = ["SceneError", "parse", "check_structure", "shown", "utf8_text", "MAX_DEPTH"]
 
 #: how deeply tables and arrays may nest in a scene file (the deepest schema entry,
 #: ``[fit.mask] exclude = [{theta_r_deg = [lo, hi]}]``, is 5 levels)
@@ -160,9 +160,7 @@ def _illumination(path, ill):
         "theta_i": math.radians(_number(path, "[illumination] theta_i_deg", ill["theta_i_deg"], 0.0, 90.0))
     }
     try:
-        out["polarization"] = tuple(
-            float(x) for x in polarization_state(ill.get("polarization", "unpolarized"))
-        )
+        out["polarization"] = tuple(float(x) for x in stokes(ill.get("polarization", "unpolarized")))
     except ValueError as exc:
         raise _err(path, "[illumination] polarization", str(exc)) from exc
     wl = ill.get("wavelength_nm")
@@ -188,29 +186,6 @@ def _illumination(path, ill):
                 path, f"[illumination] {key}", "only for source = 'point' (a collimated beam has none)"
             )
     return out
-
-
-def polarization_state(value):
-    """The unit-intensity Stokes vector of a polarization given in a file: a name of
-    :func:`models.polarization.stokes` or ``[I, Q, U, V]``; ``ValueError`` for anything
-    else, a non-finite angle included."""
-    if isinstance(value, str):
-        if value.startswith("linear:"):
-            try:
-                angle = float(value[7:])
-            except ValueError:
-                angle = math.nan
-            if not math.isfinite(angle):
-                raise ValueError(f"linear:<deg> needs a finite angle in degrees; got {shown(value)}")
-        return stokes(value)
-    if not isinstance(value, list) or not all(
-        isinstance(x, (int, float)) and not isinstance(x, bool) for x in value
-    ):
-        raise ValueError(
-            "must be a name (unpolarized, s, p, +45, -45, left, right, linear:<deg>) or "
-            f"[I, Q, U, V] numbers; got {shown(value)}"
-        )
-    return stokes(value)
 
 
 def _coating(path, c):

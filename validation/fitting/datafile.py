@@ -60,8 +60,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models.polarization import ellipsometric
-from models.scene.schema import polarization_state, shown, utf8_text
+from models.polarization import ellipsometric, stokes
+from models.scene.schema import shown, utf8_text
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -254,7 +254,7 @@ def _sidecar_problem(key, value):
         return f"aperture_deg must be a number in [0, 90]; got {shown(value)}"
     if key == "incident_polarization":
         try:
-            polarization_state(value)
+            stokes(value)
         except ValueError as exc:
             return f"incident_polarization: {exc}"
     if key == "truth":
@@ -401,7 +401,7 @@ def _parse_rows(path, header, rows, col_of):
                 continue
             if cell not in cache:
                 try:
-                    cache[cell] = polarization_state(cell)
+                    cache[cell] = stokes(cell)
                 except ValueError as exc:
                     raise DataFileError(path, lineno, j, f"column 'incident': {exc}") from exc
             incident[i] = cache[cell]
@@ -446,7 +446,7 @@ def load_data(path) -> Dataset:
         raise DataFileError(path, header_line, None, "no data rows")
     values, incident = _parse_rows(path, header, rows, col_of)
     if "incident_polarization" in meta:
-        incident[:] = polarization_state(meta["incident_polarization"])
+        incident[:] = stokes(meta["incident_polarization"])
     eta, P, PC = _ellipsometric(values, len(rows))
     return Dataset(
         path=path,
