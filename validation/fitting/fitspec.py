@@ -120,14 +120,16 @@ class FitSpec:
     def u_bounds(self):
         return np.array([p.u_bounds for p in self.free])
 
-    def log_prior(self, u) -> float:
+    def log_prior(self, u):
         """Flat in sampling coordinates inside the bounds (the prior density of the
-        declared uniform/log-uniform priors, up to a constant); ``-inf`` outside."""
+        declared uniform/log-uniform priors, up to a constant); ``-inf`` outside or where a
+        coordinate is not finite.  Vectorized: one position ``(k,)`` gives a float,
+        positions ``(W, k)`` a ``(W,)`` array (the likelihood's batch of walkers)."""
         b = self.u_bounds()
         u = np.asarray(u, dtype=float)
-        if np.all(np.isfinite(u)) and np.all(u >= b[:, 0]) and np.all(u <= b[:, 1]):
-            return 0.0
-        return -math.inf
+        inside = np.all(np.isfinite(u) & (u >= b[:, 0]) & (u <= b[:, 1]), axis=-1)
+        out = np.where(inside, 0.0, -math.inf)
+        return float(out) if out.ndim == 0 else out
 
     def physical(self, u) -> dict:
         return {p.key: float(p.from_u(v)) for p, v in zip(self.free, u, strict=True)}

@@ -113,7 +113,6 @@ class Likelihood:
         # decided once, at the scene's own values: re-deciding per evaluation would make ln L
         # jump where a decision flips.
         self.decisions = self.scene.decisions()
-        self._bounds = spec.u_bounds()
         scene_keys = {p.key: (p.low, p.high) for p in spec.free if not p.is_noise}
         probe = (d.theta_i[:8], d.theta_r[:8], d.phi_r[:8])
         self.binding = binding.bind(self.scene, scene_keys, self.decisions, probe)
@@ -263,20 +262,15 @@ class Likelihood:
         to it)."""
         return float(np.sum(self.pointwise_rebuilt(u)))
 
-    def in_bounds(self, U) -> np.ndarray:
-        """Positions inside the prior's bounds (finite), ``(W,)`` booleans."""
-        b = self._bounds
-        return np.all(np.isfinite(U) & (U >= b[:, 0]) & (U <= b[:, 1]), axis=1)
-
     def batch(self, U) -> np.ndarray:
         """Log posterior of positions ``U`` ``(W, k)`` in one evaluation, ``(W,)``: the prior is
-        flat inside the bounds (checked once, vectorized), ``-inf`` outside or where the
-        model predicts no light at a used row."""
+        flat inside the bounds (:meth:`FitSpec.log_prior`, vectorized), ``-inf`` outside or
+        where the model predicts no light at a used row."""
         U = np.atleast_2d(np.asarray(U, dtype=float))
-        out = np.full(len(U), -math.inf)
-        inside = np.flatnonzero(self.in_bounds(U))
+        out = self.spec.log_prior(U)
+        inside = np.flatnonzero(np.isfinite(out))
         if inside.size:
-            ll = self.loglike_batch(U[inside])
+            ll = out[inside] + self.loglike_batch(U[inside])
             out[inside] = np.where(np.isfinite(ll), ll, -math.inf)
         return out
 
