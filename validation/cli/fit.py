@@ -111,14 +111,13 @@ def _load(args):
     (and against each other) before any work."""
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import check_against_data, fitspec_from
+    from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
 
     sc = scene_mod.load(args.scene)
     data = load_data(args.data)
     spec = fitspec_from(sc, args.free, args.noise, args.near_specular_deg, args.exclude)
-    check_against_data(sc, spec, data)
-    return sc, data, spec, Likelihood(sc, spec, data)
+    return sc, data, spec, Likelihood(sc, spec, data)  # refuses a spec the data cannot inform
 
 
 def _load_and_describe(args):

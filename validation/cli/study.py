@@ -214,7 +214,7 @@ def _compare_likelihoods(args):
     """One likelihood per ``--scene`` on the data, named by the scene file."""
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import check_against_data, fitspec_from
+    from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
 
     data = load_data(args.data)
@@ -222,7 +222,6 @@ def _compare_likelihoods(args):
     for path in args.scene:
         sc = scene_mod.load(path)
         spec = fitspec_from(sc, None, args.noise, args.near_specular_deg, args.exclude)
-        check_against_data(sc, spec, data)
         liks.append(Likelihood(sc, spec, data))
         names.append(os.path.basename(path))
     return liks, names

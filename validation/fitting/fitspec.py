@@ -53,7 +53,6 @@ __all__ = [
     "NOISE_TERMS",
     "parse_free",
     "fitspec_from",
-    "check_against_data",
     "masked_rows",
 ]
 
@@ -164,6 +163,13 @@ class FitSpec:
                     v = lo + np.mod(v - lo + 1e-9, 360.0) - 1e-9  # the azimuth's turn that starts at lo
                 inside &= (v >= lo - 1e-9) & (v <= hi + 1e-9)
             keep &= ~inside
+        return keep
+
+    def kept(self, data) -> np.ndarray:
+        """:meth:`mask`, or :class:`FitSpecError` when it keeps no row of ``data``."""
+        keep = self.mask(data)
+        if not keep.any():
+            raise FitSpecError(f"{data.path}: mask: every data row is masked out; no row is left")
         return keep
 
     def describe(self) -> str:
@@ -439,70 +445,4 @@ def masked_rows(data, near_specular_deg=None, exclude=None):
     """The rows of ``data`` a mask keeps (``--near-specular-deg``, ``--exclude``, as in
     :func:`fitspec_from`); :class:`FitSpecError` when it keeps none."""
     ns, boxes = _mask_entries("--", {}, near_specular_deg, exclude)
-    keep = FitSpec((), {}, ns, boxes).mask(data)
-    if not keep.any():
-        raise FitSpecError(f"{data.path}: mask: every data row is masked out; nothing left")
-    return data.subset(keep)
-
-
-#: noise term -> (likelihood term, data attribute, its error attribute)
-_TERM_DATA = {
-    "brdf": ("brdf", "brdf", "brdf_err"),
-    "eta_deg": ("eta", "eta", "eta_err"),
-    "P": ("P", "P", "P_err"),
-    "P_C": ("P_C", "P_C", "P_C_err"),
-}
-
-
-def check_against_data(scene, spec, data) -> None:
-    """Raise :class:`FitSpecError` unless ``spec`` can give a meaningful posterior on ``data``
-    with ``scene``, before any sampling: the same wavelength, rows left after the mask, a noise
-    level (or error column) for the BRDF, no term of zero variance (a fixed level of 0, or one
-    whose square underflows, without an error column: the likelihood would be degenerate and
-    the chain frozen), and no free noise level for a term the likelihood does not have (its
-    posterior would be its prior).
-
-    Parameters
-    ----------
-    scene : models.scene.Scene
-    spec : FitSpec
-    data : validation.fitting.datafile.Dataset
-    """
-    from .likelihood import term_variances
-
-    wl_s, wl_d = scene.wavelength_nm, data.meta.get("wavelength_nm")
-    if wl_s is not None and wl_d is not None and abs(wl_s - wl_d) > 1e-9 * wl_s:
-        raise FitSpecError(
-            f"wavelength: the data ({wl_d:g} nm, {data.path}) and the scene ({wl_s:g} nm, {scene.path}) "
-            "differ; the scene's optical constants are for its wavelength"
-        )
-    keep = spec.mask(data)
-    if not keep.any():
-        raise FitSpecError(f"{data.path}: mask: every data row is masked out; nothing to fit")
-    d = data.subset(keep)
-    free = {p.key[6:] for p in spec.free if p.is_noise}
-    for noise, (term, col, err) in _TERM_DATA.items():
-        has, errors = getattr(d, col) is not None, getattr(d, err)
-        if noise in free and (noise in spec.off or not has):
-            why = "the term is off" if noise in spec.off else f"the data ({data.path}) have no {col} column"
-            raise FitSpecError(
-                f"noise.{noise}: free, but the likelihood has no {col} term ({why}); its posterior would be its prior"
-            )
-        level = noise in spec.noise or noise in free
-        if noise == "brdf" and not (level or errors is not None):
-            raise FitSpecError(
-                "noise.brdf: the BRDF term needs a noise level (fixed or free: --noise brdf=0.05 or "
-                "--noise brdf:0.005:1:log) or a brdf_err column"
-            )
-        if noise in free or noise in spec.off or not has or not (level or errors is not None):
-            continue  # a free level is sampled; a term not used has no variance
-        var = np.broadcast_to(term_variances(spec.noise, d, [term])[term], (len(d),))
-        bad = ~(var >= np.finfo(float).tiny)
-        if bad.any():
-            line = int(d.lines[bad][0]) if d.lines is not None else None
-            raise FitSpecError(
-                f"noise.{noise} = {spec.noise.get(noise, 0.0):g}: the {col} term has zero variance"
-                + (f" at {data.path}:{line}" if line else "")
-                + f" (no {err} column there): the likelihood is degenerate; give a level > 0 "
-                f"(or free it: --noise {noise}:LOW:HIGH)"
-            )
+    return data.subset(FitSpec((), {}, ns, boxes).kept(data))
