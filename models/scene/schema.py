@@ -10,10 +10,10 @@ alone).  Values that a model takes are validated by that model's declared parame
 from __future__ import annotations
 
 import math
+import re
 
 from ..aperture import DetectorAperture
 from ..facet import FacetBRDF
-from ..params import check_index
 from ..point_source import PointSourceBRDF
 from ..polarization import stokes
 from ..subsurface_facet import SubsurfaceFacetBRDF
@@ -321,15 +321,13 @@ def _film(path, film, substrate, wavelength_nm):
         for k, what in (("index", "n or [n, k] (finite)"), ("thickness_nm", "a number >= 0")):
             if k not in layer:
                 raise _err(path, f"{key}.{k}", f"required: {what}")
-        n = _index(path, f"{key}.index", layer["index"])
-        try:
-            n = check_index("index", n)
-        except ValueError as exc:
-            raise _err(path, f"{key}.index", str(exc)) from exc
-        if n == math.inf:
-            raise _err(path, f"{key}.index", 'a film has a finite index n or [n, k], not "inf"')
-        out.append((n, _number(path, f"{key}.thickness_nm", layer["thickness_nm"], 0.0)))
-    return FilmStack(layers=tuple(out), substrate=substrate, wavelength_nm=wavelength_nm)
+        out.append((_index(path, f"{key}.index", layer["index"]), layer["thickness_nm"]))
+    try:  # the stack validates the values; its message names layers[j] index / thickness_nm
+        return FilmStack(layers=tuple(out), substrate=substrate, wavelength_nm=wavelength_nm)
+    except ValueError as exc:
+        m = re.match(r"layers\[(\d+)\] (index|thickness_nm)", str(exc))
+        key = f"[substrate.film] layers[{m[1]}].{m[2]}" if m else "[substrate.film]"
+        raise _err(path, key, str(exc)) from exc
 
 
 def _slope_keys_apply(path, s, kind, entry):
