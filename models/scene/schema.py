@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 
 from ..aperture import DetectorAperture
 from ..facet import FacetBRDF
@@ -20,7 +21,16 @@ from ..subsurface_facet import SubsurfaceFacetBRDF
 from ..thin_film import FilmStack
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
-__all__ = ["SceneError", "parse", "check_structure", "shown", "utf8_text", "MAX_DEPTH"]
+__all__ = [
+    "SceneError",
+    "parse",
+    "check_structure",
+    "shown",
+    "where",
+    "long_digits",
+    "read_utf8",
+    "MAX_DEPTH",
+]
 
 #: how deeply tables and arrays may nest in a scene file (the deepest schema entry,
 #: ``[fit.mask] exclude = [{theta_r_deg = [lo, hi]}]``, is 5 levels)
@@ -37,14 +47,37 @@ class SceneError(ValueError):
     """A scene file problem; the message names the file, the key and the allowed values."""
 
 
-def utf8_text(raw: bytes):
-    """``(text, None)`` for UTF-8 bytes (a byte-order mark dropped), else ``(the valid text
-    before the first bad byte, that byte)`` so that errors can say where it is."""
+def where(text: str, offset: int):
+    """``(line, column)``, both 1-based, of a character offset of ``text``."""
+    return text.count("\n", 0, offset) + 1, offset - text.rfind("\n", 0, offset)
+
+
+def long_digits(text: str):
+    """The regular-expression match of the first run of more digits than Python converts
+    to an integer (``sys.get_int_max_str_digits()``), or ``None``: what a parser's bare
+    ``ValueError`` about such an integer was about, so that errors can say where it is."""
+    limit = sys.get_int_max_str_digits()
+    return re.search(rf"\d{{{limit + 1},}}", text) if limit else None
+
+
+def read_utf8(path: str, what: str, error):
+    """The UTF-8 text of the file ``path`` (a byte-order mark dropped).  A file that cannot
+    be read or is not UTF-8 raises ``error(at, message)``, ``at`` the ``(line, column)`` of
+    the first bad byte (``None`` for a file not read); ``what`` names the file in the
+    message ("scene file", "data file")."""
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise error(None, f"cannot read the {what} ({exc.strerror})") from exc
     body = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw
     try:
-        return body.decode("utf-8"), None
+        return body.decode("utf-8")
     except UnicodeDecodeError as exc:
-        return body[: exc.start].decode("utf-8"), body[exc.start]
+        text = body[: exc.start].decode("utf-8")
+        raise error(
+            where(text, len(text)), f"not UTF-8 text (byte 0x{body[exc.start]:02x}); save the {what} as UTF-8"
+        ) from None
 
 
 def _key_path(keys):

@@ -61,7 +61,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from models.polarization import ellipsometric, stokes
-from models.scene.schema import shown, utf8_text
+from models.scene.schema import long_digits, read_utf8, shown, where
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -167,16 +167,7 @@ def _sidecar_path(path):
 
 def _text_of(path, what):
     """The UTF-8 text of a file (a byte-order mark dropped); errors name ``file:line:column``."""
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise DataFileError(path, 0, None, f"cannot read the {what} ({exc.strerror})") from exc
-    text, bad = utf8_text(raw)
-    if bad is None:
-        return text
-    line, col = text.count("\n") + 1, len(text) - text.rfind("\n")
-    raise DataFileError(path, line, col, f"not UTF-8 text (byte 0x{bad:02x}); save the {what} as UTF-8")
+    return read_utf8(path, what, lambda at, msg: DataFileError(path, *(at or (0, None)), msg))
 
 
 class _NotJSON(ValueError):
@@ -209,9 +200,13 @@ def _parse_json(side, text):
     except RecursionError as exc:
         raise DataFileError(side, 1, None, "not valid JSON for a sidecar: nested too deeply") from exc
     except ValueError as exc:  # _NotJSON, or an integer of thousands of digits Python will not read
-        found = list(re.finditer(getattr(exc, "pattern", r"\d{4300,}"), text))
-        at = found[-1].start() if found else 0
-        line, col = text.count("\n", 0, at) + 1, at - text.rfind("\n", 0, at)
+        if isinstance(exc, _NotJSON):
+            found = list(re.finditer(exc.pattern, text))
+            at = found[-1].start() if found else 0
+        else:
+            digits = long_digits(text)
+            at = digits.start() if digits else 0
+        line, col = where(text, at)
         keys = re.findall(r'"((?:[^"\\]|\\.)*)"\s*:', text[:at])  # the key the token belongs to
         key = f"{keys[-1]}: " if keys and "twice" not in str(exc) else ""
         raise DataFileError(side, line, col, f"{key}not valid JSON: {exc}") from exc
