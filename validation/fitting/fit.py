@@ -146,7 +146,7 @@ def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
     U = samples[pick]
     batch = None
     if lik.binding is not None:  # every draw's model at once (a model set)
-        values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(lik.spec.free)}
+        values, _ = lik.walkers(U)
         batch = lik.predict(lik.model(values), data)
     for j, u in enumerate(U):  # the replicates draw in the order they always did
         values = lik.spec.physical(u)

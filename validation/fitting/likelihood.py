@@ -169,7 +169,7 @@ class Likelihood:
             out["P_C"] = d.P_C - pred["P_C"]
         return out
 
-    def _walkers(self, U):
+    def walkers(self, U):
         """Physical values of positions ``U`` (``(W, k)``) as ``(W, 1)`` arrays, and the noise."""
         values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(self.spec.free)}
         return values, self.spec.noise_values(values)
@@ -191,7 +191,7 @@ class Likelihood:
         U = np.atleast_2d(np.asarray(U, dtype=float))
         if self.binding is None:
             return self._pointwise_each(U)
-        values, noise = self._walkers(U)
+        values, noise = self.walkers(U)
         try:
             model = self.model(values)
             self.binding.check(model)  # vectorized: every walker's parameters at once
@@ -247,7 +247,7 @@ class Likelihood:
     def whitened(self, u) -> np.ndarray:
         """Residuals divided by their standard deviations (for least squares); large
         finite values where the model predicts no light."""
-        values, noise = self._walkers(np.asarray(u, dtype=float)[None])
+        values, noise = self.walkers(np.asarray(u, dtype=float)[None])
         res = self.residuals(self.predict(self.model(values)))
         var = self._variances(noise)
         out = []
