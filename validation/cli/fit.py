@@ -161,7 +161,7 @@ def _require_walkers(settings, ndim):
         raise UsageError(str(exc)) from exc
 
 
-def _interrupted(args, ck, final):
+def _interrupted(ck, final):
     """The one line Ctrl-C prints: where the chain is and how to continue it."""
     from validation.fitting.checkpoint import saved_steps
 
@@ -203,7 +203,7 @@ def _run_fit(args, lik, settings):
             )
             executor = ex.describe()
     except KeyboardInterrupt:
-        return _interrupted(args, ck, final)
+        return _interrupted(ck, final)
     if os.path.exists(ck):
         os.replace(ck, final)
     return write_fit(

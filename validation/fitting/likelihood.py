@@ -174,7 +174,7 @@ class Likelihood:
         values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(self.spec.free)}
         return values, self.spec.noise_values(values)
 
-    def _pointwise_rows(self, values, noise, pred) -> np.ndarray:
+    def _pointwise_rows(self, noise, pred) -> np.ndarray:
         res = self.residuals(pred)
         var = self._variances(noise)
         total = np.zeros(res["brdf"].shape)
@@ -197,7 +197,7 @@ class Likelihood:
             self.binding.check(model)  # vectorized: every walker's parameters at once
         except ValueError:
             return self._pointwise_valid(U)
-        return self._pointwise_rows(values, noise, self.predict(model))
+        return self._pointwise_rows(noise, self.predict(model))
 
     def _pointwise_valid(self, U):
         """Rows of ``-inf`` for the positions the scene refuses (rebuilt and validated one by
@@ -232,9 +232,7 @@ class Likelihood:
         """Per-row log-likelihood at one position with the scene rebuilt and validated there (the
         per-walker path before model sets; a ``ValueError`` where the scene refuses ``u``)."""
         values = self.spec.physical(u)
-        return self._pointwise_rows(
-            values, self.spec.noise_values(values), self.predict(self.model_rebuilt(values))
-        )
+        return self._pointwise_rows(self.spec.noise_values(values), self.predict(self.model_rebuilt(values)))
 
     def pointwise(self, u) -> np.ndarray:
         """Per-row log-likelihood (all terms summed per row), ``-inf`` where impossible."""
