@@ -110,10 +110,19 @@ def check_structure(data, path: str) -> None:
                 stack.append((keys + (k,), x))
         elif isinstance(v, list):
             stack.extend((keys + (i,), x) for i, x in enumerate(v))
-        elif isinstance(v, int) and not isinstance(v, bool) and abs(v) > 1.7e308:
+        elif isinstance(v, int) and not isinstance(v, bool) and not _float_holds(v):
             raise _err(
                 path, _key_path(keys), f"{str(v)[:20]}... ({len(str(v))} digits) is too large a number"
             )
+
+
+def _float_holds(v: int) -> bool:
+    """True when ``float(v)`` is finite (Python rounds; past the largest float it overflows)."""
+    try:
+        float(v)
+    except OverflowError:
+        return False
+    return True
 
 
 def parse(data: dict, path: str) -> dict:
