@@ -11,9 +11,9 @@ import argparse
 import math
 import os
 import re
-import tempfile
 
 from models.scene.schema import shown
+from validation.atomic import write_problem
 
 __all__ = [
     "UsageError",
@@ -127,18 +127,6 @@ def scheduler_address(text):
     return text
 
 
-def _probe(folder):
-    """Whether this process can create a file in the existing ``folder``: the permission
-    bits do not say it for root or on read-only file systems, a real file does."""
-    try:
-        fd, name = tempfile.mkstemp(prefix=".probe-", dir=folder)
-    except OSError as exc:
-        return exc.strerror or str(exc)
-    os.close(fd)
-    os.unlink(name)
-    return None
-
-
 def writable_folder(path, flag):
     """Raise :class:`UsageError` unless ``path`` is a folder this process can write to, or
     can be created (its nearest existing parent is a writable folder).  Nothing is created."""
@@ -152,7 +140,7 @@ def writable_folder(path, flag):
     if not os.path.isdir(existing):
         shown = "" if existing == path else f" ({existing} is a file)"
         raise UsageError(f"{flag} {given}: not a folder{shown}")
-    problem = _probe(existing)
+    problem = write_problem(existing)
     if problem:
         raise UsageError(f"{flag} {given}: cannot write in {existing} ({problem})")
 
