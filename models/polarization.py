@@ -18,6 +18,7 @@ polarization ``P = sqrt(Q^2 + U^2 + V^2) / I``.
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -105,25 +106,59 @@ _NAMED = {
 }
 
 
+_STATES = "one of unpolarized, s, p, +45, -45, left, right, linear:<deg>, or [I, Q, U, V] numbers"
+
+
+def _refused(what, state):
+    from .scene.schema import shown  # the one cut repr of a bad value (the scene imports this module)
+
+    return ValueError(f"polarization {what}; got {shown(state)}")
+
+
+def _is_real(x):
+    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
 def stokes(state) -> np.ndarray:
-    """A unit-intensity Stokes vector from a name or a 4-vector.
+    """A Stokes vector from a name or a 4-vector (a name gives unit intensity).
 
     Names: ``unpolarized``, ``s``, ``p``, ``+45``, ``-45``, ``left``, ``right``,
-    or ``linear:<deg>`` (linear polarization at that angle from s toward p).
+    or ``linear:<deg>`` (linear polarization at that finite angle from s toward p).
+    A 4-vector ``[I, Q, U, V]`` (a list, tuple or real array) of finite real numbers,
+    not bools, with ``I > 0`` and ``Q^2 + U^2 + V^2 <= I^2``.
+
+    Raises
+    ------
+    ValueError
+        Anything else, naming ``polarization`` and what it may be.
     """
     if isinstance(state, str):
         if state.startswith("linear:"):
-            a = math.radians(float(state.split(":", 1)[1]))
+            try:
+                deg = float(state[7:])
+            except ValueError:
+                deg = math.nan
+            if not math.isfinite(deg):
+                raise _refused("linear:<deg> needs a finite angle in degrees", state)
+            a = math.radians(deg)
             return np.array([1.0, math.cos(2 * a), math.sin(2 * a), 0.0])
         if state not in _NAMED:
-            allowed = ", ".join(sorted(_NAMED)) + ", linear:<deg>"
-            raise ValueError(f"polarization must be one of {allowed}; got {state!r}")
+            raise _refused(f"must be {_STATES}", state)
         return np.array(_NAMED[state])
-    v = np.asarray(state, dtype=float)
+    if isinstance(state, np.ndarray):
+        real = state.dtype.kind in "iuf"
+    else:
+        real = isinstance(state, (list, tuple)) and all(_is_real(x) for x in state)
+    if not real:
+        raise _refused(f"must be {_STATES}", state)
+    try:
+        v = np.asarray(state, dtype=float)
+    except OverflowError:  # an integer no float can hold
+        v = np.full(len(state), math.inf)
     if v.shape != (4,) or not np.all(np.isfinite(v)):
-        raise ValueError("polarization Stokes vector must be 4 finite numbers (I, Q, U, V)")
+        raise _refused("Stokes vector must be 4 finite numbers (I, Q, U, V)", state)
     if v[0] <= 0 or np.sqrt(v[1] ** 2 + v[2] ** 2 + v[3] ** 2) > v[0] * (1 + 1e-12):
-        raise ValueError("polarization Stokes vector needs I > 0 and Q^2 + U^2 + V^2 <= I^2")
+        raise _refused("Stokes vector needs I > 0 and Q^2 + U^2 + V^2 <= I^2", state)
     return v
 
 

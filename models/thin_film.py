@@ -108,13 +108,15 @@ class FilmStack(Declared):
 
     def _validate(self):
         try:
-            layers = tuple((idx, float(d)) for idx, d in self.layers)
+            pairs = tuple((idx, d) for idx, d in self.layers)
         except (TypeError, ValueError):
             raise ValueError(
                 f"layers must be a sequence of (index, thickness_nm) pairs; got {self.layers!r}"
             ) from None
-        for j, (_, d) in enumerate(layers):
-            check_real(f"layers[{j}] thickness_nm", d, 0.0)
+        # check_real, not float(): a bool or a string is no thickness (float(True) is 1.0)
+        layers = tuple(
+            (idx, check_real(f"layers[{j}] thickness_nm", d, 0.0)) for j, (idx, d) in enumerate(pairs)
+        )
         object.__setattr__(self, "layers", layers)
         _ = self.indices  # validates every index at this wavelength
 

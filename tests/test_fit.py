@@ -74,6 +74,9 @@ def test_scene_fit_table_and_log_prior_bounds():
     u = np.array([math.log(0.1), 1.5, 1.37, 7.62, math.log(0.05)])
     assert spec.log_prior(u) == 0.0
     assert spec.log_prior(u + np.array([0, 0.6, 0, 0, 0])) == -math.inf  # coating 2.1 > 2
+    # vectorized over walkers (what Likelihood.batch uses): out of bounds or not finite: -inf
+    U = np.array([u, u + [0, 0.6, 0, 0, 0], u + [0, 0, 0, 0, math.nan], u - [0, 0, 0, 8, 0]])
+    np.testing.assert_array_equal(spec.log_prior(U), [0.0, -math.inf, -math.inf, -math.inf])
     assert spec.physical(u)["substrate.sigma"] == pytest.approx(0.1)
     # the command line replaces the scene's free list
     assert fitspec_from(sc, ["sigma:0.05:0.2:log"]).names == ["substrate.sigma", "noise.brdf"]

@@ -39,6 +39,50 @@ def test_stokes_conventions():
         stokes([1, 2, 0, 0])
 
 
+@pytest.mark.parametrize(
+    "state, words",
+    [
+        ("linear:nan", "finite angle"),
+        ("linear:inf", "finite angle"),
+        ("linear:1e400", "finite angle"),
+        ("linear:abc", "finite angle"),
+        ("linear:", "finite angle"),
+        ([1, True, 0, 0], "one of"),
+        ((True, False, False, False), "one of"),
+        (np.array([True, False, False, False]), "one of"),
+        ([1, "0", 0, 0], "one of"),
+        ([1, None, 0, 0], "one of"),
+        ({"I": 1}, "one of"),
+        (None, "one of"),
+        (1.0, "one of"),
+        ([10**400, 0, 0, 0], "4 finite numbers"),
+        ([1, 0, 0, float("nan")], "4 finite numbers"),
+        ([1, 0, 0], "4 finite numbers"),
+        (np.zeros((2, 2)), "4 finite numbers"),
+    ],
+)
+def test_stokes_refuses_what_is_not_a_polarization(state, words):
+    """Every refusal names the polarization and what it may be; none returns NaN."""
+    with pytest.raises(ValueError, match="polarization") as exc:
+        stokes(state)
+    assert words in str(exc.value)
+
+
+def test_stokes_takes_names_angles_and_real_vectors():
+    np.testing.assert_allclose(stokes("linear:90"), [1, -1, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(stokes("linear:0"), [1, 1, 0, 0])
+    for v in ([2, 0, 0, 1], (2.0, 0.0, 0.0, 1.0), np.array([2, 0, 0, 1]), [np.float32(2), 0, 0, np.int64(1)]):
+        np.testing.assert_array_equal(stokes(v), [2.0, 0.0, 0.0, 1.0])
+
+
+def test_a_model_refuses_a_nan_incident_angle():
+    """``scattered_stokes`` goes through :func:`stokes`: no all-NaN result from 'linear:nan'."""
+    import models
+
+    with pytest.raises(ValueError, match="polarization linear:<deg>"):
+        models.FacetBRDF().scattered_stokes(0.5, 0.5, 0.0, "linear:nan")
+
+
 def test_ellipsometric_quantities():
     i, eta, pc, p = ellipsometric(np.array([[2.0, 0.0, 2.0, 0.0], [1.0, 0.0, 0.0, 0.5], [0, 0, 0, 0]]))
     assert eta[0] == pytest.approx(np.pi / 4)

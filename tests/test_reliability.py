@@ -20,7 +20,8 @@ from models import scene
 from validation.atomic import LockHeld, atomic_write_json, file_lock, strict_json
 from validation.cli import main
 from validation.fitting.datafile import load_data, write_data
-from validation.fitting.fitspec import FitSpecError, check_against_data, fitspec_from
+from validation.fitting.fitspec import FitSpecError, fitspec_from
+from validation.fitting.likelihood import Likelihood
 from validation.report import nightly
 from validation.studies.scenes import P_FLOOR, _plot_scan, scan, scene_csv
 
@@ -82,9 +83,9 @@ def test_zero_noise_is_meaningful_beside_an_error_column(tmp_path):
     p = str(tmp_path / "e.csv")
     write_data(p, cols, {"incident_polarization": "linear:45"})
     with_err = load_data(p)
-    check_against_data(sc, fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0"]), with_err)
+    assert Likelihood(sc, fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0"]), with_err).terms == ("brdf",)
     with pytest.raises(FitSpecError, match="zero variance"):
-        check_against_data(sc, fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0"]), d)
+        Likelihood(sc, fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0"]), d)
 
 
 def test_data_comments_stay_comments(tmp_path):

@@ -172,12 +172,22 @@ NO_WL = 'name = "x"\n[illumination]\ntheta_i_deg = 30\n'
         (
             ILL + GGX + "[substrate.film]\nlayers = [{index = 2.6, thickness_nm = -1}]\n",
             "[substrate.film] layers[0].thickness_nm",
-            ">= 0",
+            "in [0, inf); got -1",
         ),
         (
             ILL + GGX + '[substrate.film]\nlayers = [{index = 2.6, thickness_nm = "1"}]\n',
             "[substrate.film] layers[0].thickness_nm",
-            "finite number",
+            "finite real number in [0, inf); got '1'",
+        ),
+        (
+            ILL + GGX + "[substrate.film]\nlayers = [{index = 2.6, thickness_nm = true}]\n",
+            "[substrate.film] layers[0].thickness_nm",
+            "a bool is not a number",
+        ),
+        (
+            ILL + GGX + "[substrate.film]\nlayers = [{index = true, thickness_nm = 1}]\n",
+            "[substrate.film] layers[0].index",
+            "a number n, a pair [n, k]",
         ),
         (
             ILL + GGX + "[substrate.film]\nlayers = [{index = 2.6, thickness_nm = 1}, {index = [1.5, -1], "

@@ -229,3 +229,9 @@ def test_interference_flakes_follow_the_stack_reflectance():
         got = np.abs(film[:, k, k]) ** 2 / np.abs(bare[:, k, k]) ** 2
         assert np.max(np.abs(got / (r_film[k] / r_bare[k]) - 1)) < 1e-12
         assert np.min(r_film[k] / r_bare[k]) > 3  # the film matters: an interference peak
+
+
+@pytest.mark.parametrize("thickness", [True, False, "5", -1.0, math.nan])
+def test_film_thickness_must_be_a_number_not_a_bool_or_text(thickness):
+    with pytest.raises(ValueError, match=r"layers\[0\] thickness_nm must be a finite real number"):
+        FilmStack(layers=((2.6, thickness),), substrate=1.5, wavelength_nm=550.0)

@@ -24,6 +24,7 @@ __all__ = [
     "atomic_write_text",
     "atomic_write_json",
     "atomic_savefig",
+    "write_problem",
     "strict_json",
     "LockHeld",
     "file_lock",
@@ -88,6 +89,19 @@ def atomic_savefig(fig, path, **kwargs):
     ext = os.path.splitext(path)[1]
     with _temp_beside(path, suffix=ext) as tmp:
         fig.savefig(tmp, **kwargs)
+
+
+def write_problem(folder):
+    """Why this process cannot create a file in the existing ``folder`` (``None``: it can).
+    The permission bits do not say it for root or on read-only file systems; a real file
+    (created and removed at once) does."""
+    try:
+        fd, name = tempfile.mkstemp(prefix=".probe-", dir=folder)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    os.close(fd)
+    os.unlink(name)
+    return None
 
 
 class LockHeld(TimeoutError):

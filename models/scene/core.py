@@ -11,7 +11,7 @@ from ..base import Model
 from . import editing
 from .assembly import Mechanism, mechanisms
 from .decisions import Assembly, assemble
-from .schema import SceneError, check_structure, parse, utf8_text
+from .schema import SceneError, check_structure, long_digits, parse, read_utf8, where
 
 __all__ = ["Scene", "load", "loads", "from_dict"]
 
@@ -115,10 +115,9 @@ def from_dict(data: dict, path: str = "<scene>") -> Scene:
     return Scene(path=path, raw=copy.deepcopy(data), **parse(data, path))
 
 
-def _where(text, offset):
-    """``line:column`` (1-based) of a character offset of ``text``."""
-    line = text.count("\n", 0, offset) + 1
-    return f"{line}:{offset - (text.rfind(chr(10), 0, offset) + 1) + 1}"
+def _at(text, offset):
+    """``line:column`` (1-based) of a character offset of ``text``, as the errors show it."""
+    return "{}:{}".format(*where(text, offset))
 
 
 def _toml_error(text, path, exc):
@@ -128,7 +127,7 @@ def _toml_error(text, path, exc):
     if m:
         return SceneError(f"{path}:{m.group(1)}:{m.group(2)}: not valid TOML: {msg[: m.start()]}")
     if msg.endswith(" (at end of document)"):
-        return SceneError(f"{path}:{_where(text, len(text))}: not valid TOML: {msg[:-21]} (at the end)")
+        return SceneError(f"{path}:{_at(text, len(text))}: not valid TOML: {msg[:-21]} (at the end)")
     return SceneError(f"{path}: not valid TOML: {msg}")
 
 
@@ -144,13 +143,13 @@ def loads(text: str, path: str = "<scene>") -> Scene:
             f"{path}: not valid TOML for a scene: arrays or inline tables nested too deeply for the parser"
         ) from exc
     except ValueError as exc:  # Python refuses to convert an integer of thousands of digits
-        digits = re.search(r"\d{4300,}", text)
+        digits = long_digits(text)
         if digits is None:
             raise SceneError(f"{path}: not valid TOML: {exc}") from exc
         start = text.rfind("\n", 0, digits.start()) + 1
         key = text[start : digits.start()].split("=")[0].strip() or "value"
         raise SceneError(
-            f"{path}:{_where(text, digits.start())}: {key}: a number of {len(digits.group())} digits "
+            f"{path}:{_at(text, digits.start())}: {key}: a number of {len(digits.group())} digits "
             "is too long to read"
         ) from exc
     return from_dict(data, path)
@@ -159,14 +158,9 @@ def loads(text: str, path: str = "<scene>") -> Scene:
 def load(path) -> Scene:
     """Read and validate a scene file (UTF-8, with or without a byte-order mark)."""
     path = str(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from exc
-    text, bad = utf8_text(raw)
-    if bad is not None:
-        raise SceneError(
-            f"{path}:{_where(text, len(text))}: not UTF-8 text (byte 0x{bad:02x}); save the scene file as UTF-8"
-        )
+    text = read_utf8(
+        path,
+        "scene file",
+        lambda at, msg: SceneError(f"{path}:{at[0]}:{at[1]}: {msg}" if at else f"{path}: {msg}"),
+    )
     return loads(text, path)

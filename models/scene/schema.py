@@ -10,17 +10,27 @@ alone).  Values that a model takes are validated by that model's declared parame
 from __future__ import annotations
 
 import math
+import re
+import sys
 
 from ..aperture import DetectorAperture
 from ..facet import FacetBRDF
-from ..params import check_index
 from ..point_source import PointSourceBRDF
 from ..polarization import stokes
 from ..subsurface_facet import SubsurfaceFacetBRDF
 from ..thin_film import FilmStack
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
-__all__ = ["SceneError", "parse", "check_structure", "polarization_state", "utf8_text", "MAX_DEPTH"]
+__all__ = [
+    "SceneError",
+    "parse",
+    "check_structure",
+    "shown",
+    "where",
+    "long_digits",
+    "read_utf8",
+    "MAX_DEPTH",
+]
 
 #: how deeply tables and arrays may nest in a scene file (the deepest schema entry,
 #: ``[fit.mask] exclude = [{theta_r_deg = [lo, hi]}]``, is 5 levels)
@@ -37,14 +47,37 @@ class SceneError(ValueError):
     """A scene file problem; the message names the file, the key and the allowed values."""
 
 
-def utf8_text(raw: bytes):
-    """``(text, None)`` for UTF-8 bytes (a byte-order mark dropped), else ``(the valid text
-    before the first bad byte, that byte)`` so that errors can say where it is."""
+def where(text: str, offset: int):
+    """``(line, column)``, both 1-based, of a character offset of ``text``."""
+    return text.count("\n", 0, offset) + 1, offset - text.rfind("\n", 0, offset)
+
+
+def long_digits(text: str):
+    """The regular-expression match of the first run of more digits than Python converts
+    to an integer (``sys.get_int_max_str_digits()``), or ``None``: what a parser's bare
+    ``ValueError`` about such an integer was about, so that errors can say where it is."""
+    limit = sys.get_int_max_str_digits()
+    return re.search(rf"\d{{{limit + 1},}}", text) if limit else None
+
+
+def read_utf8(path: str, what: str, error):
+    """The UTF-8 text of the file ``path`` (a byte-order mark dropped).  A file that cannot
+    be read or is not UTF-8 raises ``error(at, message)``, ``at`` the ``(line, column)`` of
+    the first bad byte (``None`` for a file not read); ``what`` names the file in the
+    message ("scene file", "data file")."""
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise error(None, f"cannot read the {what} ({exc.strerror})") from exc
     body = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw
     try:
-        return body.decode("utf-8"), None
+        return body.decode("utf-8")
     except UnicodeDecodeError as exc:
-        return body[: exc.start].decode("utf-8"), body[exc.start]
+        text = body[: exc.start].decode("utf-8")
+        raise error(
+            where(text, len(text)), f"not UTF-8 text (byte 0x{body[exc.start]:02x}); save the {what} as UTF-8"
+        ) from None
 
 
 def _key_path(keys):
@@ -77,10 +110,19 @@ def check_structure(data, path: str) -> None:
                 stack.append((keys + (k,), x))
         elif isinstance(v, list):
             stack.extend((keys + (i,), x) for i, x in enumerate(v))
-        elif isinstance(v, int) and not isinstance(v, bool) and abs(v) > 1.7e308:
+        elif isinstance(v, int) and not isinstance(v, bool) and not _float_holds(v):
             raise _err(
                 path, _key_path(keys), f"{str(v)[:20]}... ({len(str(v))} digits) is too large a number"
             )
+
+
+def _float_holds(v: int) -> bool:
+    """True when ``float(v)`` is finite (Python rounds; past the largest float it overflows)."""
+    try:
+        float(v)
+    except OverflowError:
+        return False
+    return True
 
 
 def parse(data: dict, path: str) -> dict:
@@ -91,10 +133,10 @@ def parse(data: dict, path: str) -> dict:
         raise _err(
             path,
             "name",
-            f"a non-empty, one-line string of printable characters is required; got {_shown(name)}",
+            f"a non-empty, one-line string of printable characters is required; got {shown(name)}",
         )
     if "fit" in data and not isinstance(data["fit"], dict):
-        raise _err(path, "[fit]", f"must be a table (free, noise, mask); got {_shown(data['fit'])}")
+        raise _err(path, "[fit]", f"must be a table (free, noise, mask); got {shown(data['fit'])}")
     out = {"name": name, **_illumination(path, data.get("illumination"))}
     out["coating"] = _coating(path, data["coating"]) if "coating" in data else None
     out["substrate"] = (
@@ -110,10 +152,11 @@ def _err(path, key, msg):
     return SceneError(f"{path}: {key}: {msg}")
 
 
-def _shown(value):
-    """``repr(value)``, cut to a readable length."""
+def shown(value, width=60):
+    """``repr(value)`` cut to ``width`` characters (``...`` at the end when cut), for the
+    ``got ...`` part of an error message about a file's or a flag's value."""
     text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def _unknown(path, section, table, allowed):
@@ -127,11 +170,11 @@ def _unknown(path, section, table, allowed):
 def _number(path, key, value, low=None, high=None, low_open=False):
     """A quantity of the scene itself (not a model parameter): a finite number in range."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise _err(path, key, f"must be a finite number; got {_shown(value)}")
+        raise _err(path, key, f"must be a finite number; got {shown(value)}")
     if low is not None and (value < low or (low_open and value == low)):
-        raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {_shown(value)}")
+        raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {shown(value)}")
     if high is not None and value > high:
-        raise _err(path, key, f"must be <= {high:g}; got {_shown(value)}")
+        raise _err(path, key, f"must be <= {high:g}; got {shown(value)}")
     return float(value)
 
 
@@ -159,9 +202,7 @@ def _illumination(path, ill):
         "theta_i": math.radians(_number(path, "[illumination] theta_i_deg", ill["theta_i_deg"], 0.0, 90.0))
     }
     try:
-        out["polarization"] = tuple(
-            float(x) for x in polarization_state(ill.get("polarization", "unpolarized"))
-        )
+        out["polarization"] = tuple(float(x) for x in stokes(ill.get("polarization", "unpolarized")))
     except ValueError as exc:
         raise _err(path, "[illumination] polarization", str(exc)) from exc
     wl = ill.get("wavelength_nm")
@@ -187,29 +228,6 @@ def _illumination(path, ill):
                 path, f"[illumination] {key}", "only for source = 'point' (a collimated beam has none)"
             )
     return out
-
-
-def polarization_state(value):
-    """The unit-intensity Stokes vector of a polarization given in a file: a name of
-    :func:`models.polarization.stokes` or ``[I, Q, U, V]``; ``ValueError`` for anything
-    else, a non-finite angle included."""
-    if isinstance(value, str):
-        if value.startswith("linear:"):
-            try:
-                angle = float(value[7:])
-            except ValueError:
-                angle = math.nan
-            if not math.isfinite(angle):
-                raise ValueError(f"linear:<deg> needs a finite angle in degrees; got {_shown(value)}")
-        return stokes(value)
-    if not isinstance(value, list) or not all(
-        isinstance(x, (int, float)) and not isinstance(x, bool) for x in value
-    ):
-        raise ValueError(
-            "must be a name (unpolarized, s, p, +45, -45, left, right, linear:<deg>) or "
-            f"[I, Q, U, V] numbers; got {_shown(value)}"
-        )
-    return stokes(value)
 
 
 def _coating(path, c):
@@ -240,7 +258,7 @@ def _distribution(path, section, table):
     kind = table.get("distribution")
     names = [n for n, e in TABLE.items() if e.kind == "distribution"]
     if kind not in names:
-        raise _err(path, f"{section}distribution", f"must be one of {', '.join(names)}; got {_shown(kind)}")
+        raise _err(path, f"{section}distribution", f"must be one of {', '.join(names)}; got {shown(kind)}")
     for k in table:
         if k != "distribution" and k not in TABLE[kind].keys:
             raise _err(
@@ -271,7 +289,7 @@ def _index(path, key, value):
         return complex(float(value), 0.0)
     if isinstance(value, list) and len(value) == 2 and all(real(v) for v in value):
         return complex(float(value[0]), float(value[1]))
-    raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {_shown(value)}')
+    raise _err(path, key, f'must be a number n, a pair [n, k], or "inf"; got {shown(value)}')
 
 
 def _substrate(path, s, data, wavelength_nm):
@@ -334,28 +352,24 @@ def _film(path, film, substrate, wavelength_nm):
         raise _err(
             path,
             "[substrate.film] layers",
-            f"required: a non-empty array of tables {{index = [n, k], thickness_nm = d}}; got {_shown(layers)}",
+            f"required: a non-empty array of tables {{index = [n, k], thickness_nm = d}}; got {shown(layers)}",
         )
     out = []
     for j, layer in enumerate(layers):
         key = f"[substrate.film] layers[{j}]"
         if not isinstance(layer, dict):
-            raise _err(
-                path, key, f"must be a table {{index = [n, k], thickness_nm = d}}; got {_shown(layer)}"
-            )
+            raise _err(path, key, f"must be a table {{index = [n, k], thickness_nm = d}}; got {shown(layer)}")
         _unknown(path, f"{key}.", layer, {"index", "thickness_nm"})
         for k, what in (("index", "n or [n, k] (finite)"), ("thickness_nm", "a number >= 0")):
             if k not in layer:
                 raise _err(path, f"{key}.{k}", f"required: {what}")
-        n = _index(path, f"{key}.index", layer["index"])
-        try:
-            n = check_index("index", n)
-        except ValueError as exc:
-            raise _err(path, f"{key}.index", str(exc)) from exc
-        if n == math.inf:
-            raise _err(path, f"{key}.index", 'a film has a finite index n or [n, k], not "inf"')
-        out.append((n, _number(path, f"{key}.thickness_nm", layer["thickness_nm"], 0.0)))
-    return FilmStack(layers=tuple(out), substrate=substrate, wavelength_nm=wavelength_nm)
+        out.append((_index(path, f"{key}.index", layer["index"]), layer["thickness_nm"]))
+    try:  # the stack validates the values; its message names layers[j] index / thickness_nm
+        return FilmStack(layers=tuple(out), substrate=substrate, wavelength_nm=wavelength_nm)
+    except ValueError as exc:
+        m = re.match(r"layers\[(\d+)\] (index|thickness_nm)", str(exc))
+        key = f"[substrate.film] layers[{m[1]}].{m[2]}" if m else "[substrate.film]"
+        raise _err(path, key, str(exc)) from exc
 
 
 def _slope_keys_apply(path, s, kind, entry):

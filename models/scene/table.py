@@ -65,8 +65,8 @@ class Entry:
     substrate models only: ``slopes`` says whether ``[substrate] distribution`` gives the
     class's slopes (``"optional"``, ``"required"``) or is not used (``"ignored"``), ``alone``
     that the model has no interface, so no ``[coating]`` or ``[volume]`` may come with it,
-    and ``mechanisms`` turns the validated ``[substrate]`` into mechanisms; ``flags`` are the
-    keys that take ``true``/``false`` (every other key refuses a bool: it is not a number).
+    and ``mechanisms`` turns the validated ``[substrate]`` into mechanisms.  A key's value,
+    ``true``/``false`` included, is the class's to accept or refuse (:mod:`models.params`).
     """
 
     kind: str  # "distribution" or "model"
@@ -77,7 +77,6 @@ class Entry:
     slopes: str = "optional"
     alone: bool = False
     mechanisms: Callable | None = None
-    flags: tuple = ()
 
 
 def _slopes(cls, *keys, required=("sigma",)):
@@ -123,7 +122,6 @@ TABLE = {
         slopes="required",
         alone=True,
         mechanisms=maxwell_beard_mechanisms,
-        flags=("polarized",),
     ),
 }
 
@@ -166,8 +164,6 @@ def build(name: str, table: dict, **given):
     kwargs = {}
     for key in entry.keys:
         if key in table:
-            if isinstance(table[key], bool) and key not in entry.flags:
-                raise KeyProblem(key, _bool_refused(entry.cls, key, table[key]))
             kwargs[parameter(key)] = _file_value(key, table[key])
     for key, value in entry.defaults.items():
         if key not in kwargs and _target(entry.cls, key) not in kwargs:
@@ -178,18 +174,6 @@ def build(name: str, table: dict, **given):
         raise KeyProblem(_key_named(str(exc), entry), str(exc) + _degrees_note(exc, entry, table)) from exc
     targets = dict.fromkeys(_target(entry.cls, parameter(k)) for k in entry.keys)
     return instance, {t: getattr(instance, t) for t in targets}
-
-
-def _bool_refused(cls, key, value):
-    """Why ``true``/``false`` is no value for ``key``: its declared range (a choice says which
-    names it takes), else that it must be a number."""
-    info = next((i for i in cls.parameters() if i.name == parameter(key)), None)
-    if info is not None and info.kind == "choice":
-        try:
-            cls.check_parameter(info.name, value)
-        except ValueError as exc:
-            return str(exc)
-    return f"must be a number, not {str(value).lower()}"
 
 
 def _file_value(key, value):

@@ -32,8 +32,6 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from validation.atomic import strict_json  # re-exported: validate --json writes it
-
 __all__ = [
     "Check",
     "Finding",
@@ -47,7 +45,6 @@ __all__ = [
     "format_checks",
     "tally",
     "check_record",
-    "strict_json",
     "text_section",
     "texts",
     "SEED",

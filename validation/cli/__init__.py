@@ -40,6 +40,7 @@ INPUT_ERRORS = {
     "validation.fitting.datafile": "DataFileError",
     "validation.fitting.fitspec": "FitSpecError",
     "validation.fitting.checkpoint": "CheckpointError",
+    "validation.fitting.executors": "SchedulerError",
     "validation.report.nightly": "HistoryError",
 }
 

@@ -11,7 +11,9 @@ import argparse
 import math
 import os
 import re
-import tempfile
+
+from models.scene.schema import shown
+from validation.atomic import write_problem
 
 __all__ = [
     "UsageError",
@@ -37,10 +39,6 @@ class UsageError(ValueError):
     message names the flag (the command line turns it into ``error: ...``, exit 2)."""
 
 
-def _shown(text):
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
 def int_at_least(low):
     """An argparse type: an integer >= ``low``."""
 
@@ -48,7 +46,7 @@ def int_at_least(low):
         try:
             v = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"must be an integer >= {low}; got {_shown(text)!r}") from None
+            raise argparse.ArgumentTypeError(f"must be an integer >= {low}; got {shown(text, 40)}") from None
         if v < low:
             raise argparse.ArgumentTypeError(f"must be an integer >= {low}; got {v}")
         return v
@@ -74,9 +72,9 @@ def _finite(text):
     try:
         v = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a finite number; got {_shown(text)!r}") from None
+        raise argparse.ArgumentTypeError(f"must be a finite number; got {shown(text, 40)}") from None
     if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"must be a finite number; got {_shown(text)!r}")
+        raise argparse.ArgumentTypeError(f"must be a finite number; got {shown(text, 40)}")
     return v
 
 
@@ -84,7 +82,7 @@ def positive_float(text):
     """An argparse type: a finite number > 0 (a tolerance, a noise level)."""
     v = _finite(text)
     if v <= 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number > 0; got {_shown(text)!r}")
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0; got {shown(text, 40)}")
     return v
 
 
@@ -92,7 +90,7 @@ def nonneg_float(text):
     """An argparse type: a finite number >= 0 (a time to wait)."""
     v = _finite(text)
     if v < 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0; got {_shown(text)!r}")
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0; got {shown(text, 40)}")
     return v
 
 
@@ -124,21 +122,9 @@ def scheduler_address(text):
     """An argparse type: a Dask scheduler address, ``[PROTOCOL://]HOST:PORT``."""
     if not _ADDRESS.match(text):
         raise argparse.ArgumentTypeError(
-            f"must be a scheduler address [PROTOCOL://]HOST:PORT, e.g. tcp://10.0.0.5:8786; got {_shown(text)!r}"
+            f"must be a scheduler address [PROTOCOL://]HOST:PORT, e.g. tcp://10.0.0.5:8786; got {shown(text, 40)}"
         )
     return text
-
-
-def _probe(folder):
-    """Whether this process can create a file in the existing ``folder``: the permission
-    bits do not say it for root or on read-only file systems, a real file does."""
-    try:
-        fd, name = tempfile.mkstemp(prefix=".probe-", dir=folder)
-    except OSError as exc:
-        return exc.strerror or str(exc)
-    os.close(fd)
-    os.unlink(name)
-    return None
 
 
 def writable_folder(path, flag):
@@ -154,7 +140,7 @@ def writable_folder(path, flag):
     if not os.path.isdir(existing):
         shown = "" if existing == path else f" ({existing} is a file)"
         raise UsageError(f"{flag} {given}: not a folder{shown}")
-    problem = _probe(existing)
+    problem = write_problem(existing)
     if problem:
         raise UsageError(f"{flag} {given}: cannot write in {existing} ({problem})")
 

@@ -12,8 +12,7 @@ __all__ = ["register", "run"]
 def run(spec, json_path=None, quick=False, checks=None) -> int:
     """Check the model ``spec`` names, print the table, write ``json_path`` (strict JSON,
     atomically) if given; 0 when no check fails, 1 when one does, 2 on a bad argument."""
-    from validation.atomic import atomic_write_text
-    from validation.checks.registry import strict_json
+    from validation.atomic import atomic_write_json
     from validation.testing import check_model, load_model
 
     # like pytest, a module beside the user is importable: `scatterbench check mybrdf:Model`
@@ -30,7 +29,7 @@ def run(spec, json_path=None, quick=False, checks=None) -> int:
     print(report.format())
     print(f"check finished in {time.perf_counter() - t0:.1f} s")
     if json_path:
-        atomic_write_text(json_path, strict_json({"quick": quick, **report.as_dict()}))
+        atomic_write_json(json_path, {"quick": quick, **report.as_dict()})
     return 0 if report.passed else 1
 
 

@@ -38,6 +38,16 @@ def _check_executor(args):
         raise UsageError("--workers and --scheduler: give one (local processes or a Dask cluster)")
 
 
+def _open_executor(args):
+    """The executor ``--workers``/``--scheduler`` ask for, its description printed.  A
+    scheduler that does not answer raises ``SchedulerError``, an input error (exit 2)."""
+    from validation.fitting.executors import make_executor
+
+    ex = make_executor(args.workers, args.scheduler)
+    print(f"executor: {ex.describe()}")
+    return ex
+
+
 def _executor_args(p):
     p.add_argument(
         "--workers",
@@ -101,14 +111,13 @@ def _load(args):
     (and against each other) before any work."""
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import check_against_data, fitspec_from
+    from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
 
     sc = scene_mod.load(args.scene)
     data = load_data(args.data)
     spec = fitspec_from(sc, args.free, args.noise, args.near_specular_deg, args.exclude)
-    check_against_data(sc, spec, data)
-    return sc, data, spec, Likelihood(sc, spec, data)
+    return sc, data, spec, Likelihood(sc, spec, data)  # refuses a spec the data cannot inform
 
 
 def _load_and_describe(args):
@@ -152,7 +161,7 @@ def _require_walkers(settings, ndim):
         raise UsageError(str(exc)) from exc
 
 
-def _interrupted(args, ck, final):
+def _interrupted(ck, final):
     """The one line Ctrl-C prints: where the chain is and how to continue it."""
     from validation.fitting.checkpoint import saved_steps
 
@@ -176,15 +185,13 @@ def _run_fit(args, lik, settings):
     posterior summary, or the exit code 130 after Ctrl-C.  The running checkpoint is
     chain.partial.npz; it becomes chain.npz when the run ends, so a failed --force
     run never replaces a previous complete chain."""
-    from validation.fitting.executors import make_executor
     from validation.fitting.fit import run_fit, write_fit
 
     os.makedirs(args.out, exist_ok=True)
     ck = os.path.join(args.out, "chain.partial.npz")
     final = os.path.join(args.out, "chain.npz")
     try:
-        with make_executor(args.workers, args.scheduler) as ex:
-            print(f"executor: {ex.describe()}")
+        with _open_executor(args) as ex:
             res = run_fit(
                 lik,
                 settings,
@@ -196,7 +203,7 @@ def _run_fit(args, lik, settings):
             )
             executor = ex.describe()
     except KeyboardInterrupt:
-        return _interrupted(args, ck, final)
+        return _interrupted(ck, final)
     if os.path.exists(ck):
         os.replace(ck, final)
     return write_fit(

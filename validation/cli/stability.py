@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import time
 
-from .fit import _check_executor, _executor_args
-from .study import _open_executor
+from .fit import _check_executor, _executor_args, _open_executor
 
 __all__ = ["register"]
 

@@ -25,29 +25,12 @@ from .fit import (
     _executor_args,
     _load_and_describe,
     _mcmc_args,
+    _open_executor,
     _require_walkers,
     _spec_args,
 )
 
 __all__ = ["register"]
-
-
-def _open_executor(args):
-    """The executor ``--workers``/``--scheduler`` ask for, its description printed.
-
-    Raises
-    ------
-    UsageError
-        A scheduler that does not answer (exit 2).
-    """
-    from validation.fitting.executors import make_executor
-
-    try:
-        ex = make_executor(args.workers, args.scheduler)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from exc
-    print(f"executor: {ex.describe()}")
-    return ex
 
 
 # ----------------------------------------------------------------------------- recovery
@@ -231,7 +214,7 @@ def _compare_likelihoods(args):
     """One likelihood per ``--scene`` on the data, named by the scene file."""
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import check_against_data, fitspec_from
+    from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
 
     data = load_data(args.data)
@@ -239,7 +222,6 @@ def _compare_likelihoods(args):
     for path in args.scene:
         sc = scene_mod.load(path)
         spec = fitspec_from(sc, None, args.noise, args.near_specular_deg, args.exclude)
-        check_against_data(sc, spec, data)
         liks.append(Likelihood(sc, spec, data))
         names.append(os.path.basename(path))
     return liks, names

@@ -19,13 +19,12 @@ def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
     (e.g. with a report built on it); ``specs``: the checks (default: every registered
     check, less the slow ones when ``quick``).
     """
-    from validation.atomic import atomic_write_text
+    from validation.atomic import atomic_write_json
     from validation.checks.registry import (
         CheckContext,
         check_record,
         format_checks,
         run_checks,
-        strict_json,
         tally,
         texts,
     )
@@ -39,7 +38,7 @@ def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
     if json_path:
         doc = {"quick": quick, "seed": ctx.seed, "summary": tally(results)}
         doc["checks"] = [check_record(r) for r in results]
-        atomic_write_text(json_path, strict_json(doc))
+        atomic_write_json(json_path, doc)
     for section in texts():
         out = section(ctx)
         if out:

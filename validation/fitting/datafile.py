@@ -60,8 +60,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models.polarization import ellipsometric
-from models.scene.schema import polarization_state, utf8_text
+from models.polarization import ellipsometric, stokes
+from models.scene.schema import long_digits, read_utf8, shown, where
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -167,16 +167,7 @@ def _sidecar_path(path):
 
 def _text_of(path, what):
     """The UTF-8 text of a file (a byte-order mark dropped); errors name ``file:line:column``."""
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise DataFileError(path, 0, None, f"cannot read the {what} ({exc.strerror})") from exc
-    text, bad = utf8_text(raw)
-    if bad is None:
-        return text
-    line, col = text.count("\n") + 1, len(text) - text.rfind("\n")
-    raise DataFileError(path, line, col, f"not UTF-8 text (byte 0x{bad:02x}); save the {what} as UTF-8")
+    return read_utf8(path, what, lambda at, msg: DataFileError(path, *(at or (0, None)), msg))
 
 
 class _NotJSON(ValueError):
@@ -209,9 +200,13 @@ def _parse_json(side, text):
     except RecursionError as exc:
         raise DataFileError(side, 1, None, "not valid JSON for a sidecar: nested too deeply") from exc
     except ValueError as exc:  # _NotJSON, or an integer of thousands of digits Python will not read
-        found = list(re.finditer(getattr(exc, "pattern", r"\d{4300,}"), text))
-        at = found[-1].start() if found else 0
-        line, col = text.count("\n", 0, at) + 1, at - text.rfind("\n", 0, at)
+        if isinstance(exc, _NotJSON):
+            found = list(re.finditer(exc.pattern, text))
+            at = found[-1].start() if found else 0
+        else:
+            digits = long_digits(text)
+            at = digits.start() if digits else 0
+        line, col = where(text, at)
         keys = re.findall(r'"((?:[^"\\]|\\.)*)"\s*:', text[:at])  # the key the token belongs to
         key = f"{keys[-1]}: " if keys and "twice" not in str(exc) else ""
         raise DataFileError(side, line, col, f"{key}not valid JSON: {exc}") from exc
@@ -245,16 +240,16 @@ def _sidecar_problem(key, value):
     if key not in SIDECAR_KEYS:
         return f"unknown key {key!r}; allowed: {', '.join(sorted(SIDECAR_KEYS))}"
     if key == "format" and value != FORMAT:
-        return f"format must be {FORMAT!r}; got {_shown(value)}"
+        return f"format must be {FORMAT!r}; got {shown(value)}"
     if key in ("sample", "instrument", "description") and not isinstance(value, str):
-        return f"{key} must be a string; got {_shown(value)}"
+        return f"{key} must be a string; got {shown(value)}"
     if key == "wavelength_nm" and not (_is_num(value) and value > 0):
-        return f"wavelength_nm must be a finite number > 0; got {_shown(value)}"
+        return f"wavelength_nm must be a finite number > 0; got {shown(value)}"
     if key == "aperture_deg" and not (_is_num(value) and 0 <= value <= 90):
-        return f"aperture_deg must be a number in [0, 90]; got {_shown(value)}"
+        return f"aperture_deg must be a number in [0, 90]; got {shown(value)}"
     if key == "incident_polarization":
         try:
-            polarization_state(value)
+            stokes(value)
         except ValueError as exc:
             return f"incident_polarization: {exc}"
     if key == "truth":
@@ -262,13 +257,8 @@ def _sidecar_problem(key, value):
             return "truth must be an object {scene key: value}"
         for k, v in value.items():
             if not _is_num(v):
-                return f"truth: {k}: must be a finite number (the true value); got {_shown(v)}"
+                return f"truth: {k}: must be a finite number (the true value); got {shown(v)}"
     return None
-
-
-def _shown(value):
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _is_num(v):
@@ -406,7 +396,7 @@ def _parse_rows(path, header, rows, col_of):
                 continue
             if cell not in cache:
                 try:
-                    cache[cell] = polarization_state(cell)
+                    cache[cell] = stokes(cell)
                 except ValueError as exc:
                     raise DataFileError(path, lineno, j, f"column 'incident': {exc}") from exc
             incident[i] = cache[cell]
@@ -451,7 +441,7 @@ def load_data(path) -> Dataset:
         raise DataFileError(path, header_line, None, "no data rows")
     values, incident = _parse_rows(path, header, rows, col_of)
     if "incident_polarization" in meta:
-        incident[:] = polarization_state(meta["incident_polarization"])
+        incident[:] = stokes(meta["incident_polarization"])
     eta, P, PC = _ellipsometric(values, len(rows))
     return Dataset(
         path=path,

@@ -26,7 +26,15 @@ import hashlib
 import multiprocessing
 import pickle
 
-__all__ = ["SerialExecutor", "ProcessExecutor", "DaskExecutor", "make_executor"]
+__all__ = ["SerialExecutor", "ProcessExecutor", "DaskExecutor", "SchedulerError", "make_executor"]
+
+#: seconds :class:`DaskExecutor` waits for a scheduler given by address to answer
+SCHEDULER_TIMEOUT = 30
+
+
+class SchedulerError(ValueError):
+    """No dask.distributed scheduler answered at the address given (``--scheduler``): the
+    address is the user's input (the command line turns it into ``error: ...``, exit 2)."""
 
 
 def _chunks(items, n):
@@ -154,8 +162,10 @@ class ProcessExecutor(SerialExecutor):
 class DaskExecutor(SerialExecutor):
     kind = "dask"
 
-    def __init__(self, address_or_client, timeout=30):
+    def __init__(self, address_or_client, timeout=None):
         from dask.distributed import Client
+
+        timeout = SCHEDULER_TIMEOUT if timeout is None else timeout
 
         if isinstance(address_or_client, Client):
             self.client, self._own = address_or_client, False
@@ -163,7 +173,7 @@ class DaskExecutor(SerialExecutor):
             try:
                 self.client = Client(address_or_client, timeout=timeout)
             except OSError as exc:  # refused, unreachable, timed out: the address is the user's input
-                raise ValueError(
+                raise SchedulerError(
                     f"scheduler: no dask.distributed scheduler answered at {address_or_client!r} "
                     f"within {timeout} s ({exc})"
                 ) from None
@@ -188,7 +198,8 @@ class DaskExecutor(SerialExecutor):
 def make_executor(workers: int = 1, scheduler: str | None = None):
     """``--workers N`` / ``--scheduler ADDRESS`` -> an executor.
 
-    Raises ``ValueError`` for ``workers`` below 1 or a scheduler that does not answer.
+    Raises ``ValueError`` for ``workers`` below 1, :class:`SchedulerError` (a ``ValueError``)
+    for a scheduler that does not answer.
     """
     if scheduler:
         return DaskExecutor(scheduler)

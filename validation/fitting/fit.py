@@ -20,7 +20,6 @@ import numpy as np
 from models.polarization import wrap_axis
 
 from .checkpoint import CheckpointBackend
-from .fitspec import check_against_data
 from .likelihood import TERMS, Likelihood, replicate, term_variances
 from .sampling import ChainResult, initial_ball, optimize, run_chain, summarize
 from .settings import ChainSettings
@@ -102,7 +101,6 @@ def run_fit(
     """
     settings = ChainSettings() if settings is None else settings
     settings.require_walkers(len(lik.spec.free))
-    check_against_data(lik.scene, lik.spec, lik.data_all)  # refuse a degenerate posterior before sampling
     fp = fingerprint(lik, settings)
     if resume:  # before the optimum: a checkpoint that cannot be resumed fails at once
         backend = CheckpointBackend.load(resume_from or checkpoint, fp, save_to=checkpoint)
@@ -148,7 +146,7 @@ def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
     U = samples[pick]
     batch = None
     if lik.binding is not None:  # every draw's model at once (a model set)
-        values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(lik.spec.free)}
+        values, _ = lik.walkers(U)
         batch = lik.predict(lik.model(values), data)
     for j, u in enumerate(U):  # the replicates draw in the order they always did
         values = lik.spec.physical(u)

@@ -43,6 +43,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from models.scene.schema import shown
+
 __all__ = [
     "FreeParam",
     "FitSpec",
@@ -51,7 +53,6 @@ __all__ = [
     "NOISE_TERMS",
     "parse_free",
     "fitspec_from",
-    "check_against_data",
     "masked_rows",
 ]
 
@@ -118,14 +119,16 @@ class FitSpec:
     def u_bounds(self):
         return np.array([p.u_bounds for p in self.free])
 
-    def log_prior(self, u) -> float:
+    def log_prior(self, u):
         """Flat in sampling coordinates inside the bounds (the prior density of the
-        declared uniform/log-uniform priors, up to a constant); ``-inf`` outside."""
+        declared uniform/log-uniform priors, up to a constant); ``-inf`` outside or where a
+        coordinate is not finite.  Vectorized: one position ``(k,)`` gives a float,
+        positions ``(W, k)`` a ``(W,)`` array (the likelihood's batch of walkers)."""
         b = self.u_bounds()
         u = np.asarray(u, dtype=float)
-        if np.all(np.isfinite(u)) and np.all(u >= b[:, 0]) and np.all(u <= b[:, 1]):
-            return 0.0
-        return -math.inf
+        inside = np.all(np.isfinite(u) & (u >= b[:, 0]) & (u <= b[:, 1]), axis=-1)
+        out = np.where(inside, 0.0, -math.inf)
+        return float(out) if out.ndim == 0 else out
 
     def physical(self, u) -> dict:
         return {p.key: float(p.from_u(v)) for p, v in zip(self.free, u, strict=True)}
@@ -162,6 +165,13 @@ class FitSpec:
             keep &= ~inside
         return keep
 
+    def kept(self, data) -> np.ndarray:
+        """:meth:`mask`, or :class:`FitSpecError` when it keeps no row of ``data``."""
+        keep = self.mask(data)
+        if not keep.any():
+            raise FitSpecError(f"{data.path}: mask: every data row is masked out; no row is left")
+        return keep
+
     def describe(self) -> str:
         lines = ["free parameters (prior, bounds):"]
         lines += [f"  {p.key:<22} {p.prior:<8} [{p.low:g}, {p.high:g}]" for p in self.free]
@@ -190,21 +200,16 @@ def specular_distance(ti, tr, pr):
     return np.arccos(np.clip(c, -1.0, 1.0))
 
 
-def _shown(value):
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _num(where, text):
     """A number given as a number or as text (``"0.5"`` on the command line); not a bool."""
     if isinstance(text, bool) or not isinstance(text, (int, float, str)):
-        raise FitSpecError(f"{where}: {_shown(text)} is not a number")
+        raise FitSpecError(f"{where}: {shown(text)} is not a number")
     try:
         v = float(text)
     except (ValueError, OverflowError):
-        raise FitSpecError(f"{where}: {_shown(text)} is not a number") from None
+        raise FitSpecError(f"{where}: {shown(text)} is not a number") from None
     if not math.isfinite(v):
-        raise FitSpecError(f"{where}: {_shown(text)} is not a finite number")
+        raise FitSpecError(f"{where}: {shown(text)} is not a finite number")
     return v
 
 
@@ -299,16 +304,16 @@ def _free_table(where, e):
     """A free entry given as a table ``{key, low, high[, prior]}``."""
     missing = {"key", "low", "high"} - set(e)
     if missing:
-        raise FitSpecError(f"{where}: table entry {_shown(e)} lacks {sorted(missing)}")
+        raise FitSpecError(f"{where}: table entry {shown(e)} lacks {sorted(missing)}")
     extra = set(e) - {"key", "low", "high", "prior"}
     if extra:
         raise FitSpecError(
-            f"{where}: unknown key(s) {sorted(extra)} in {_shown(e)}; allowed: key, low, high, prior"
+            f"{where}: unknown key(s) {sorted(extra)} in {shown(e)}; allowed: key, low, high, prior"
         )
     if not isinstance(e["key"], str):
-        raise FitSpecError(f"{where}: key must be a dotted scene key (a string); got {_shown(e['key'])}")
+        raise FitSpecError(f"{where}: key must be a dotted scene key (a string); got {shown(e['key'])}")
     if not isinstance(e.get("prior", "uniform"), str):
-        raise FitSpecError(f"{where} {e['key']}: prior must be 'uniform' or 'log'; got {_shown(e['prior'])}")
+        raise FitSpecError(f"{where} {e['key']}: prior must be 'uniform' or 'log'; got {shown(e['prior'])}")
     key = ALIASES.get(e["key"], e["key"])
     low, high = _num(f"{where} {key} low", e["low"]), _num(f"{where} {key} high", e["high"])
     return _free(where, key, low, high, e.get("prior", "uniform"))
@@ -387,7 +392,7 @@ def _mask_entries(where, table, near_specular_deg, exclude):
     table_boxes = mask.get("exclude", [])
     if not isinstance(table_boxes, list):
         raise FitSpecError(
-            f"{where} mask exclude: expected a list of tables {{axis = [lo, hi]}}; got {_shown(table_boxes)}"
+            f"{where} mask exclude: expected a list of tables {{axis = [lo, hi]}}; got {shown(table_boxes)}"
         )
     boxes = [_exclude_box(f"{where} mask exclude", b) for b in table_boxes]
     if exclude:
@@ -440,70 +445,4 @@ def masked_rows(data, near_specular_deg=None, exclude=None):
     """The rows of ``data`` a mask keeps (``--near-specular-deg``, ``--exclude``, as in
     :func:`fitspec_from`); :class:`FitSpecError` when it keeps none."""
     ns, boxes = _mask_entries("--", {}, near_specular_deg, exclude)
-    keep = FitSpec((), {}, ns, boxes).mask(data)
-    if not keep.any():
-        raise FitSpecError(f"{data.path}: mask: every data row is masked out; nothing left")
-    return data.subset(keep)
-
-
-#: noise term -> (likelihood term, data attribute, its error attribute)
-_TERM_DATA = {
-    "brdf": ("brdf", "brdf", "brdf_err"),
-    "eta_deg": ("eta", "eta", "eta_err"),
-    "P": ("P", "P", "P_err"),
-    "P_C": ("P_C", "P_C", "P_C_err"),
-}
-
-
-def check_against_data(scene, spec, data) -> None:
-    """Raise :class:`FitSpecError` unless ``spec`` can give a meaningful posterior on ``data``
-    with ``scene``, before any sampling: the same wavelength, rows left after the mask, a noise
-    level (or error column) for the BRDF, no term of zero variance (a fixed level of 0, or one
-    whose square underflows, without an error column: the likelihood would be degenerate and
-    the chain frozen), and no free noise level for a term the likelihood does not have (its
-    posterior would be its prior).
-
-    Parameters
-    ----------
-    scene : models.scene.Scene
-    spec : FitSpec
-    data : validation.fitting.datafile.Dataset
-    """
-    from .likelihood import term_variances
-
-    wl_s, wl_d = scene.wavelength_nm, data.meta.get("wavelength_nm")
-    if wl_s is not None and wl_d is not None and abs(wl_s - wl_d) > 1e-9 * wl_s:
-        raise FitSpecError(
-            f"wavelength: the data ({wl_d:g} nm, {data.path}) and the scene ({wl_s:g} nm, {scene.path}) "
-            "differ; the scene's optical constants are for its wavelength"
-        )
-    keep = spec.mask(data)
-    if not keep.any():
-        raise FitSpecError(f"{data.path}: mask: every data row is masked out; nothing to fit")
-    d = data.subset(keep)
-    free = {p.key[6:] for p in spec.free if p.is_noise}
-    for noise, (term, col, err) in _TERM_DATA.items():
-        has, errors = getattr(d, col) is not None, getattr(d, err)
-        if noise in free and (noise in spec.off or not has):
-            why = "the term is off" if noise in spec.off else f"the data ({data.path}) have no {col} column"
-            raise FitSpecError(
-                f"noise.{noise}: free, but the likelihood has no {col} term ({why}); its posterior would be its prior"
-            )
-        level = noise in spec.noise or noise in free
-        if noise == "brdf" and not (level or errors is not None):
-            raise FitSpecError(
-                "noise.brdf: the BRDF term needs a noise level (fixed or free: --noise brdf=0.05 or "
-                "--noise brdf:0.005:1:log) or a brdf_err column"
-            )
-        if noise in free or noise in spec.off or not has or not (level or errors is not None):
-            continue  # a free level is sampled; a term not used has no variance
-        var = np.broadcast_to(term_variances(spec.noise, d, [term])[term], (len(d),))
-        bad = ~(var >= np.finfo(float).tiny)
-        if bad.any():
-            line = int(d.lines[bad][0]) if d.lines is not None else None
-            raise FitSpecError(
-                f"noise.{noise} = {spec.noise.get(noise, 0.0):g}: the {col} term has zero variance"
-                + (f" at {data.path}:{line}" if line else "")
-                + f" (no {err} column there): the likelihood is degenerate; give a level > 0 "
-                f"(or free it: --noise {noise}:LOW:HIGH)"
-            )
+    return data.subset(FitSpec((), {}, ns, boxes).kept(data))

@@ -34,7 +34,7 @@ import numpy as np
 from models.polarization import ellipsometric, wrap_axis
 from models.scene import binding
 
-from .fitspec import FitSpec
+from .fitspec import FitSpec, FitSpecError
 
 __all__ = ["Likelihood", "scene_for_data", "term_variances", "replicate", "TERMS"]
 
@@ -94,15 +94,18 @@ class Likelihood:
     every path gives the same numbers, bit for bit, whatever the batch (the chains of a
     vectorized sampler equal those of a per-walker one).  Scenes whose free keys cannot be
     bound are rebuilt per position (:meth:`model_rebuilt`, the path before model sets).
+
+    Construction refuses, with a :class:`FitSpecError` and before any model is evaluated,
+    a spec the data cannot inform: a wavelength other than the scene's, a mask that keeps
+    no row, and the term problems :func:`_terms` lists.
     """
 
     def __init__(self, scene, spec: FitSpec, data):
+        _check_wavelength(scene, data)
         self.scene = scene_for_data(scene, data)
         self.spec = spec
         self.data_all = data
-        self.mask = spec.mask(data)
-        if not self.mask.any():
-            raise ValueError(f"{data.path}: mask: every data row is masked out; nothing to fit")
+        self.mask = spec.kept(data)
         self.data = data.subset(self.mask)
         d = self.data
         self._log_obs = np.log(d.brdf)
@@ -113,7 +116,6 @@ class Likelihood:
         # decided once, at the scene's own values: re-deciding per evaluation would make ln L
         # jump where a decision flips.
         self.decisions = self.scene.decisions()
-        self._bounds = spec.u_bounds()
         scene_keys = {p.key: (p.low, p.high) for p in spec.free if not p.is_noise}
         probe = (d.theta_i[:8], d.theta_r[:8], d.phi_r[:8])
         self.binding = binding.bind(self.scene, scene_keys, self.decisions, probe)
@@ -167,12 +169,12 @@ class Likelihood:
             out["P_C"] = d.P_C - pred["P_C"]
         return out
 
-    def _walkers(self, U):
+    def walkers(self, U):
         """Physical values of positions ``U`` (``(W, k)``) as ``(W, 1)`` arrays, and the noise."""
         values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(self.spec.free)}
         return values, self.spec.noise_values(values)
 
-    def _pointwise_rows(self, values, noise, pred) -> np.ndarray:
+    def _pointwise_rows(self, noise, pred) -> np.ndarray:
         res = self.residuals(pred)
         var = self._variances(noise)
         total = np.zeros(res["brdf"].shape)
@@ -189,13 +191,13 @@ class Likelihood:
         U = np.atleast_2d(np.asarray(U, dtype=float))
         if self.binding is None:
             return self._pointwise_each(U)
-        values, noise = self._walkers(U)
+        values, noise = self.walkers(U)
         try:
             model = self.model(values)
             self.binding.check(model)  # vectorized: every walker's parameters at once
         except ValueError:
             return self._pointwise_valid(U)
-        return self._pointwise_rows(values, noise, self.predict(model))
+        return self._pointwise_rows(noise, self.predict(model))
 
     def _pointwise_valid(self, U):
         """Rows of ``-inf`` for the positions the scene refuses (rebuilt and validated one by
@@ -230,9 +232,7 @@ class Likelihood:
         """Per-row log-likelihood at one position with the scene rebuilt and validated there (the
         per-walker path before model sets; a ``ValueError`` where the scene refuses ``u``)."""
         values = self.spec.physical(u)
-        return self._pointwise_rows(
-            values, self.spec.noise_values(values), self.predict(self.model_rebuilt(values))
-        )
+        return self._pointwise_rows(self.spec.noise_values(values), self.predict(self.model_rebuilt(values)))
 
     def pointwise(self, u) -> np.ndarray:
         """Per-row log-likelihood (all terms summed per row), ``-inf`` where impossible."""
@@ -245,7 +245,7 @@ class Likelihood:
     def whitened(self, u) -> np.ndarray:
         """Residuals divided by their standard deviations (for least squares); large
         finite values where the model predicts no light."""
-        values, noise = self._walkers(np.asarray(u, dtype=float)[None])
+        values, noise = self.walkers(np.asarray(u, dtype=float)[None])
         res = self.residuals(self.predict(self.model(values)))
         var = self._variances(noise)
         out = []
@@ -263,20 +263,15 @@ class Likelihood:
         to it)."""
         return float(np.sum(self.pointwise_rebuilt(u)))
 
-    def in_bounds(self, U) -> np.ndarray:
-        """Positions inside the prior's bounds (finite), ``(W,)`` booleans."""
-        b = self._bounds
-        return np.all(np.isfinite(U) & (U >= b[:, 0]) & (U <= b[:, 1]), axis=1)
-
     def batch(self, U) -> np.ndarray:
         """Log posterior of positions ``U`` ``(W, k)`` in one evaluation, ``(W,)``: the prior is
-        flat inside the bounds (checked once, vectorized), ``-inf`` outside or where the
-        model predicts no light at a used row."""
+        flat inside the bounds (:meth:`FitSpec.log_prior`, vectorized), ``-inf`` outside or
+        where the model predicts no light at a used row."""
         U = np.atleast_2d(np.asarray(U, dtype=float))
-        out = np.full(len(U), -math.inf)
-        inside = np.flatnonzero(self.in_bounds(U))
+        out = self.spec.log_prior(U)
+        inside = np.flatnonzero(np.isfinite(out))
         if inside.size:
-            ll = self.loglike_batch(U[inside])
+            ll = out[inside] + self.loglike_batch(U[inside])
             out[inside] = np.where(np.isfinite(ll), ll, -math.inf)
         return out
 
@@ -284,23 +279,60 @@ class Likelihood:
         return float(self.batch(np.asarray(u, dtype=float)[None])[0])
 
 
+#: likelihood term -> (its noise term, data attribute, its error attribute)
+_TERM_DATA = {
+    "brdf": ("brdf", "brdf", "brdf_err"),
+    "eta": ("eta_deg", "eta", "eta_err"),
+    "P": ("P", "P", "P_err"),
+    "P_C": ("P_C", "P_C", "P_C_err"),
+}
+
+
+def _check_wavelength(scene, data):
+    wl_s, wl_d = scene.wavelength_nm, data.meta.get("wavelength_nm")
+    if wl_s is not None and wl_d is not None and abs(wl_s - wl_d) > 1e-9 * wl_s:
+        raise FitSpecError(
+            f"wavelength: the data ({wl_d:g} nm, {data.path}) and the scene ({wl_s:g} nm, {scene.path}) "
+            "differ; the scene's optical constants are for its wavelength"
+        )
+
+
 def _terms(spec, d):
-    """The likelihood's terms for the spec and the data (see the module docstring)."""
-    free_noise = {p.key[6:] for p in spec.free if p.is_noise}
-    have = lambda t: t in spec.noise or t in free_noise  # noqa: E731
-    used = lambda t, col, err: (  # noqa: E731
-        t not in spec.off and col is not None and (have(t) or err is not None)
-    )
-    terms = ["brdf"]
+    """The likelihood's terms for the spec and the (masked) data ``d`` (see the module
+    docstring).  :class:`FitSpecError` unless they give a meaningful posterior, before any
+    sampling: a noise level (or error column) for the BRDF, no free noise level for a term
+    the likelihood does not have (its posterior would be its prior), no term of zero
+    variance (a fixed level of 0, or one whose square underflows, without an error column:
+    the likelihood would be degenerate and the chain frozen)."""
+    free = {p.key[6:] for p in spec.free if p.is_noise}
+    have = lambda t: t in spec.noise or t in free  # noqa: E731
     if not (have("brdf") or d.brdf_err is not None):
-        raise ValueError(
+        raise FitSpecError(
             "noise.brdf: the BRDF term needs a noise level (fixed or free: --noise brdf=0.05 or "
             "--noise brdf:0.005:1:log) or a brdf_err column"
         )
-    if used("eta_deg", d.eta, d.eta_err):
-        terms.append("eta")
-    if used("P", d.P, d.P_err):
-        terms.append("P")
-    if used("P_C", d.P_C, d.P_C_err):
-        terms.append("P_C")
+    terms = [
+        t
+        for t, (noise, col, err) in _TERM_DATA.items()
+        if noise not in spec.off
+        and getattr(d, col) is not None
+        and (have(noise) or getattr(d, err) is not None)
+    ]
+    for t, (noise, col, err) in _TERM_DATA.items():
+        if noise in free and t not in terms:
+            why = "the term is off" if noise in spec.off else f"the data ({d.path}) have no {col} column"
+            raise FitSpecError(
+                f"noise.{noise}: free, but the likelihood has no {col} term ({why}); its posterior would be its prior"
+            )
+        if noise in free or t not in terms:
+            continue  # a free level is sampled; a term not used has no variance
+        bad = ~(np.broadcast_to(term_variances(spec.noise, d, [t])[t], (len(d),)) >= np.finfo(float).tiny)
+        if bad.any():
+            line = int(d.lines[bad][0]) if d.lines is not None else None
+            raise FitSpecError(
+                f"noise.{noise} = {spec.noise.get(noise, 0.0):g}: the {col} term has zero variance"
+                + (f" at {d.path}:{line}" if line else "")
+                + f" (no {err} column there): the likelihood is degenerate; give a level > 0 "
+                f"(or free it: --noise {noise}:LOW:HIGH)"
+            )
     return tuple(terms)

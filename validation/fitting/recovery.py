@@ -36,6 +36,7 @@ import numpy as np
 from .fit import run_fit
 from .fitspec import FitSpec
 from .likelihood import Likelihood, replicate, term_variances
+from .sampling import _progress_bar
 from .settings import ChainSettings
 
 __all__ = [
@@ -194,21 +195,12 @@ def _run_members(executor, members, per_cell, progress):
     one task per member, so a slow chain does not hold back a worker's whole share
     (members are independent and seeded by their own ``seed``: the results do not
     depend on the grouping or on where they run)."""
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(members), unit="fit", desc="injections", mininterval=1.0)
     results = []
-    try:
+    with _progress_bar(progress, len(members), unit="fit", desc="injections") as bar:
         for start in range(0, len(members), per_cell):
             cell = members[start : start + per_cell]
             results.extend(executor.map(run_member, cell, tasks=len(cell)))
-            if bar is not None:
-                bar.update(per_cell)
-    finally:
-        if bar is not None:
-            bar.close()
+            bar.update(per_cell)
     return results
 
 

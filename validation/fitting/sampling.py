@@ -269,14 +269,15 @@ def _first_state(backend, settings, p0):
 
 
 @contextlib.contextmanager
-def _progress_bar(show, total, initial):
-    """A tqdm bar over the step budget (``show``), else a stand-in that does nothing."""
+def _progress_bar(show, total, initial=0, unit="step", desc="emcee"):
+    """A tqdm bar (``show``) over ``total`` (the step budget of a chain; the fits of a
+    recovery study), else a stand-in that does nothing."""
     if not show:
         yield SimpleNamespace(update=lambda n: None)
         return
     from tqdm import tqdm
 
-    bar = tqdm(total=total, initial=initial, unit="step", desc="emcee", mininterval=1.0)
+    bar = tqdm(total=total, initial=initial, unit=unit, desc=desc, mininterval=1.0)
     try:
         yield bar
     finally:

@@ -9,28 +9,34 @@ it from its flags in one place (``_chain_settings`` in :mod:`validation.cli.fit`
 from __future__ import annotations
 
 import dataclasses
-import math
 import numbers
 from dataclasses import dataclass
+
+import numpy as np
+
+from models.params import check_real
 
 __all__ = ["ChainSettings"]
 
 
 def _integer(name, value, low):
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+    """``value`` as an ``int >= low``.  Not :func:`models.params.check_real`: that converts to
+    a float, which an integer above sys.float_info.max overflows (a valid seed here)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < low:
         raise ValueError(f"{name} must be an integer >= {low}; got {value!r}")
     return int(value)
 
 
 def _positive(name, value):
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, numbers.Real)
-        or not math.isfinite(value)
-        or value <= 0
-    ):
-        raise ValueError(f"{name} must be a finite number > 0; got {value!r}")
-    return float(value)
+    """``value`` as a finite float > 0, judged by :func:`models.params.check_real` (a bool is
+    not a number), with the settings' own message; a complex is refused here, where
+    ``check_real`` would take one of no imaginary part."""
+    try:
+        if isinstance(value, numbers.Real):
+            return check_real(name, value, low=0.0, low_open=True)
+    except (ValueError, OverflowError):  # OverflowError: an integer no float can hold
+        pass
+    raise ValueError(f"{name} must be a finite number > 0; got {value!r}")
 
 
 @dataclass(frozen=True)

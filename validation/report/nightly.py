@@ -35,7 +35,7 @@ import re
 import shutil
 from typing import NamedTuple
 
-from validation.atomic import LockHeld, atomic_write_json, file_lock
+from validation.atomic import LockHeld, atomic_write_json, file_lock, write_problem
 
 from .build import read_results_checked, write_report
 
@@ -87,18 +87,6 @@ def compare_results(old, new):
     return out
 
 
-def _writable(folder):
-    """Why this process cannot create a file in ``folder`` (None: it can)."""
-    try:
-        probe = os.path.join(folder, f".probe-{os.getpid()}")
-        with open(probe, "w"):
-            pass
-        os.unlink(probe)
-    except OSError as exc:
-        return exc.strerror or str(exc)
-    return None
-
-
 def _check_folder(history):
     """The history folder exists (made if need be) and this process can write in it."""
     if os.path.lexists(history) and not os.path.isdir(history):
@@ -107,7 +95,7 @@ def _check_folder(history):
         os.makedirs(history, exist_ok=True)
     except OSError as exc:
         raise HistoryError(f"{history}: cannot create the history folder ({exc.strerror})") from exc
-    problem = _writable(history)
+    problem = write_problem(history)
     if problem:
         raise HistoryError(
             f"{history}: cannot write in the history folder ({problem}); a nightly run writes its "
@@ -121,7 +109,7 @@ def _check_layout(history):
     if os.path.lexists(runs) and not os.path.isdir(runs):
         raise HistoryError(f"{runs}: not a folder; the history keeps one folder per run there")
     os.makedirs(runs, exist_ok=True)
-    problem = _writable(runs)
+    problem = write_problem(runs)
     if problem:
         raise HistoryError(f"{runs}: cannot write in it ({problem})")
     latest = os.path.join(history, "latest")
