@@ -97,6 +97,9 @@ def test_accepted_findings_are_findings_with_their_reason():
     r = check_model(facet, checks=["energy"], quick=True).results[0]
     assert r.status == "finding" and r.measured > 1.0 and "89.99" in r.where
     assert "no shadowing" in r.detail and "value <= hit_fraction + 1e-3" in r.fails_if
+    # the default FacetBTDF (Eq. 37 as printed) is shipped as it is: a finding, not a failure
+    btdf = check_model(dict(SHIPPED)["FacetBTDF"], checks=["energy"], quick=True).results[0]
+    assert btdf.status == "finding" and btdf.measured > 1.0 and "Eq. 37" in btdf.detail
     # the same excess on a model scatterbench does not ship is no accepted finding
     plain = km.Lambertian()
     plain.energy_bound = 0.5

@@ -322,17 +322,16 @@ def shipped_models() -> list[tuple[str, object]]:
     test suite checks them.
 
     The stability sweep's representative instance of each class (its defaults, or for a
-    wrapper a representative inner model), except where a cheaper one tests the same code
-    or the default is a paper's known excess:
+    wrapper a representative inner model), except where a cheaper one tests the same code:
 
     * ``RoughDiffuseBRDF`` with 20 facet pairs per geometry (Monte Carlo; the kit checks
       shapes, finiteness, realizability and the seed, not its precision);
     * ``PointSourceBRDF`` with 4 radial nodes over the disc (the default 16 costs 1.2 ms
-      per geometry; the quadrature is the same code);
-    * ``FacetBTDF`` with ``convention="corrected"``: the printed Eq. 37 normalization
-      integrates above 1 toward grazing incidence, a finding of the paper the check
-      registry states (``seed003.check_btdf_paper_normalization``) but that
-      ``accepted_findings.toml`` does not hold.
+      per geometry; the quadrature is the same code).
+
+    Where a default is a paper's known slip (``CookTorranceBRDF``'s published
+    normalization, ``FacetBTDF``'s Eq. 37), the kit reports a finding with the reason
+    ``accepted_findings.toml`` gives.
     """
     import models
     from validation.studies.stability import edge_instances
@@ -340,7 +339,6 @@ def shipped_models() -> list[tuple[str, object]]:
     cheaper = {
         "RoughDiffuseBRDF": {"pairs": 20},
         "PointSourceBRDF": {"resolution": 4},
-        "FacetBTDF": {"convention": "corrected"},
     }
     out = []
     for cls in models.Model.registry:
