@@ -14,6 +14,7 @@ import numpy as np
 import models
 import references
 from models.cook_torrance import fresnel_real_printed
+from models.geometry import refracted_cos
 from validation.numerics.integrate import integrated_reflectance
 from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 
@@ -43,11 +44,10 @@ def _energy_published(model):
 
 def _jacobian(ti, tr, nv):
     """Refraction Jacobian ``n_v^2 cos Psi cos Theta / (cos psi cos theta)`` between Eq. 24's
-    denominator and the refraction-consistent one."""
-    ci, cr = np.cos(ti), np.cos(tr)
-    cI = np.sqrt(1 - (np.sin(ti) / nv) ** 2)
-    cR = np.sqrt(1 - (np.sin(tr) / nv) ** 2)
-    return nv * nv * cI * cR / (ci * cr)
+    denominator and the refraction-consistent one, in a varnish of (real) index ``nv``."""
+    cI = refracted_cos(np.sin(ti), 1.0, nv).real
+    cR = refracted_cos(np.sin(tr), 1.0, nv).real
+    return nv * nv * cI * cR / (np.cos(ti) * np.cos(tr))
 
 
 def _rel_where_both(a, b):
@@ -82,10 +82,11 @@ def published_over_energy_error(n=20000):
         (models.CookTorranceBRDF, {"slopes": models.GaussianSlopes(0.2)}),
         (models.VarnishedCookTorranceBRDF, {"slopes": models.StrokeSlopes(0.05, 0.4, 0.3)}),
     ):
+        corrected = cls(convention="corrected", **kw)
         a = cls(convention="paper", **kw).brdf(ti, tr, pr)
-        b = cls(convention="corrected", **kw).brdf(ti, tr, pr)
+        b = corrected.brdf(ti, tr, pr)
         if cls is models.VarnishedCookTorranceBRDF:
-            b = b * _jacobian(ti, tr, 1.5)
+            b = b * _jacobian(ti, tr, corrected.coating)
         live = b > 0
         worst = max(worst, float(np.max(np.abs(a[live] / b[live] / (4 * math.pi) - 1))))
     return worst
