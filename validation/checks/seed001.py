@@ -23,6 +23,7 @@ from .common import random_geometries as _geoms
 from .registry import Finding, check, judge, text_section
 
 __all__ = [
+    "energy_published",
     "ct_vs_facet_error",
     "fresnel_real_error",
     "printed_fresnel_error",
@@ -36,7 +37,7 @@ IRON = 2.29 + 3.37j
 SUBSTRATES = (IRON, 1.37 + 7.62j, 1.5, 3.88 + 0.02j, math.inf)
 
 
-def _energy_published(model):
+def energy_published(model):
     """Energy normalization with Eq. 24's printed solid angle: the printed (``paper``) varnished
     model divided by the exact 4 pi (the model has no single convention for this pair)."""
     return (1.0 / (4.0 * math.pi)) * model
@@ -270,7 +271,7 @@ def varnish_albedos(tol=1e-4):
                 convention="paper" if sa == "published" else "corrected",
             )
             if sa == "published":
-                model = _energy_published(model)
+                model = energy_published(model)
             for ti in (0.0, 30.0, 60.0, 80.0, 89.0):
                 r = integrated_reflectance(model, math.radians(ti), tol=tol)
                 rs, rp = models.fresnel_reflectance(math.cos(math.radians(ti)), 1.0, 1.5)
@@ -353,7 +354,7 @@ def _pair(m=0.1, nv=1.5, sub=IRON, solid_angle="published"):
         shadowing="none",
     )
     if solid_angle == "published":
-        v = _energy_published(v)
+        v = energy_published(v)
     s = models.SubsurfaceFacetBRDF(slopes=models.GaussianSlopes(sigma=m), coating=nv, substrate=sub)
     return v, s
 
@@ -523,7 +524,7 @@ def anisotropy_text(ctx):
 
 # ------------------------------------------------------------------ extremes
 def extreme_seed001_models():
-    base = _energy_published(models.VarnishedCookTorranceBRDF())
+    base = energy_published(models.VarnishedCookTorranceBRDF())
     out = []
     for m in (1e-6, 0.03, 2.0):
         for sub in (IRON, 1.5, 1.0 + 0j, math.inf):
@@ -571,7 +572,7 @@ def check_extremes(ctx):
 # ------------------------------------------------------------------ point source
 def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_deg=17.0, resolution=8):
     """Max ``|f_g - f| / max f`` over an in-plane section, per source distance (R = 1)."""
-    base = _energy_published(models.VarnishedCookTorranceBRDF())
+    base = energy_published(models.VarnishedCookTorranceBRDF())
     tr = np.radians(np.linspace(0, 60, 241))
     ti = math.radians(ti_deg)
     f = base.brdf(ti, tr, 0.0)
@@ -587,7 +588,7 @@ def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_
 def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     """``{d: max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak}`` for the
     varnished iron plate, R = 1 (the reversed path from :mod:`validation.numerics.reciprocity`)."""
-    base = _energy_published(models.VarnishedCookTorranceBRDF())
+    base = energy_published(models.VarnishedCookTorranceBRDF())
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.4, (2, n))
     pr = rng.uniform(-0.3, 0.3, n)
