@@ -205,6 +205,27 @@ def test_scatmech_committed_references(monkeypatch):
     assert none.status == "skip" and "no committed reference values" in none.detail
 
 
+class _DeclaresDiffuse:
+    """scatterbench's DiffuseSubsurfaceBRDF behind a plain class naming its SCATMECH equivalent."""
+
+    def __init__(self, n, rho):
+        self.inner = models.DiffuseSubsurfaceBRDF(coating=n, rho=rho)
+        self.scatmech = ("Diffuse_Subsurface_BRDF_Model", {"substrate": n, "reflectance.table": rho})
+
+    def mueller(self, theta_i, theta_r, phi_r):
+        return self.inner.mueller(theta_i, theta_r, phi_r)
+
+
+def test_scatmech_tolerance_is_the_registrys_per_model(monkeypatch):
+    """The kit holds a SCATMECH model to the registry's limit for it: Diffuse_Subsurface to
+    2e-3 (SCATMECH's 0.2-deg R-bar table), the facet models to 1e-6."""
+    monkeypatch.setitem(sys.modules, "pySCATMECH", None)
+    monkeypatch.setitem(sys.modules, "pySCATMECH.brdf", None)
+    r = check_model(_DeclaresDiffuse(2.5, 1.0), checks=["scatmech"]).results[0]
+    assert r.status == "pass" and 1e-6 < r.measured < 2e-3 and r.tolerance == 2e-3
+    assert check_model(_Declares(0.05, 0.05), checks=["scatmech"]).results[0].tolerance == 1e-6
+
+
 def test_scatmech_live_pyscatmech():
     """Where the real pySCATMECH is installed, the kit's live comparison passes for a model
     that is SCATMECH's Facet_BRDF_Model and fails for one 2% off in roughness."""
