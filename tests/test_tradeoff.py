@@ -14,6 +14,7 @@ from validation.cli import main
 from validation.studies.tradeoff import (
     MIN_BATCHES,
     MIN_WORK,
+    KnobResult,
     KnobUnavailable,
     Point,
     at_precision,
@@ -45,12 +46,33 @@ def test_choose_meets_tolerance_against_reference(results):
             pick = choose(r, tol)
             if pick is not None:
                 assert pick.error <= tol
-                assert all(p.seconds >= pick.seconds for p in r.points if p.error <= tol)
+                for p in r.points:
+                    if p.error <= tol and p is not pick:
+                        # costs at least as much, or ties with it (same error) and loses the tie
+                        tie = p.error == pick.error and p.evaluations >= pick.evaluations
+                        assert p.seconds >= pick.seconds or tie
+                        if tie and p.evaluations == pick.evaluations:
+                            assert r.points.index(p) > r.points.index(pick)  # pick is the coarser
 
 
 def test_pareto():
     pts = [Point(1, 1e-2, 1.0, 1), Point(2, 1e-3, 2.0, 1), Point(3, 1e-2, 3.0, 1)]
     assert [p.setting for p in pareto(pts)] == [1, 2]
+
+
+@pytest.mark.parametrize("noise", [(1.02, 1.0, 1.01), (1.0, 1.02, 1.01), (1.01, 1.02, 1.0)])
+def test_ties_are_broken_by_evaluations_then_the_coarser_setting_not_by_noise(noise):
+    """Integration tolerances 1e-2, 1e-3, 1e-4 stop at the same evaluations with the same
+    error: whichever CPU time the noise makes smallest, --tol picks the coarsest, 1e-2."""
+    tied = [Point(tol, 6.43e-5, s * 1e-3, 15750) for tol, s in zip((1e-2, 1e-3, 1e-4), noise, strict=True)]
+    finer = Point(1e-5, 2e-7, 3e-3, 40000)
+    r = KnobResult("integration tolerance", "q", "ref", [*tied, finer])
+    assert choose(r, 1e-4) is tied[0]
+    assert [p.setting for p in pareto(r.points)] == [1e-2, 1e-5]
+    # equal error, fewer evaluations wins even when listed later and timed slower
+    fewer = Point(1e-6, 6.43e-5, 2e-3, 15000)
+    r = KnobResult("integration tolerance", "q", "ref", [*tied, fewer])
+    assert choose(r, 1e-4) is fewer and pareto(r.points) == [fewer]
 
 
 def test_cli_writes_json_and_png(tmp_path, capsys):

@@ -27,7 +27,9 @@ beside the best.
 
 ``pareto`` keeps the settings no other setting beats on both cost and error;
 ``choose(knob, tol)`` returns the cheapest setting whose *measured* error meets
-``tol`` (or says none does).
+``tol`` (or says none does).  Settings with the same error are a tie that CPU-time
+noise must not break: both keep the one with the fewest evaluations, then the coarser
+setting (listed first: every knob lists its settings coarser first).
 """
 
 from __future__ import annotations
@@ -345,8 +347,21 @@ def knob_precision(quick=False, model=None):
     )
 
 
+def _untied(points):
+    """One point per distinct error, in the points' order: of those with the same error
+    the fewest evaluations, then the first listed (the coarser setting).  Equal error and
+    evaluations mean the same work (e.g. integration tolerances 1e-2..1e-4 stopping at
+    the same 15750 evaluations): their CPU times differ by noise only."""
+    best = {}
+    for i, p in enumerate(points):
+        if p.error not in best or p.evaluations < best[p.error][1].evaluations:
+            best[p.error] = (i, p)
+    return [p for _, p in sorted(best.values(), key=lambda t: t[0])]
+
+
 def pareto(points):
-    """Settings not dominated in (cost, error)."""
+    """Settings not dominated in (cost, error), ties in error broken as :func:`_untied`."""
+    points = _untied(points)
     keep = []
     for p in points:
         dominated = any(
@@ -359,8 +374,9 @@ def pareto(points):
 
 
 def choose(result: KnobResult, tol: float):
-    """Cheapest setting whose measured error is <= tol, or None."""
-    ok = [p for p in result.points if p.error <= tol]
+    """Cheapest setting whose measured error is <= tol, or None; ties in error broken
+    deterministically (fewest evaluations, then the coarser setting: :func:`_untied`)."""
+    ok = [p for p in _untied(result.points) if p.error <= tol]
     return min(ok, key=lambda p: p.seconds) if ok else None
 
 
