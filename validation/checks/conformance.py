@@ -36,6 +36,7 @@ import numpy as np
 import models
 from models.params import param
 
+from .common import fp_warnings
 from .registry import Check, CheckContext, Finding, judge
 
 __all__ = [
@@ -283,10 +284,8 @@ def evaluate(model, ti, tr, pr, **kw):
     """``(M, warned)``: ``model.mueller(ti, tr, pr, **kw)`` as an array and the number of
     floating-point warnings it raised (gradual underflow, the correct IEEE result for far
     tails, not counted)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-            M = np.asarray(model.mueller(ti, tr, pr, **kw))
+    with fp_warnings() as caught:
+        M = np.asarray(model.mueller(ti, tr, pr, **kw))
     return M, len(caught)
 
 

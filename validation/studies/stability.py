@@ -33,7 +33,6 @@ import math
 import os
 import threading
 import tomllib
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -270,12 +269,12 @@ def _label(ti, tr, pr):
 
 
 def _evaluate(model, ti, tr, pr, found, name, params):
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-            M = model.mueller(ti, tr, pr)
-            J = None if model.depolarizing else model.jones(ti, tr, pr)
-            M32 = model.mueller(ti.astype(np.float32), tr.astype(np.float32), pr.astype(np.float32))
+    from validation.checks.common import fp_warnings  # not at import: it loads every check
+
+    with fp_warnings() as caught:
+        M = model.mueller(ti, tr, pr)
+        J = None if model.depolarizing else model.jones(ti, tr, pr)
+        M32 = model.mueller(ti.astype(np.float32), tr.astype(np.float32), pr.astype(np.float32))
     for w in caught:
         found.append(Finding(name, params, "fp-warning", 1.0, str(w.message)))
     bad = ~np.all(np.isfinite(M), axis=(-1, -2))
