@@ -129,6 +129,33 @@ def test_stochastic_and_scalar_claims_skip_with_notes():
     assert statuses == ["pass", "skip"]
 
 
+def test_jones_reciprocity_is_checked_for_a_model_with_jones():
+    class OneCrossTerm(km.Lambertian):
+        """Reciprocal M00 and Mueller, but a Jones matrix with one cross term: J_rev = J,
+        while reciprocity predicts Z J^T Z (the cross term moved, with its sign flipped)."""
+
+        def jones(self, theta_i, theta_r, phi_r):
+            shape = np.broadcast_shapes(np.shape(theta_i), np.shape(theta_r), np.shape(phi_r))
+            return np.broadcast_to(np.array([[0.5, 0.25], [0.0, 0.5]], dtype=complex), shape + (2, 2))
+
+    results = check_model(OneCrossTerm(), checks=["reciprocity"]).results
+    assert [(r.name, r.status) for r in results] == [
+        ("reciprocity: M00", "pass"),
+        ("reciprocity: Mueller", "pass"),
+        ("reciprocity: Jones", "fail"),
+    ]
+    assert "J_rev" in results[2].detail and results[2].measured > 0.1
+    # without jones there is no Jones verdict; a scalar claim skips it with the Mueller one
+    assert [r.name for r in check_model(km.Lambertian(), checks=["reciprocity"]).results] == [
+        "reciprocity: M00",
+        "reciprocity: Mueller",
+    ]
+    scalar = OneCrossTerm()
+    scalar.reciprocal = "scalar"
+    statuses = [r.status for r in check_model(scalar, checks=["reciprocity"]).results]
+    assert statuses == ["pass", "skip", "skip"]
+
+
 def test_a_model_that_raises_fails_the_check_that_called_it():
     class Raises(km.Lambertian):
         def mueller(self, theta_i, theta_r, phi_r):

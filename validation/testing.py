@@ -21,7 +21,7 @@ The checks (:func:`validation.checks.conformance.conformance_checks`): ``broadca
 (scalar, 0-d, array, broadcast and chunked calls agree), ``dtypes`` (float32 and integer
 angles), ``out_argument`` (``out=``, if ``mueller`` takes one), ``finite`` and
 ``nonnegative`` (M00 >= 0) on a grid of extreme geometries, ``realizable`` (coherency
-eigenvalues), ``reciprocity`` (M00 and Mueller), ``energy`` (integrated reflectance at a
+eigenvalues), ``reciprocity`` (M00, Mueller and, with ``jones``, Jones), ``energy`` (integrated reflectance at a
 ladder of incidences), ``determinism`` (the same seed gives the same numbers),
 ``pickle``, ``parameter_extremes`` (a :class:`models.Model`'s declared parameters at their
 edges) and ``scatmech`` (agreement with an equivalent SCATMECH model).  A check that needs
@@ -144,7 +144,7 @@ def check_model(model, *, checks=None, quick=False, label=None, ctx=None) -> Mod
     >>> from validation.testing import check_model
     >>> report = check_model(models.FacetBRDF(), checks=["reciprocity"])
     >>> [(r.name, r.status) for r in report.results]
-    [('reciprocity: M00', 'pass'), ('reciprocity: Mueller', 'pass')]
+    [('reciprocity: M00', 'pass'), ('reciprocity: Mueller', 'pass'), ('reciprocity: Jones', 'pass')]
     """
     if not callable(getattr(model, "mueller", None)):
         raise ValueError(f"model must have a mueller(theta_i, theta_r, phi_r) method; got {model!r}")

@@ -60,7 +60,8 @@ __all__ = [
 #: The optional attributes a model may set, and what the kit does with each.
 ATTRIBUTES = {
     "reciprocal": "True (default): Helmholtz reciprocity in M00 and in the Mueller relation "
-    "M_rev = D M^T D, D = diag(1, 1, -1, 1); 'scalar': in M00 only; False: not claimed (skipped)",
+    "M_rev = D M^T D, D = diag(1, 1, -1, 1) (and J_rev = Z J^T Z for a model with jones); "
+    "'scalar': in M00 only; False: not claimed (skipped)",
     "energy_bound": "upper bound of the integrated reflectance (default 1; e.g. 4 pi for a "
     "published normalization that is not energy-normalized)",
     "stochastic": "True for a Monte Carlo model (default: True when it has a 'seed' attribute); "
