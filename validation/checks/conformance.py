@@ -298,10 +298,11 @@ def where(ti, tr, pr, k=None):
     return f"theta_i={d(float(ti)):.6g} deg, theta_r={d(float(tr)):.6g} deg, phi_r={d(float(pr)):.6g} deg"
 
 
-def accepted_reason(model, kind, fields):
-    """``(reason, condition)`` of the accepted finding (``accepted_findings.toml``) that
-    explains a ``kind`` of finding with these numeric ``fields`` on one of scatterbench's
-    own models, else ``None``: only scatterbench's models carry accepted findings."""
+def accepted_reason(model, kind, fields, accepted=None):
+    """``(reason, condition)`` of the accepted finding (``accepted_findings.toml``, or the
+    entries ``accepted``) that explains a ``kind`` of finding with these numeric ``fields``
+    on one of scatterbench's own models, else ``None``: only scatterbench's models carry
+    accepted findings."""
     from validation.studies import stability
 
     if not type(model).__module__.startswith("models."):
@@ -309,11 +310,8 @@ def accepted_reason(model, kind, fields):
     f = stability.Finding(
         type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields
     )
-    for entry in stability.load_accepted():
-        ok, _ = stability.classify([f], [entry])
-        if ok:
-            return entry["reason"], entry.get("condition") or "always"
-    return None
+    entry = stability.accepted_entry(f, accepted)
+    return None if entry is None else (entry["reason"], entry.get("condition") or "always")
 
 
 def finding_of(reason, condition) -> Finding:

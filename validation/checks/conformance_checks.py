@@ -387,18 +387,15 @@ def _energy_bound(model):
 def _energy_reason(model, ti, r, bound):
     """The accepted finding (``(reason, condition)`` or ``None``) that explains the
     integrated reflectance ``r`` above ``bound`` at ``ti``, from the fields the stability
-    sweep gives its energy findings; the hit fraction (an integral) only when needed."""
-    from validation.numerics.energy import hit_fraction
-    from validation.studies.stability import _scalar_params  # the fields accepted conditions read
+    sweep gives its energy findings (:func:`validation.studies.stability.energy_fields`);
+    the hit fraction (an integral) only when needed."""
+    from validation.studies.stability import energy_fields, load_accepted, model_hit_fraction
 
-    fields = {"value": r.value, "theta_i": ti, "excess": r.value - r.error - bound}
-    if isinstance(model, Declared):
-        fields.update(_scalar_params(model))
-    found = accepted_reason(model, "energy", fields)
-    slopes = getattr(model, "slopes", None)
-    if found is None and isinstance(slopes, models.SlopeDistribution):
-        fields["hit_fraction"] = hit_fraction(slopes, ti, float(getattr(model, "coating", 1.0)))
-        found = accepted_reason(model, "energy", fields)
+    accepted = load_accepted()
+    fields = energy_fields(model, ti, r.value, r.error, bound, hit=False)
+    found = accepted_reason(model, "energy", fields, accepted)
+    if found is None and (h := model_hit_fraction(model, ti)) is not None:
+        found = accepted_reason(model, "energy", {**fields, "hit_fraction": h}, accepted)
     return found
 
 
