@@ -26,6 +26,7 @@ import numpy as np
 # Use the models of the checkout this script lives in (not an installed copy).
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import models  # noqa: E402
+from validation.checks.seed001 import energy_published  # noqa: E402
 
 
 def _timed(fn, repeat=1):
@@ -41,8 +42,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer distances and resolutions")
     args = ap.parse_args(argv)
-    # energy normalization with Eq. 24's printed solid angle: the printed model over the exact 4 pi
-    base = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF()
+    base = energy_published(models.VarnishedCookTorranceBRDF())
     ti = math.radians(17.0)
     tr = np.radians(np.linspace(0, 40, 161))
     pr = np.radians(np.linspace(-10, 10, 41))

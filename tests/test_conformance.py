@@ -97,6 +97,9 @@ def test_accepted_findings_are_findings_with_their_reason():
     r = check_model(facet, checks=["energy"], quick=True).results[0]
     assert r.status == "finding" and r.measured > 1.0 and "89.99" in r.where
     assert "no shadowing" in r.detail and "value <= hit_fraction + 1e-3" in r.fails_if
+    # the default FacetBTDF (Eq. 37 as printed) is shipped as it is: a finding, not a failure
+    btdf = check_model(dict(SHIPPED)["FacetBTDF"], checks=["energy"], quick=True).results[0]
+    assert btdf.status == "finding" and btdf.measured > 1.0 and "Eq. 37" in btdf.detail
     # the same excess on a model scatterbench does not ship is no accepted finding
     plain = km.Lambertian()
     plain.energy_bound = 0.5
@@ -124,6 +127,33 @@ def test_stochastic_and_scalar_claims_skip_with_notes():
     lam.reciprocal = "scalar"
     statuses = [r.status for r in check_model(lam, checks=["reciprocity"]).results]
     assert statuses == ["pass", "skip"]
+
+
+def test_jones_reciprocity_is_checked_for_a_model_with_jones():
+    class OneCrossTerm(km.Lambertian):
+        """Reciprocal M00 and Mueller, but a Jones matrix with one cross term: J_rev = J,
+        while reciprocity predicts Z J^T Z (the cross term moved, with its sign flipped)."""
+
+        def jones(self, theta_i, theta_r, phi_r):
+            shape = np.broadcast_shapes(np.shape(theta_i), np.shape(theta_r), np.shape(phi_r))
+            return np.broadcast_to(np.array([[0.5, 0.25], [0.0, 0.5]], dtype=complex), shape + (2, 2))
+
+    results = check_model(OneCrossTerm(), checks=["reciprocity"]).results
+    assert [(r.name, r.status) for r in results] == [
+        ("reciprocity: M00", "pass"),
+        ("reciprocity: Mueller", "pass"),
+        ("reciprocity: Jones", "fail"),
+    ]
+    assert "J_rev" in results[2].detail and results[2].measured > 0.1
+    # without jones there is no Jones verdict; a scalar claim skips it with the Mueller one
+    assert [r.name for r in check_model(km.Lambertian(), checks=["reciprocity"]).results] == [
+        "reciprocity: M00",
+        "reciprocity: Mueller",
+    ]
+    scalar = OneCrossTerm()
+    scalar.reciprocal = "scalar"
+    statuses = [r.status for r in check_model(scalar, checks=["reciprocity"]).results]
+    assert statuses == ["pass", "skip", "skip"]
 
 
 def test_a_model_that_raises_fails_the_check_that_called_it():
@@ -200,6 +230,27 @@ def test_scatmech_committed_references(monkeypatch):
     assert off.status == "fail" and off.where
     none = check_model(_Declares(0.07, 0.07), checks=["scatmech"]).results[0]
     assert none.status == "skip" and "no committed reference values" in none.detail
+
+
+class _DeclaresDiffuse:
+    """scatterbench's DiffuseSubsurfaceBRDF behind a plain class naming its SCATMECH equivalent."""
+
+    def __init__(self, n, rho):
+        self.inner = models.DiffuseSubsurfaceBRDF(coating=n, rho=rho)
+        self.scatmech = ("Diffuse_Subsurface_BRDF_Model", {"substrate": n, "reflectance.table": rho})
+
+    def mueller(self, theta_i, theta_r, phi_r):
+        return self.inner.mueller(theta_i, theta_r, phi_r)
+
+
+def test_scatmech_tolerance_is_the_registrys_per_model(monkeypatch):
+    """The kit holds a SCATMECH model to the registry's limit for it: Diffuse_Subsurface to
+    2e-3 (SCATMECH's 0.2-deg R-bar table), the facet models to 1e-6."""
+    monkeypatch.setitem(sys.modules, "pySCATMECH", None)
+    monkeypatch.setitem(sys.modules, "pySCATMECH.brdf", None)
+    r = check_model(_DeclaresDiffuse(2.5, 1.0), checks=["scatmech"]).results[0]
+    assert r.status == "pass" and 1e-6 < r.measured < 2e-3 and r.tolerance == 2e-3
+    assert check_model(_Declares(0.05, 0.05), checks=["scatmech"]).results[0].tolerance == 1e-6
 
 
 def test_scatmech_live_pyscatmech():

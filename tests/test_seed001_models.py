@@ -324,7 +324,7 @@ def test_varnish_energy_form_still_creates_energy():
     although the varnish transmits 0.96 each way -- the missing refraction Jacobian.
     With it (convention 'corrected') it is T_in T_out = 0.9216 (m -> 0 limit)."""
     kw = dict(slopes=models.StrokeSlopes(0.03, 0.03), substrate=math.inf)
-    energy_printed = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF(convention="paper", **kw)
+    energy_printed = c.energy_published(models.VarnishedCookTorranceBRDF(convention="paper", **kw))
     pub = integrated_reflectance(energy_printed, 0.0, tol=1e-4)
     ref = integrated_reflectance(
         models.VarnishedCookTorranceBRDF(convention="corrected", **kw), 0.0, tol=1e-4

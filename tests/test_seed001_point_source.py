@@ -10,8 +10,7 @@ import references
 from validation.checks import seed001 as c
 from validation.numerics.reciprocity import reciprocity_error
 
-# energy normalization with Eq. 24's printed solid angle: the printed model over the exact 4 pi
-BASE = (1.0 / (4.0 * math.pi)) * models.VarnishedCookTorranceBRDF()
+BASE = c.energy_published(models.VarnishedCookTorranceBRDF())
 
 
 def test_infinite_distance_is_the_model(rng):

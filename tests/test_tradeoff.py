@@ -9,12 +9,13 @@ import numpy as np
 import pytest
 
 import models
-from models.base import Model
-from models.params import param
 from validation.atomic import atomic_write_json
 from validation.cli import main
 from validation.studies.tradeoff import (
     MIN_BATCHES,
+    MIN_WORK,
+    KnobResult,
+    KnobUnavailable,
     Point,
     at_precision,
     choose,
@@ -45,12 +46,33 @@ def test_choose_meets_tolerance_against_reference(results):
             pick = choose(r, tol)
             if pick is not None:
                 assert pick.error <= tol
-                assert all(p.seconds >= pick.seconds for p in r.points if p.error <= tol)
+                for p in r.points:
+                    if p.error <= tol and p is not pick:
+                        # costs at least as much, or ties with it (same error) and loses the tie
+                        tie = p.error == pick.error and p.evaluations >= pick.evaluations
+                        assert p.seconds >= pick.seconds or tie
+                        if tie and p.evaluations == pick.evaluations:
+                            assert r.points.index(p) > r.points.index(pick)  # pick is the coarser
 
 
 def test_pareto():
     pts = [Point(1, 1e-2, 1.0, 1), Point(2, 1e-3, 2.0, 1), Point(3, 1e-2, 3.0, 1)]
     assert [p.setting for p in pareto(pts)] == [1, 2]
+
+
+@pytest.mark.parametrize("noise", [(1.02, 1.0, 1.01), (1.0, 1.02, 1.01), (1.01, 1.02, 1.0)])
+def test_ties_are_broken_by_evaluations_then_the_coarser_setting_not_by_noise(noise):
+    """Integration tolerances 1e-2, 1e-3, 1e-4 stop at the same evaluations with the same
+    error: whichever CPU time the noise makes smallest, --tol picks the coarsest, 1e-2."""
+    tied = [Point(tol, 6.43e-5, s * 1e-3, 15750) for tol, s in zip((1e-2, 1e-3, 1e-4), noise, strict=True)]
+    finer = Point(1e-5, 2e-7, 3e-3, 40000)
+    r = KnobResult("integration tolerance", "q", "ref", [*tied, finer])
+    assert choose(r, 1e-4) is tied[0]
+    assert [p.setting for p in pareto(r.points)] == [1e-2, 1e-5]
+    # equal error, fewer evaluations wins even when listed later and timed slower
+    fewer = Point(1e-6, 6.43e-5, 2e-3, 15000)
+    r = KnobResult("integration tolerance", "q", "ref", [*tied, fewer])
+    assert choose(r, 1e-4) is fewer and pareto(r.points) == [fewer]
 
 
 def test_cli_writes_json_and_png(tmp_path, capsys):
@@ -111,7 +133,7 @@ def test_costs_are_resolved_best_of_batches(results):
     number of points instead of running backwards."""
     for r in results.values():
         for p in r.points:
-            assert p.calls >= MIN_BATCHES and p.spread >= 0 and p.wall_seconds > 0
+            assert p.cpu_total >= MIN_WORK and p.wall_seconds > 0
     grid = results["in-plane grid"].points
     assert grid[0].calls > 100  # a ~0.1 ms call: batched, not timed once
     assert grid[-1].seconds > grid[0].seconds  # 361 points cost more than 19
@@ -139,8 +161,8 @@ class RoundedFacet(models.FacetBRDF):
 
 
 class Plain:
-    """A model without a precision option (not a models.Model: every Model's mueller takes
-    ``precision``, the numpy path rounding its float64 result)."""
+    """A model without a float32 kernel (not a models.Model: its mueller takes no
+    ``precision``)."""
 
     depolarizing = True
 
@@ -148,27 +170,29 @@ class Plain:
         return np.broadcast_to(np.diag([1 / math.pi, 0, 0, 0]), np.shape(theta_i) + (4, 4))
 
 
-@dataclass(frozen=True)
-class Flat(Model):
-    """A model whose precision is a declared parameter (the other form the option may take)."""
-
-    depolarizing = True
-    precision: str = param("float64", "evaluation precision", kind="choice", choices=("float64", "float32"))
-
-    def _mueller16(self, ti, tr, pr):
-        out = np.zeros((16, ti.size))
-        out[0] = 1 / math.pi if self.precision == "float64" else np.float32(1 / math.pi)
-        return out
+#: models whose mueller takes precision= (every models.Model) but that no float32 kernel
+#: evaluates: Monte Carlo and the point-source wrapper (float64, rounded, at the same cost)
+NO_KERNEL = [
+    models.RoughDiffuseBRDF(pairs=200),
+    models.PointSourceBRDF(model=models.CookTorranceBRDF(convention="corrected"), distance=100.0),
+]
 
 
-def test_precision_option_forms():
-    assert precision_option(RoundedFacet()) == "keyword" and precision_option(Flat()) == "parameter"
+def test_precision_option_is_a_real_float32_kernel():
+    assert precision_option(RoundedFacet()) == "keyword"
+    assert precision_option(models.SubsurfaceFacetBRDF()) == "keyword"
     assert precision_option(Plain()) is None
-    assert at_precision(Flat(), "float32")(0.1, 0.2, 0.3)[0, 0] == np.float32(1 / math.pi)
+    for m in NO_KERNEL:
+        assert precision_option(m) is None, m
+    with models.backend("numpy"):  # the reference path: float64, rounded
+        assert precision_option(models.SubsurfaceFacetBRDF()) is None
+    assert at_precision(RoundedFacet(), "float32")(0.1, 0.2, 0.3).dtype == np.float32
     with pytest.raises(ValueError, match="precision must be 'float64' or 'float32'; got 'half'"):
-        at_precision(Flat(), "half")
-    with pytest.raises(ValueError, match="precision: Plain has no precision option"):
+        at_precision(RoundedFacet(), "half")
+    with pytest.raises(ValueError, match="precision: Plain has no float32 kernel"):
         at_precision(Plain(), "float32")
+    with pytest.raises(ValueError, match="precision: RoughDiffuseBRDF has no float32 kernel"):
+        at_precision(NO_KERNEL[0], "float32")
 
 
 def test_precision_knob_measures_float32_against_float64():
@@ -181,11 +205,24 @@ def test_precision_knob_measures_float32_against_float64():
     assert pick is min(r.points, key=lambda p: p.seconds)
 
 
-def test_precision_knob_is_skipped_with_its_reason_where_no_model_has_the_option():
-    skipped = {}
-    out = study(names=["precision"], quick=True, skipped=skipped)
-    default = models.SubsurfaceFacetBRDF()
-    if precision_option(default) is None:
-        assert out == [] and "SubsurfaceFacetBRDF has no precision option" in skipped["precision"]
-    else:  # the kernels' option exists: the knob is measured
-        assert [r.knob for r in out] == ["precision"] and not skipped
+def test_precision_knob_is_unavailable_with_its_reason_without_a_float32_kernel():
+    with pytest.raises(KnobUnavailable, match="Plain has no float32 kernel"):
+        knob_precision(quick=True, model=Plain())
+    for m in NO_KERNEL:
+        with pytest.raises(KnobUnavailable, match=f"{type(m).__name__} has no float32 kernel"):
+            knob_precision(quick=True, model=m)
+
+
+def test_scene_precision_is_decided_and_measured_on_the_scenes_model(monkeypatch):
+    from validation.studies import scenes, tradeoff
+
+    notes = []
+    assert scenes._choose_precision(NO_KERNEL[0], 1e-3, notes) == "float64"
+    assert notes == ["precision: float64 (RoughDiffuseBRDF has no float32 kernel)"]
+    seen = []
+    real = tradeoff.KNOBS["precision"]
+    monkeypatch.setitem(tradeoff.KNOBS, "precision", lambda **kw: seen.append(kw) or real(**kw))
+    model = models.FacetBRDF(slopes=models.GaussianSlopes(0.3))
+    notes = []
+    assert scenes._choose_precision(model, 1e-3, notes) in ("float32", "float64")
+    assert seen == [{"quick": True, "model": model}] and notes[0].startswith("precision: chose")

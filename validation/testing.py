@@ -21,7 +21,7 @@ The checks (:func:`validation.checks.conformance.conformance_checks`): ``broadca
 (scalar, 0-d, array, broadcast and chunked calls agree), ``dtypes`` (float32 and integer
 angles), ``out_argument`` (``out=``, if ``mueller`` takes one), ``finite`` and
 ``nonnegative`` (M00 >= 0) on a grid of extreme geometries, ``realizable`` (coherency
-eigenvalues), ``reciprocity`` (M00 and Mueller), ``energy`` (integrated reflectance at a
+eigenvalues), ``reciprocity`` (M00, Mueller and, with ``jones``, Jones), ``energy`` (integrated reflectance at a
 ladder of incidences), ``determinism`` (the same seed gives the same numbers),
 ``pickle``, ``parameter_extremes`` (a :class:`models.Model`'s declared parameters at their
 edges) and ``scatmech`` (agreement with an equivalent SCATMECH model).  A check that needs
@@ -144,7 +144,7 @@ def check_model(model, *, checks=None, quick=False, label=None, ctx=None) -> Mod
     >>> from validation.testing import check_model
     >>> report = check_model(models.FacetBRDF(), checks=["reciprocity"])
     >>> [(r.name, r.status) for r in report.results]
-    [('reciprocity: M00', 'pass'), ('reciprocity: Mueller', 'pass')]
+    [('reciprocity: M00', 'pass'), ('reciprocity: Mueller', 'pass'), ('reciprocity: Jones', 'pass')]
     """
     if not callable(getattr(model, "mueller", None)):
         raise ValueError(f"model must have a mueller(theta_i, theta_r, phi_r) method; got {model!r}")
@@ -322,17 +322,16 @@ def shipped_models() -> list[tuple[str, object]]:
     test suite checks them.
 
     The stability sweep's representative instance of each class (its defaults, or for a
-    wrapper a representative inner model), except where a cheaper one tests the same code
-    or the default is a paper's known excess:
+    wrapper a representative inner model), except where a cheaper one tests the same code:
 
     * ``RoughDiffuseBRDF`` with 20 facet pairs per geometry (Monte Carlo; the kit checks
       shapes, finiteness, realizability and the seed, not its precision);
-    * ``PointSourceBRDF`` with 4 radial nodes over the disc (the default 16 costs 1.2 ms
-      per geometry; the quadrature is the same code);
-    * ``FacetBTDF`` with ``convention="corrected"``: the printed Eq. 37 normalization
-      integrates above 1 toward grazing incidence, a finding of the paper the check
-      registry states (``seed003.check_btdf_paper_normalization``) but that
-      ``accepted_findings.toml`` does not hold.
+    * ``PointSourceBRDF`` with 4 radial nodes over the disc (the default is 16, and the
+      cost grows with their square; the quadrature is the same code).
+
+    Where a default is a paper's known slip (``CookTorranceBRDF``'s published
+    normalization, ``FacetBTDF``'s Eq. 37), the kit reports a finding with the reason
+    ``accepted_findings.toml`` gives.
     """
     import models
     from validation.studies.stability import edge_instances
@@ -340,7 +339,6 @@ def shipped_models() -> list[tuple[str, object]]:
     cheaper = {
         "RoughDiffuseBRDF": {"pairs": 20},
         "PointSourceBRDF": {"resolution": 4},
-        "FacetBTDF": {"convention": "corrected"},
     }
     out = []
     for cls in models.Model.registry:

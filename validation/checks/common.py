@@ -4,6 +4,7 @@ distributions' numerical normalization and conversion errors."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import warnings
 
@@ -15,6 +16,7 @@ import models
 __all__ = [
     "random_geometries",
     "extreme_geometries",
+    "fp_warnings",
     "count_extremes",
     "facet_suite",
     "slope_normalization_errors",
@@ -43,6 +45,17 @@ def extreme_geometries():
     return ti, tr, pr
 
 
+@contextlib.contextmanager
+def fp_warnings():
+    """Record the warnings raised in the block, floating-point ones included (division by
+    zero, overflow, invalid operation; not gradual underflow, the correct IEEE result for
+    far tails): yields the list they go into."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
+            yield caught
+
+
 def count_extremes(models_, ti, tr, pr, jones=False):
     """``(bad, warned, M)`` over models at the given geometries: non-finite Mueller (and
     Jones) elements and negative M00 counted in ``bad``, floating-point warnings other than
@@ -51,11 +64,9 @@ def count_extremes(models_, ti, tr, pr, jones=False):
     bad = warned = 0
     Ms = []
     for m in models_:
-        with warnings.catch_warnings(record=True) as w:
-            warnings.simplefilter("always")
-            with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-                M = m.mueller(ti, tr, pr)
-                J = m.jones(ti, tr, pr) if jones else None
+        with fp_warnings() as w:
+            M = m.mueller(ti, tr, pr)
+            J = m.jones(ti, tr, pr) if jones else None
         warned += len(w)
         bad += int(np.sum(~np.isfinite(M))) + int(np.sum(M[..., 0, 0] < 0))
         if J is not None:

@@ -36,6 +36,7 @@ import numpy as np
 import models
 from models.params import param
 
+from .common import fp_warnings
 from .registry import Check, CheckContext, Finding, judge
 
 __all__ = [
@@ -59,7 +60,8 @@ __all__ = [
 #: The optional attributes a model may set, and what the kit does with each.
 ATTRIBUTES = {
     "reciprocal": "True (default): Helmholtz reciprocity in M00 and in the Mueller relation "
-    "M_rev = D M^T D, D = diag(1, 1, -1, 1); 'scalar': in M00 only; False: not claimed (skipped)",
+    "M_rev = D M^T D, D = diag(1, 1, -1, 1) (and J_rev = Z J^T Z for a model with jones); "
+    "'scalar': in M00 only; False: not claimed (skipped)",
     "energy_bound": "upper bound of the integrated reflectance (default 1; e.g. 4 pi for a "
     "published normalization that is not energy-normalized)",
     "stochastic": "True for a Monte Carlo model (default: True when it has a 'seed' attribute); "
@@ -283,10 +285,8 @@ def evaluate(model, ti, tr, pr, **kw):
     """``(M, warned)``: ``model.mueller(ti, tr, pr, **kw)`` as an array and the number of
     floating-point warnings it raised (gradual underflow, the correct IEEE result for far
     tails, not counted)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-            M = np.asarray(model.mueller(ti, tr, pr, **kw))
+    with fp_warnings() as caught:
+        M = np.asarray(model.mueller(ti, tr, pr, **kw))
     return M, len(caught)
 
 
@@ -298,10 +298,11 @@ def where(ti, tr, pr, k=None):
     return f"theta_i={d(float(ti)):.6g} deg, theta_r={d(float(tr)):.6g} deg, phi_r={d(float(pr)):.6g} deg"
 
 
-def accepted_reason(model, kind, fields):
-    """``(reason, condition)`` of the accepted finding (``accepted_findings.toml``) that
-    explains a ``kind`` of finding with these numeric ``fields`` on one of scatterbench's
-    own models, else ``None``: only scatterbench's models carry accepted findings."""
+def accepted_reason(model, kind, fields, accepted=None):
+    """``(reason, condition)`` of the accepted finding (``accepted_findings.toml``, or the
+    entries ``accepted``) that explains a ``kind`` of finding with these numeric ``fields``
+    on one of scatterbench's own models, else ``None``: only scatterbench's models carry
+    accepted findings."""
     from validation.studies import stability
 
     if not type(model).__module__.startswith("models."):
@@ -309,11 +310,8 @@ def accepted_reason(model, kind, fields):
     f = stability.Finding(
         type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields
     )
-    for entry in stability.load_accepted():
-        ok, _ = stability.classify([f], [entry])
-        if ok:
-            return entry["reason"], entry.get("condition") or "always"
-    return None
+    entry = stability.accepted_entry(f, accepted)
+    return None if entry is None else (entry["reason"], entry.get("condition") or "always")
 
 
 def finding_of(reason, condition) -> Finding:

@@ -19,7 +19,7 @@ import numpy as np
 
 import models
 from models.params import Declared
-from models.polarization import coherency_eigenvalues, reciprocal_mueller
+from models.polarization import coherency_eigenvalues
 
 from .common import extreme_geometries, random_geometries
 from .conformance import (
@@ -317,29 +317,29 @@ def check_realizable(model, ctx):
 
 
 def _reciprocity_errors(model, ctx):
-    """``(geometry, scalar, mueller, note)``: per grid geometry the relative violations of
-    ``f = f_rev`` and ``M_rev = D M^T D`` (relative to the larger M00 of the two paths)."""
-    from validation.numerics.reciprocity import reversed_mueller
+    """``(geometry, errors, note)``: :func:`validation.numerics.reciprocity.reciprocity_errors`
+    on the grid, kept where both paths are finite (non-finite values are the finite check's
+    failure), with the geometries they belong to."""
+    from validation.numerics.reciprocity import reciprocity_errors
 
-    ti, tr, pr, M, _, _ = _grid(model, ctx)
-    rev = np.asarray(reversed_mueller(as_model(model), ti, tr, pr)).reshape(-1, 4, 4)
-    # non-finite values are the finite check's failure: judged here where both paths are finite
-    fin = np.all(np.isfinite(M), axis=(-1, -2)) & np.all(np.isfinite(rev), axis=(-1, -2))
-    ti, tr, pr, M, rev = ti[fin], tr[fin], pr[fin], M[fin], rev[fin]
-    scale = np.maximum(np.abs(M[:, 0, 0]), np.abs(rev[:, 0, 0]))
-    lit = scale > 0
-    den = np.where(lit, scale, 1.0)
-    scalar = np.where(lit, np.abs(M[:, 0, 0] - rev[:, 0, 0]) / den, 0.0)
-    full = np.where(lit, np.max(np.abs(rev - reciprocal_mueller(M)), axis=(-1, -2)) / den, 0.0)
-    note = f"{int(lit.sum())} lit geometries"
+    ti, tr, pr, M, J, _ = _grid(model, ctx)
+    e = reciprocity_errors(as_model(model), ti, tr, pr, mueller=M, jones=J)
+    fin = e.finite
+    note = f"{int(np.sum(e.live & fin))} lit geometries"
     if not fin.all():
         note += f" ({int(np.sum(~fin))} non-finite ones left to the finite check)"
-    return (ti, tr, pr), scalar, full, note
+    kept = {
+        "scalar": e.scalar[fin],
+        "mueller": e.mueller[fin],
+        "jones": None if J is None or e.jones is None else e.jones[fin],
+    }
+    return (ti[fin], tr[fin], pr[fin]), kept, note
 
 
 @model_check(
     tests="Helmholtz reciprocity: f(i -> r) = f(r -> i) and, for polarization, M_rev = D M^T D with "
-    "D = diag(1, 1, -1, 1) in the psps basis (validation.numerics.reciprocity)"
+    "D = diag(1, 1, -1, 1) in the psps basis, and J_rev = Z J^T Z with Z = diag(1, -1) for a "
+    "non-depolarizing model with jones (validation.numerics.reciprocity)"
 )
 def check_reciprocity(model, ctx):
     claim = claims(model, "reciprocal", True)
@@ -347,8 +347,8 @@ def check_reciprocity(model, ctx):
         return skipped("reciprocity", "the model does not claim reciprocity (reciprocal = False)")
     if _stochastic(model):
         return skipped("reciprocity", "stochastic: reciprocal only within its sampling error, not exactly")
-    geometry, scalar, full, note = _reciprocity_errors(model, ctx)
-    e, k = _worst(scalar)
+    geometry, errors, note = _reciprocity_errors(model, ctx)
+    e, k = _worst(errors["scalar"])
     out = [
         verdict(
             "reciprocity: M00",
@@ -358,13 +358,17 @@ def check_reciprocity(model, ctx):
             where=where(*geometry, k),
         )
     ]
-    if claim == "scalar":
-        why = "the model claims scalar reciprocity only (reciprocal = 'scalar')"
-        out.append(skipped("reciprocity: Mueller", why))
-    else:
-        e, k = _worst(full)
-        detail = f"max |M_rev - D M^T D| / M00 over {note}"
-        out.append(verdict("reciprocity: Mueller", e, RECIPROCITY_TOL, detail, where=where(*geometry, k)))
+    polarized = [("Mueller", "mueller", "max |M_rev - D M^T D| / M00")]
+    if errors["jones"] is not None:
+        polarized.append(("Jones", "jones", "max |J_rev - phase Z J^T Z| / sqrt(M00)"))
+    for name, key, what in polarized:
+        if claim == "scalar":
+            why = "the model claims scalar reciprocity only (reciprocal = 'scalar')"
+            out.append(skipped(f"reciprocity: {name}", why))
+        else:
+            e, k = _worst(errors[key])
+            detail = f"{what} over {note}"
+            out.append(verdict(f"reciprocity: {name}", e, RECIPROCITY_TOL, detail, where=where(*geometry, k)))
     return out
 
 
@@ -383,18 +387,15 @@ def _energy_bound(model):
 def _energy_reason(model, ti, r, bound):
     """The accepted finding (``(reason, condition)`` or ``None``) that explains the
     integrated reflectance ``r`` above ``bound`` at ``ti``, from the fields the stability
-    sweep gives its energy findings; the hit fraction (an integral) only when needed."""
-    from validation.numerics.energy import hit_fraction
-    from validation.studies.stability import _scalar_params  # the fields accepted conditions read
+    sweep gives its energy findings (:func:`validation.studies.stability.energy_fields`);
+    the hit fraction (an integral) only when needed."""
+    from validation.studies.stability import energy_fields, load_accepted, model_hit_fraction
 
-    fields = {"value": r.value, "theta_i": ti, "excess": r.value - r.error - bound}
-    if isinstance(model, Declared):
-        fields.update(_scalar_params(model))
-    found = accepted_reason(model, "energy", fields)
-    slopes = getattr(model, "slopes", None)
-    if found is None and isinstance(slopes, models.SlopeDistribution):
-        fields["hit_fraction"] = hit_fraction(slopes, ti, float(getattr(model, "coating", 1.0)))
-        found = accepted_reason(model, "energy", fields)
+    accepted = load_accepted()
+    fields = energy_fields(model, ti, r.value, r.error, bound, hit=False)
+    found = accepted_reason(model, "energy", fields, accepted)
+    if found is None and (h := model_hit_fraction(model, ti)) is not None:
+        found = accepted_reason(model, "energy", {**fields, "hit_fraction": h}, accepted)
     return found
 
 

@@ -22,12 +22,41 @@ import references
 from .common import random_geometries
 from .conformance import claims, model_check, skipped, verdict, where
 
-__all__ = ["SCATMECH_TOL", "committed_cases", "matching_cases", "normalized"]
+__all__ = [
+    "SCATMECH_TOL",
+    "SCATMECH_DEFAULT_TOL",
+    "SCATMECH_FLOOR",
+    "scatmech_tolerance",
+    "committed_cases",
+    "matching_cases",
+    "normalized",
+]
 
-#: max ``|M - M_scatmech| / M00``, as the registry's SCATMECH checks
-SCATMECH_TOL = 1e-6
-#: below this SCATMECH M00 a case is compared absolutely (as validation.checks.seed003)
-_FLOOR = 1e-250
+#: max ``|M - M_scatmech| / M00`` per SCATMECH model: one table for the registry's SCATMECH
+#: checks (:mod:`.seed000`, :mod:`.seed003`) and the kit's ``scatmech`` check
+SCATMECH_TOL = {
+    "Facet_BRDF_Model": 1e-6,
+    "Subsurface_Facet_BRDF_Model": 1e-6,
+    # SCATMECH tabulates the internal reflectance average R-bar (seed 003 Eq. 22) on a
+    # 0.2-deg grid; scatterbench integrates it exactly, and the diffuse values inherit the
+    # table's error through 1 / (1 - rho R-bar), largest at rho = 1 (seed003.check_scatmech_seed003
+    # prints the R-bar offset)
+    "Diffuse_Subsurface_BRDF_Model": 2e-3,
+    "First_Diffuse_BRDF_Model": 1e-6,
+    "Shadowed_Facet_BRDF_Model": 1e-6,
+}
+#: the limit for a SCATMECH model the table does not name
+SCATMECH_DEFAULT_TOL = 1e-6
+#: below this SCATMECH M00 a case is compared absolutely: the slope densities flush
+#: exp(-x) to an exact zero for x > 700 (models.slopes._exp_neg), SCATMECH keeps ~1e-300
+SCATMECH_FLOOR = 1e-250
+
+
+def scatmech_tolerance(name):
+    """The limit of ``max |M - M_scatmech| / M00`` against SCATMECH model ``name``."""
+    return SCATMECH_TOL.get(name, SCATMECH_DEFAULT_TOL)
+
+
 #: SCATMECH defaults of the parameters the committed files set explicitly
 _DEFAULTS = {"Facet_BRDF_Model": {"type": 0}}
 
@@ -181,8 +210,9 @@ def check_scatmech(model, ctx):
         return skipped("scatmech", why)
     ti, tr, pr, R = data
     M = np.asarray(model.mueller(ti, tr, pr)).reshape(-1, 4, 4)
-    e = np.max(np.abs(M - R), axis=(-1, -2)) / np.maximum(R[:, 0, 0], _FLOOR)
+    e = np.max(np.abs(M - R), axis=(-1, -2)) / np.maximum(R[:, 0, 0], SCATMECH_FLOOR)
     e = np.where(np.isfinite(e), e, math.inf)
     k = int(np.argmax(e))
     detail = f"max |M - M_scatmech| / M00 over {len(e)} geometries ({source}; {decl[0]})"
-    return verdict("scatmech", float(e[k]), SCATMECH_TOL, detail, where=where(ti, tr, pr, k))
+    tol = scatmech_tolerance(decl[0])
+    return verdict("scatmech", float(e[k]), tol, detail, where=where(ti, tr, pr, k))

@@ -25,6 +25,7 @@ from .common import (
     slope_conversion_errors,
     slope_normalization_errors,
 )
+from .conformance_scatmech import scatmech_tolerance
 from .registry import Finding, check, judge, text_section
 from .table1 import compute_table1, format_table1
 
@@ -116,10 +117,13 @@ def check_scatmech_facet(ctx):
         judge(
             f"SCATMECH: {label} Mueller, max |dM|/M00",
             float(e[key].max()),
-            1e-6,
+            scatmech_tolerance(scatmech),
             f"{len(e[key])} committed cases",
         )
-        for key, label in (("facet", "FacetBRDF"), ("subsurface", "SubsurfaceFacetBRDF"))
+        for key, label, scatmech in (
+            ("facet", "FacetBRDF", "Facet_BRDF_Model"),
+            ("subsurface", "SubsurfaceFacetBRDF", "Subsurface_Facet_BRDF_Model"),
+        )
     ]
 
 

@@ -14,6 +14,7 @@ import numpy as np
 import models
 import references
 from models.cook_torrance import fresnel_real_printed
+from models.geometry import refracted_cos
 from validation.numerics.integrate import integrated_reflectance
 from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 
@@ -22,6 +23,7 @@ from .common import random_geometries as _geoms
 from .registry import Finding, check, judge, text_section
 
 __all__ = [
+    "energy_published",
     "ct_vs_facet_error",
     "fresnel_real_error",
     "printed_fresnel_error",
@@ -35,7 +37,7 @@ IRON = 2.29 + 3.37j
 SUBSTRATES = (IRON, 1.37 + 7.62j, 1.5, 3.88 + 0.02j, math.inf)
 
 
-def _energy_published(model):
+def energy_published(model):
     """Energy normalization with Eq. 24's printed solid angle: the printed (``paper``) varnished
     model divided by the exact 4 pi (the model has no single convention for this pair)."""
     return (1.0 / (4.0 * math.pi)) * model
@@ -43,11 +45,10 @@ def _energy_published(model):
 
 def _jacobian(ti, tr, nv):
     """Refraction Jacobian ``n_v^2 cos Psi cos Theta / (cos psi cos theta)`` between Eq. 24's
-    denominator and the refraction-consistent one."""
-    ci, cr = np.cos(ti), np.cos(tr)
-    cI = np.sqrt(1 - (np.sin(ti) / nv) ** 2)
-    cR = np.sqrt(1 - (np.sin(tr) / nv) ** 2)
-    return nv * nv * cI * cR / (ci * cr)
+    denominator and the refraction-consistent one, in a varnish of (real) index ``nv``."""
+    cI = refracted_cos(np.sin(ti), 1.0, nv).real
+    cR = refracted_cos(np.sin(tr), 1.0, nv).real
+    return nv * nv * cI * cR / (np.cos(ti) * np.cos(tr))
 
 
 def _rel_where_both(a, b):
@@ -82,10 +83,11 @@ def published_over_energy_error(n=20000):
         (models.CookTorranceBRDF, {"slopes": models.GaussianSlopes(0.2)}),
         (models.VarnishedCookTorranceBRDF, {"slopes": models.StrokeSlopes(0.05, 0.4, 0.3)}),
     ):
+        corrected = cls(convention="corrected", **kw)
         a = cls(convention="paper", **kw).brdf(ti, tr, pr)
-        b = cls(convention="corrected", **kw).brdf(ti, tr, pr)
+        b = corrected.brdf(ti, tr, pr)
         if cls is models.VarnishedCookTorranceBRDF:
-            b = b * _jacobian(ti, tr, 1.5)
+            b = b * _jacobian(ti, tr, corrected.coating)
         live = b > 0
         worst = max(worst, float(np.max(np.abs(a[live] / b[live] / (4 * math.pi) - 1))))
     return worst
@@ -269,7 +271,7 @@ def varnish_albedos(tol=1e-4):
                 convention="paper" if sa == "published" else "corrected",
             )
             if sa == "published":
-                model = _energy_published(model)
+                model = energy_published(model)
             for ti in (0.0, 30.0, 60.0, 80.0, 89.0):
                 r = integrated_reflectance(model, math.radians(ti), tol=tol)
                 rs, rp = models.fresnel_reflectance(math.cos(math.radians(ti)), 1.0, 1.5)
@@ -352,7 +354,7 @@ def _pair(m=0.1, nv=1.5, sub=IRON, solid_angle="published"):
         shadowing="none",
     )
     if solid_angle == "published":
-        v = _energy_published(v)
+        v = energy_published(v)
     s = models.SubsurfaceFacetBRDF(slopes=models.GaussianSlopes(sigma=m), coating=nv, substrate=sub)
     return v, s
 
@@ -522,7 +524,7 @@ def anisotropy_text(ctx):
 
 # ------------------------------------------------------------------ extremes
 def extreme_seed001_models():
-    base = _energy_published(models.VarnishedCookTorranceBRDF())
+    base = energy_published(models.VarnishedCookTorranceBRDF())
     out = []
     for m in (1e-6, 0.03, 2.0):
         for sub in (IRON, 1.5, 1.0 + 0j, math.inf):
@@ -570,7 +572,7 @@ def check_extremes(ctx):
 # ------------------------------------------------------------------ point source
 def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_deg=17.0, resolution=8):
     """Max ``|f_g - f| / max f`` over an in-plane section, per source distance (R = 1)."""
-    base = _energy_published(models.VarnishedCookTorranceBRDF())
+    base = energy_published(models.VarnishedCookTorranceBRDF())
     tr = np.radians(np.linspace(0, 60, 241))
     ti = math.radians(ti_deg)
     f = base.brdf(ti, tr, 0.0)
@@ -586,7 +588,7 @@ def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_
 def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     """``{d: max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak}`` for the
     varnished iron plate, R = 1 (the reversed path from :mod:`validation.numerics.reciprocity`)."""
-    base = _energy_published(models.VarnishedCookTorranceBRDF())
+    base = energy_published(models.VarnishedCookTorranceBRDF())
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.4, (2, n))
     pr = rng.uniform(-0.3, 0.3, n)

@@ -38,7 +38,13 @@ import numpy as np
 
 from models.polarization import reciprocal_jones, reciprocal_mueller
 
-__all__ = ["ReciprocityResult", "reciprocity_error", "reversed_mueller"]
+__all__ = [
+    "ReciprocityErrors",
+    "ReciprocityResult",
+    "reciprocity_error",
+    "reciprocity_errors",
+    "reversed_mueller",
+]
 
 
 @dataclass(frozen=True)
@@ -74,33 +80,64 @@ def reversed_mueller(model, theta_i, theta_r, phi_r):
     return _reversed(model, ti, tr, pr, "mueller")
 
 
-def reciprocity_error(model, theta_i, theta_r, phi_r) -> ReciprocityResult:
-    """Check ``f(i -> r) = f(r -> i)``, ``M_rev = D M^T D`` and (non-depolarizing
-    models) ``J_rev = Z J^T Z`` at the given geometries.
+@dataclass(frozen=True)
+class ReciprocityErrors:
+    """Per-geometry relative reciprocity violations (flat arrays, one entry a geometry);
+    0 where both directions are dark, NaN where a non-finite value enters."""
 
-    Errors are relative to the BRDF at each geometry (``M00``) so they mean
-    the same across the dynamic range; geometries dark in both directions are
-    skipped.
+    scalar: np.ndarray  # |f - f_rev| / max(f, f_rev)
+    mueller: np.ndarray  # max element |M_rev - D M^T D| / M00
+    jones: np.ndarray | None  # max |J_rev - phase Z J^T Z| / sqrt(M00); None if depolarizing
+    live: np.ndarray  # light in at least one direction
+    finite: np.ndarray  # every matrix of both paths finite (Mueller, and Jones if any)
+
+
+def reciprocity_errors(model, theta_i, theta_r, phi_r, *, mueller=None, jones=None) -> ReciprocityErrors:
+    """The relative violations of ``f(i -> r) = f(r -> i)``, ``M_rev = D M^T D`` and (non-depolarizing
+    models) ``J_rev = Z J^T Z`` at each geometry, flattened.
+
+    Errors are relative to the larger BRDF of the two paths (``M00``) so they mean the same
+    across the dynamic range.  ``mueller`` and ``jones``: the forward matrices when the
+    caller already has them (evaluated here otherwise).
     """
     ti, tr, pr = np.broadcast_arrays(*(np.asarray(a, float) for a in (theta_i, theta_r, phi_r)))
-    fwd = model.mueller(ti, tr, pr)
-    rev = _reversed(model, ti, tr, pr, "mueller")
-    f1, f2 = fwd[..., 0, 0], rev[..., 0, 0]
+    fwd = np.asarray(model.mueller(ti, tr, pr) if mueller is None else mueller).reshape(-1, 4, 4)
+    rev = np.asarray(_reversed(model, ti, tr, pr, "mueller")).reshape(-1, 4, 4)
+    f1, f2 = fwd[:, 0, 0], rev[:, 0, 0]
     scale = np.maximum(np.abs(f1), np.abs(f2))
     live = scale > 0
-    if not np.any(live):
-        return ReciprocityResult(0.0, 0.0, None if model.depolarizing else 0.0, 0)
-    s = scale[live]
-    scalar = float(np.max(np.abs(f1 - f2)[live] / s))
-    mueller = float(np.max(np.max(np.abs(rev - reciprocal_mueller(fwd)), axis=(-1, -2))[live] / s))
-    jones = None
+    den = np.where(live, scale, 1.0)
+    scalar = np.where(live, np.abs(f1 - f2) / den, 0.0)
+    full = np.where(live, np.max(np.abs(rev - reciprocal_mueller(fwd)), axis=(-1, -2)) / den, 0.0)
+    finite = np.all(np.isfinite(fwd), axis=(-1, -2)) & np.all(np.isfinite(rev), axis=(-1, -2))
+    jerr = None
     if not model.depolarizing:
-        pred = reciprocal_jones(model.jones(ti, tr, pr)).reshape(-1, 4)[live.ravel()]
-        got = _reversed(model, ti, tr, pr, "jones").reshape(-1, 4)[live.ravel()]
+        J = model.jones(ti, tr, pr) if jones is None else jones
+        pred = reciprocal_jones(np.asarray(J).reshape(-1, 2, 2)).reshape(-1, 4)
+        got = np.asarray(_reversed(model, ti, tr, pr, "jones")).reshape(-1, 4)
         # Jones matrices are defined up to an overall phase: align it first.
         inner = np.sum(pred * np.conj(got), axis=1)
         mag = np.abs(inner)
         phase = np.where(mag > 0, inner / np.where(mag > 0, mag, 1.0), 1.0)
         diff = np.max(np.abs(pred - phase[:, None] * got), axis=1)
-        jones = float(np.max(diff / np.sqrt(s)))
-    return ReciprocityResult(scalar, mueller, jones, int(live.sum()))
+        jerr = np.where(live, diff / np.sqrt(den), 0.0)
+        finite &= np.all(np.isfinite(pred), axis=1) & np.all(np.isfinite(got), axis=1)
+    return ReciprocityErrors(scalar, full, jerr, live, finite)
+
+
+def reciprocity_error(model, theta_i, theta_r, phi_r) -> ReciprocityResult:
+    """Check ``f(i -> r) = f(r -> i)``, ``M_rev = D M^T D`` and (non-depolarizing
+    models) ``J_rev = Z J^T Z`` at the given geometries: the largest of
+    :func:`reciprocity_errors`.
+
+    Errors are relative to the BRDF at each geometry (``M00``) so they mean
+    the same across the dynamic range; geometries dark in both directions are
+    skipped.
+    """
+    e = reciprocity_errors(model, theta_i, theta_r, phi_r)
+    if not np.any(e.live):
+        return ReciprocityResult(0.0, 0.0, None if model.depolarizing else 0.0, 0)
+    jones = None if e.jones is None else float(np.max(e.jones[e.live]))
+    return ReciprocityResult(
+        float(np.max(e.scalar[e.live])), float(np.max(e.mueller[e.live])), jones, int(e.live.sum())
+    )

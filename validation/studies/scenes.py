@@ -25,8 +25,8 @@ __all__ = ["scan", "scene_csv", "write_scene_outputs"]
 
 def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
     """The in-plane curve and the out-of-plane scan of ``model`` (default the scene's),
-    evaluated at ``precision`` (``"float32"`` only through the model's precision option,
-    :func:`validation.studies.tradeoff.at_precision`).  Returns ``(model, rows)``."""
+    evaluated at ``precision`` (``"float32"`` only where a float32 kernel evaluates the
+    model, :func:`validation.studies.tradeoff.at_precision`).  Returns ``(model, rows)``."""
     from .tradeoff import at_precision
 
     model = scene.build() if model is None else model
@@ -54,13 +54,14 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
     return model, rows
 
 
-def _pick(knob, tol, notes):
-    """The cheapest measured setting of ``knob`` meeting ``tol`` (the most accurate when
-    none does, said so in ``notes``); ``None``, said so, when the knob cannot be measured."""
+def _pick(knob, tol, notes, **kw):
+    """The cheapest measured setting of ``knob`` (run with ``kw``) meeting ``tol`` (the most
+    accurate when none does, said so in ``notes``); ``None``, said so, when the knob cannot
+    be measured."""
     from .tradeoff import KNOBS, KnobUnavailable, choose
 
     try:
-        r = KNOBS[knob](quick=True)
+        r = KNOBS[knob](quick=True, **kw)
     except KnobUnavailable as exc:
         notes.append(f"{knob}: not measured ({exc})")
         return None
@@ -76,14 +77,14 @@ def _pick(knob, tol, notes):
 
 
 def _choose_precision(model, tol, notes):
-    """``"float32"`` when the model has a precision option and the measured float32 error
-    meets ``tol`` at a lower cost, else ``"float64"``."""
+    """``"float32"`` when a float32 kernel evaluates ``model`` and its float32 error,
+    measured on ``model`` itself, meets ``tol`` at a lower cost, else ``"float64"``."""
     from .tradeoff import precision_option
 
     if precision_option(model) is None:
-        notes.append(f"precision: float64 ({type(model).__name__} has no precision option)")
+        notes.append(f"precision: float64 ({type(model).__name__} has no float32 kernel)")
         return "float64"
-    bits = _pick("precision", tol, notes)
+    bits = _pick("precision", tol, notes, model=model)
     return "float32" if bits == 32 else "float64"
 
 
@@ -92,8 +93,9 @@ def choose_settings(scene, tol):
 
     Returns ``(model, n_inplane, precision, notes)``: the cheapest in-plane grid, Monte
     Carlo pair count, point-source resolution and evaluation precision whose *measured*
-    error meets ``tol`` (on the representative configurations of the tradeoff study),
-    or the most accurate measured setting, said so, when none does.
+    error meets ``tol`` (the first three on the representative configurations of the
+    tradeoff study, the precision on the scene's own model), or the most accurate
+    measured setting, said so, when none does.
     """
     import dataclasses
 

@@ -33,7 +33,6 @@ import math
 import os
 import threading
 import tomllib
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -270,12 +269,12 @@ def _label(ti, tr, pr):
 
 
 def _evaluate(model, ti, tr, pr, found, name, params):
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        with np.errstate(divide="warn", over="warn", invalid="warn", under="ignore"):
-            M = model.mueller(ti, tr, pr)
-            J = None if model.depolarizing else model.jones(ti, tr, pr)
-            M32 = model.mueller(ti.astype(np.float32), tr.astype(np.float32), pr.astype(np.float32))
+    from validation.checks.common import fp_warnings  # not at import: it loads every check
+
+    with fp_warnings() as caught:
+        M = model.mueller(ti, tr, pr)
+        J = None if model.depolarizing else model.jones(ti, tr, pr)
+        M32 = model.mueller(ti.astype(np.float32), tr.astype(np.float32), pr.astype(np.float32))
     for w in caught:
         found.append(Finding(name, params, "fp-warning", 1.0, str(w.message)))
     bad = ~np.all(np.isfinite(M), axis=(-1, -2))
@@ -326,6 +325,28 @@ def _scalar_params(model):
     return out
 
 
+def model_hit_fraction(model, theta_i):
+    """The hit fraction (:func:`validation.numerics.energy.hit_fraction`, an integral) of the
+    model's slope distribution under its coating at ``theta_i``; ``None`` without slopes."""
+    slopes = getattr(model, "slopes", None)
+    if not isinstance(slopes, models.SlopeDistribution):
+        return None
+    return hit_fraction(slopes, theta_i, float(getattr(model, "coating", 1.0)))
+
+
+def energy_fields(model, theta_i, value, error, bound=1.0, hit=True):
+    """The fields of an energy finding that accepted-finding conditions read: ``excess``
+    (``value`` above ``bound`` beyond its ``error``), ``value``, ``theta_i``, the model's
+    declared scalar parameters and (``hit``, when it has slopes) :func:`model_hit_fraction`."""
+    fields = {"excess": value - bound - error, "value": value, "theta_i": theta_i}
+    if isinstance(model, Declared):
+        fields.update(_scalar_params(model))
+    h = model_hit_fraction(model, theta_i) if hit else None
+    if h is not None:
+        fields["hit_fraction"] = h
+    return fields
+
+
 def _check_energy(model, found, name, params):
     # Wrappers that average their inner model with normalized weights (the point
     # source's sum_k w_k = 1) have an albedo that is a weighted mean of the inner
@@ -338,8 +359,6 @@ def _check_energy(model, found, name, params):
     # meaningless; its energy is tested against its standard error with the model.
     if _is_monte_carlo(model):
         return
-    slopes = getattr(model, "slopes", None)
-    coating = float(getattr(model, "coating", 1.0))
     for ti in (0.0, 1.0, math.radians(89.99)):
         with np.errstate(divide="ignore", over="ignore", invalid="ignore", under="ignore"):
             r = integrated_reflectance(model, ti, tol=1e-3, max_evaluations=2_000_000)
@@ -355,11 +374,8 @@ def _check_energy(model, found, name, params):
                 )
             )
             continue
-        excess = r.value - 1.0 - r.error
-        if excess > 0:
-            fields = {"excess": excess, "value": r.value, "theta_i": ti, **_scalar_params(model)}
-            if slopes is not None:
-                fields["hit_fraction"] = hit_fraction(slopes, ti, coating)
+        if r.value - 1.0 - r.error > 0:
+            fields = energy_fields(model, ti, r.value, r.error)
             found.append(
                 Finding(name, params, "energy", r.value, f"theta_i = {math.degrees(ti):.4g} deg", fields)
             )
@@ -448,12 +464,19 @@ def _matches(entry, f):
         return False
 
 
+def accepted_entry(finding, accepted=None):
+    """The first accepted entry (:func:`load_accepted`, or ``accepted``) that explains
+    ``finding``, else ``None``."""
+    accepted = load_accepted() if accepted is None else accepted
+    return next((e for e in accepted if _matches(e, finding)), None)
+
+
 def classify(findings, accepted=None):
     """Split findings into ``(accepted, unaccepted)``; accepted items carry their reason."""
     accepted = load_accepted() if accepted is None else accepted
     ok, bad = [], []
     for f in findings:
-        entry = next((e for e in accepted if _matches(e, f)), None)
+        entry = accepted_entry(f, accepted)
         (ok if entry else bad).append((f, entry["reason"] if entry else None))
     return ok, bad
 

@@ -11,9 +11,9 @@ an independent higher-accuracy reference (never an extrapolation):
 * ``in-plane grid``: an in-plane BRDF curve sampled on ``k`` points and linearly
   interpolated, against the model evaluated on a 20001-point grid (max relative
   error over the curve);
-* ``precision``: the Mueller matrix evaluated in float32 against float64, where the
-  model has a precision option (:func:`precision_option`); skipped, saying why, where
-  it has none;
+* ``precision``: the Mueller matrix evaluated in float32 against float64, where a
+  float32 kernel evaluates the model (:func:`precision_option`); skipped, saying why,
+  where none does;
 * knobs that other modules register with :func:`register_knob` (Monte Carlo
   pairs, point-source resolution, ...).
 
@@ -27,12 +27,13 @@ beside the best.
 
 ``pareto`` keeps the settings no other setting beats on both cost and error;
 ``choose(knob, tol)`` returns the cheapest setting whose *measured* error meets
-``tol`` (or says none does).
+``tol`` (or says none does).  Settings with the same error are a tie that CPU-time
+noise must not break: both keep the one with the fewest evaluations, then the coarser
+setting (listed first: every knob lists its settings coarser first).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import inspect
 import math
@@ -42,6 +43,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 import models
+from models import evaluation
 from models.geometry import signed_inplane
 from validation.numerics.energy import exposed_reflectance
 from validation.numerics.integrate import integrated_reflectance
@@ -80,7 +82,8 @@ class Point:
 
     ``seconds`` is the best CPU time per call over ``calls`` timed calls in batches
     (:func:`time_call`); ``spread`` is ``(median - best) / best`` over those batches;
-    ``wall_seconds`` the best wall-clock time per call (``nan``: not measured).
+    ``wall_seconds`` the best wall-clock time per call (``nan``: not measured);
+    ``cpu_total`` the CPU seconds of all the timed batches (``nan``: not measured).
     """
 
     setting: float
@@ -90,6 +93,7 @@ class Point:
     spread: float = 0.0
     calls: int = 1
     wall_seconds: float = math.nan
+    cpu_total: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -121,12 +125,14 @@ def register_knob(name):
 @dataclass(frozen=True)
 class Timing:
     """The cost of a call (:func:`time_call`): best CPU seconds per call, spread of the
-    batches, calls timed, best wall-clock seconds per call."""
+    batches, calls timed, best wall-clock seconds per call, CPU seconds of all the timed
+    batches."""
 
     seconds: float
     spread: float
     calls: int
     wall_seconds: float
+    cpu_total: float
 
 
 def time_call(fn, min_work=MIN_WORK, min_batches=MIN_BATCHES, batch=BATCH):
@@ -154,12 +160,14 @@ def time_call(fn, min_work=MIN_WORK, min_batches=MIN_BATCHES, batch=BATCH):
         wall.append((time.perf_counter() - t) / number)
     best = min(cpu)
     spread = float(np.median(cpu)) / best - 1.0 if best > 0 else 0.0
-    return out, Timing(best, spread, number * len(cpu), min(wall))
+    return out, Timing(best, spread, number * len(cpu), min(wall), sum(cpu) * number)
 
 
 def _point(setting, error, timing: Timing, evaluations):
     t = timing
-    return Point(setting, float(error), t.seconds, int(evaluations), t.spread, t.calls, t.wall_seconds)
+    return Point(
+        setting, float(error), t.seconds, int(evaluations), t.spread, t.calls, t.wall_seconds, t.cpu_total
+    )
 
 
 @register_knob("integration tolerance")
@@ -275,17 +283,21 @@ def knob_point_source(quick=False):
 
 
 def precision_option(model):
-    """How ``model`` takes an evaluation precision: ``"keyword"`` (its ``mueller``
-    accepts ``precision="float64"|"float32"``), ``"parameter"`` (a declared
-    ``precision`` parameter), or ``None`` (no option: the numpy reference path
-    promotes float32 inputs and evaluates in float64)."""
-    # a declared parameter first: every models.Model's mueller now takes the keyword too
-    declared = getattr(type(model), "parameters", lambda: [])()
-    if any(info.name == "precision" for info in declared):
-        return "parameter"
-    if "precision" in inspect.signature(model.mueller).parameters:
-        return "keyword"
-    return None
+    """``"keyword"`` when ``model`` really evaluates in float32 through its ``mueller``'s
+    ``precision="float32"`` keyword, else ``None``.
+
+    Every :class:`models.Model`'s ``mueller`` takes the keyword, but only a model a
+    compiled kernel evaluates (``_kernel_spec()`` not ``None``, numba backend) computes in
+    float32: the others (Monte Carlo, wrappers such as the point source) evaluate in
+    float64 and round, at the same cost.  An object that is not a :class:`models.Model`
+    is taken at its word when its ``mueller`` takes the keyword.
+    """
+    if "precision" not in inspect.signature(model.mueller).parameters:
+        return None
+    if isinstance(model, models.Model):
+        if model._kernel_spec() is None or evaluation.current_backend() != "numba":
+            return None
+    return "keyword"
 
 
 def at_precision(model, precision):
@@ -293,28 +305,25 @@ def at_precision(model, precision):
     through the model's own option; ``ValueError`` if it has none."""
     if precision not in ("float64", "float32"):
         raise ValueError(f"precision must be 'float64' or 'float32'; got {precision!r}")
-    kind = precision_option(model)
-    if kind == "keyword":
-        return functools.partial(model.mueller, precision=precision)
-    if kind == "parameter":
-        return dataclasses.replace(model, precision=precision).mueller
-    raise ValueError(f"precision: {type(model).__name__} has no precision option")
+    if precision_option(model) is None:
+        raise ValueError(f"precision: {type(model).__name__} has no float32 kernel")
+    return functools.partial(model.mueller, precision=precision)
 
 
 @register_knob("precision")
 def knob_precision(quick=False, model=None):
     """The Mueller matrix in float32 and float64 on 4096 random geometries, against the
     float64 evaluation (so the float64 point has error 0 by construction); ``model``
-    defaults to seed 000's coated flake model.  :class:`KnobUnavailable` when the model
-    has no precision option."""
+    defaults to seed 000's coated flake model.  :class:`KnobUnavailable` when no float32
+    kernel evaluates the model (:func:`precision_option`)."""
     if model is None:
         model = models.SubsurfaceFacetBRDF(
             slopes=models.ExponentialSlopes(0.1), coating=1.5, substrate=1.37 + 7.62j
         )
     if precision_option(model) is None:
         raise KnobUnavailable(
-            f"{type(model).__name__} has no precision option (float32 kernels not present); "
-            "its numpy path promotes float32 inputs to float64, so there is no float32 cost to measure"
+            f"{type(model).__name__} has no float32 kernel: it evaluates in float64 (and rounds a "
+            "float32 request), so there is no float32 cost to measure"
         )
     rng = np.random.default_rng(12)
     ti, tr = rng.uniform(0, math.radians(85), (2, 4096))
@@ -338,8 +347,21 @@ def knob_precision(quick=False, model=None):
     )
 
 
+def _untied(points):
+    """One point per distinct error, in the points' order: of those with the same error
+    the fewest evaluations, then the first listed (the coarser setting).  Equal error and
+    evaluations mean the same work (e.g. integration tolerances 1e-2..1e-4 stopping at
+    the same 15750 evaluations): their CPU times differ by noise only."""
+    best = {}
+    for i, p in enumerate(points):
+        if p.error not in best or p.evaluations < best[p.error][1].evaluations:
+            best[p.error] = (i, p)
+    return [p for _, p in sorted(best.values(), key=lambda t: t[0])]
+
+
 def pareto(points):
-    """Settings not dominated in (cost, error)."""
+    """Settings not dominated in (cost, error), ties in error broken as :func:`_untied`."""
+    points = _untied(points)
     keep = []
     for p in points:
         dominated = any(
@@ -352,8 +374,9 @@ def pareto(points):
 
 
 def choose(result: KnobResult, tol: float):
-    """Cheapest setting whose measured error is <= tol, or None."""
-    ok = [p for p in result.points if p.error <= tol]
+    """Cheapest setting whose measured error is <= tol, or None; ties in error broken
+    deterministically (fewest evaluations, then the coarser setting: :func:`_untied`)."""
+    ok = [p for p in _untied(result.points) if p.error <= tol]
     return min(ok, key=lambda p: p.seconds) if ok else None
 
 
