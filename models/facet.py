@@ -40,7 +40,7 @@ import numpy as np
 from . import kernel_specs
 from .base import Model
 from .fresnel import coating_transmission, reflection_rs_k
-from .params import param
+from .params import check_index, param
 from .polarization import mueller16_from_jones
 from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import ExponentialSlopes, SlopeDistribution
@@ -58,6 +58,13 @@ def substrate_rs_k(cos_i, n, substrate):
         return substrate.reflection_rs_k(cos_i, n)
     m = substrate if substrate == math.inf else complex(substrate) / n
     return reflection_rs_k(cos_i, m)
+
+
+def _index_or_stack(name, value):
+    """The ``check`` of a facet model's ``substrate`` (:func:`models.params.param`): a
+    :class:`models.FilmStack` (which validated itself when built) as it is, anything else
+    validated as an index (:func:`models.params.check_index`)."""
+    return value if isinstance(value, FilmStack) else check_index(name, value)
 
 
 def _polar(ti, tr, n):
@@ -159,16 +166,6 @@ def _jones_elements(rs, K, root, h_dots, d, cos_ext, n):
 class _FacetModel(Model):
     """Shared evaluation of the exposed and the coated facet models."""
 
-    def __post_init__(self):
-        # A FilmStack validates itself; the declared index check applies to plain
-        # indices, so a stack stands aside (its bottom medium in its place) meanwhile.
-        stack = self.substrate if isinstance(self.substrate, FilmStack) else None
-        if stack is not None:
-            object.__setattr__(self, "substrate", stack.indices[1])
-        super().__post_init__()
-        if stack is not None:
-            object.__setattr__(self, "substrate", stack)
-
     def _coating(self) -> float:
         return 1.0
 
@@ -267,5 +264,10 @@ class FacetBRDF(_FacetModel):
     """
 
     slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
-    substrate: complex = param(1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor)", kind="index")
+    substrate: complex = param(
+        1.37 + 7.62j,
+        "substrate index n + ik (inf: perfect conductor) or a models.FilmStack",
+        kind="index",
+        check=_index_or_stack,
+    )
     shadowing: str = param("none", "shadowing-masking", kind="choice", choices=SHADOWING)

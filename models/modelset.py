@@ -44,14 +44,17 @@ def _declared_fields(obj):
 
 
 def _walk(obj, path, visit):
-    """Call ``visit(path, value, kind)`` for every declared real/index value under ``obj``."""
+    """Call ``visit(path, value, kind)`` for every declared real/index value under ``obj``.
+
+    A declared object where a value goes (a :class:`models.FilmStack` as a substrate
+    index) is walked into, like an ``object`` field."""
     if isinstance(obj, Declared) and dataclasses.is_dataclass(obj):
         for f in _declared_fields(obj):
             kind = f.metadata["scatterbench"]["kind"]
             value = getattr(obj, f.name)
-            if kind in ARRAY_KINDS:
+            if kind in ARRAY_KINDS and not isinstance(value, Declared):
                 visit(path + (f.name,), value, kind)
-            elif kind == "object":
+            elif kind == "object" or isinstance(value, Declared):
                 _walk(value, path + (f.name,), visit)
     elif isinstance(obj, tuple):
         for i, item in enumerate(obj):
