@@ -45,7 +45,7 @@ import numpy as np
 from . import kernel_specs
 from .base import Model
 from .fresnel import fresnel_reflectance
-from .params import Alias, check_real, choice_alias, convention_param, param
+from .params import SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN, Alias, check_real, choice_alias, convention_param, param
 from .shadowing import smith_g
 from .slopes import AnisotropicGaussianSlopes, GaussianSlopes
 from .stroke_slopes import StrokeSlopes, stroke_d
@@ -207,9 +207,16 @@ def smith_slopes(slopes):
     return GaussianSlopes(sigma=slopes.sigma)
 
 
+def _check_m(value) -> float:
+    """The old ``m=`` keyword (Eq. 8's rms slope), validated in the range of the slope width
+    it sets (``GaussianSlopes.sigma``, ``StrokeSlopes.m_parallel``/``m_perpendicular``:
+    :func:`models.params.width_param`) and named ``m``, the keyword the user gave."""
+    return check_real("m", value, SLOPE_WIDTH_MIN, SLOPE_WIDTH_MAX)
+
+
 def _slopes_from_m(given, current):
     """The old ``m=`` keyword: Eq. 8's rms slope, ``GaussianSlopes(sigma=m)``."""
-    return GaussianSlopes(sigma=check_real("m", given["m"], 0.0, low_open=True))
+    return GaussianSlopes(sigma=_check_m(given["m"]))
 
 
 class _CookTorranceBase(Model):
