@@ -235,23 +235,19 @@ class _CookTorranceBase(Model):
                 f"with coverage 1; got {s!r}"
             )
 
+    def _m_rows(self):
+        """``[m_parallel, m_perpendicular, stroke_angle]`` of the slopes (``[m, m, 0]`` for
+        ``GaussianSlopes(sigma=m)``): :func:`models.kernel_specs.slope_rows` without coverage."""
+        return kernel_specs.slope_rows(self.slopes)[1][:3]
+
     def _d_fn(self):
-        s = self.slopes
-        if isinstance(s, GaussianSlopes):
-            return stroke_d(s.sigma, s.sigma, 0.0)
-        return stroke_d(s.m_parallel, s.m_perpendicular, s.stroke_angle)
+        return stroke_d(*self._m_rows())
 
     def _cook_spec(self, variant, coating):
         """The Cook-Torrance kernel; numpy for Smith shadowing (the kernel has Blinn's G or none)."""
         if self.shadowing == "smith":
             return None
-        s = self.slopes
-        m = (
-            [s.sigma, s.sigma, 0.0]
-            if isinstance(s, GaussianSlopes)
-            else [s.m_parallel, s.m_perpendicular, s.stroke_angle]
-        )
-        rows = [coating, *kernel_specs.index_rows(self.substrate), *m]
+        rows = [coating, *kernel_specs.index_rows(self.substrate), *self._m_rows()]
         return "cook", rows, (variant, int(self.convention == "corrected"), int(self.shadowing == "blinn"))
 
     def _smith(self):
