@@ -134,18 +134,18 @@ class Compiled:
         self.call(ti, tr, pr, out, 0)
         return out
 
-    def fill(self, plan, out, rows, precision):
-        """The whole evaluation of ``plan`` (a single model) into ``out``, chunk by chunk."""
+    def write(self, out, sl, ti, tr, pr, precision):
+        """One chunk of flat float64 angles (length 1 or the chunk's) into ``out[:, sl]``, in
+        ``precision`` (the float32 kernels for ``"float32"``): in place in a C-contiguous
+        ndarray, otherwise (e.g. a memmap) through a chunk-sized buffer."""
         dtype = np.dtype(precision)
-        direct = type(out) is np.ndarray and out.flags.c_contiguous
-        for sl, ti, tr, pr, _ in plan.blocks(fill=False):
-            a, b, c = (x.astype(dtype, copy=False) for x in (ti, tr, pr))
-            if direct:
-                self.call(a, b, c, out, sl.start, precision)
-            else:  # e.g. a memmap: through a chunk-sized buffer
-                buf = np.empty((rows, sl.stop - sl.start), dtype=dtype)
-                self.call(a, b, c, buf, 0, precision)
-                out[:, sl] = buf
+        a, b, c = (x.astype(dtype, copy=False) for x in (ti, tr, pr))
+        if type(out) is np.ndarray and out.flags.c_contiguous:
+            self.call(a, b, c, out, sl.start, precision)
+        else:
+            buf = np.empty((out.shape[0], sl.stop - sl.start), dtype=dtype)
+            self.call(a, b, c, buf, 0, precision)
+            out[:, sl] = buf
 
     def fast(self, theta_i, theta_r, phi_r, rows):
         """The small-call path: floats, or C-contiguous float64 arrays of one shape (or
