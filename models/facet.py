@@ -46,7 +46,7 @@ from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import ExponentialSlopes, SlopeDistribution
 from .thin_film import FilmStack
 
-__all__ = ["FacetBRDF", "facet_jones", "substrate_rs_k"]
+__all__ = ["FacetBRDF", "facet_jones", "local_cosine", "substrate_rs_k"]
 
 
 def substrate_rs_k(cos_i, n, substrate):
@@ -85,6 +85,22 @@ def _polar(ti, tr, n):
     return cos_ext, sin_int, cos_int
 
 
+def _bisector(sin_int, cos_int, cp, sp):
+    """``(hx, hy, hz)`` of ``h = k_r' - k_i'``, which bisects the internal directions: the
+    facet normal is ``h / |h|`` and ``|h| = 2 cos(alpha)`` (Eq. 5-7)."""
+    si, sr = sin_int
+    ci, cr = cos_int
+    return sr * cp - si, sr * sp, cr + ci
+
+
+def local_cosine(ti, tr, pr, n):
+    """``cos(alpha)``: the local incidence, in a coating of index ``n``, on the facet that
+    reflects ``ti`` into ``(tr, pr)`` (``|h| / 2``, Eq. 5), as :func:`facet_jones` takes it."""
+    _, sin_int, cos_int = _polar(ti, tr, n)
+    hx, hy, hz = _bisector(sin_int, cos_int, np.cos(pr), np.sin(pr))
+    return 0.5 * np.sqrt(hx * hx + hy * hy + hz * hz)
+
+
 def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     """Jones elements ``(ss, ps, sp, pp)`` as ``(re, im)`` pairs of flat arrays
     (``ps`` = p in, s out), scaled so that their Mueller matrix is the BRDF.
@@ -100,10 +116,7 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     sp, cp = np.sin(pr), np.cos(pr)
     si, sr = sin_int
     ci, cr = cos_int
-    # h = k_r' - k_i' bisects the internal directions: facet normal h/|h| (Eq. 5-7).
-    hx = sr * cp - si
-    hy = sr * sp
-    hz = cr + ci
+    hx, hy, hz = _bisector(sin_int, cos_int, cp, sp)
     g = hx * hx + hy * hy + hz * hz  # |h|^2 = 4 cos^2(alpha), Eq. 5
     inv_hz = 1.0 / hz
     p3 = slopes.p3(hx * inv_hz, hy * inv_hz)
