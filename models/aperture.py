@@ -77,10 +77,8 @@ class DetectorAperture(_Wrapper):
     @cached_property
     def _nodes(self):
         """Unit offsets ``(a, b)`` along the nominal ``(p_r, s_r)`` axes, ``cos u`` and area weights."""
-        x, y, w = disc_quadrature(self.resolution, 2.0 * math.sin(0.25 * self.aperture))
-        if not w.sum() > 0:
-            # the cone's area (~aperture^2) underflowed; only the weights' ratios matter
-            w = disc_quadrature(self.resolution, 1.0)[2]
+        # only the weights' ratios matter (the cone's area ~aperture^2 underflows)
+        x, y, w = disc_quadrature(self.resolution, 2.0 * math.sin(0.25 * self.aperture), unit_weights=True)
         r = np.hypot(x, y)
         cos_u = 1.0 - 0.5 * r * r  # r = 2 sin(u/2)
         sin_u = r * np.sqrt(np.maximum(1.0 - 0.25 * r * r, 0.0))  # sin u = 2 sin(u/2) cos(u/2)

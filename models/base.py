@@ -204,14 +204,13 @@ class Model(Declared):
         return out.reshape(plan.shape)
 
     def _fill(self, plan, out, rows, precision):
-        kernel = None if plan.leaves else self._compiled()
-        if kernel is not None and plan.n > 0:
-            kernel.fill(plan, out, rows, precision)  # the kernel loops over the chunks itself
-            return
-        for sl, ti, tr, pr, m in plan.blocks():
-            k = m._compiled() if out.dtype == np.float64 and type(out) is np.ndarray else None
-            if k is not None:  # a model set's chunk: the kernel writes in place
-                k.call(ti, tr, pr, out, sl.start)
+        """Evaluate ``plan`` into ``out`` chunk by chunk: the kernel where one covers the model
+        (a model set's chunk is a model with flat parameters, with its own kernel rows),
+        otherwise the numpy implementation (rounded to ``out``'s dtype)."""
+        kernel = self._has_kernel and evaluation.current_backend() == "numba"
+        for sl, ti, tr, pr, m in plan.blocks(fill=not kernel):
+            if kernel:
+                m._kernel.write(out, sl, ti, tr, pr, precision)
             else:
                 out[:, sl] = m._m16(ti, tr, pr) if rows == 16 else m._m00(ti, tr, pr)
 

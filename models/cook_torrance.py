@@ -45,7 +45,7 @@ import numpy as np
 from . import kernel_specs
 from .base import Model
 from .fresnel import fresnel_reflectance
-from .params import Alias, check_real, choice_alias, convention_param, param
+from .params import SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN, Alias, check_real, choice_alias, convention_param, param
 from .shadowing import smith_g
 from .slopes import AnisotropicGaussianSlopes, GaussianSlopes
 from .stroke_slopes import StrokeSlopes, stroke_d
@@ -207,9 +207,16 @@ def smith_slopes(slopes):
     return GaussianSlopes(sigma=slopes.sigma)
 
 
+def _check_m(value) -> float:
+    """The old ``m=`` keyword (Eq. 8's rms slope), validated in the range of the slope width
+    it sets (``GaussianSlopes.sigma``, ``StrokeSlopes.m_parallel``/``m_perpendicular``:
+    :func:`models.params.width_param`) and named ``m``, the keyword the user gave."""
+    return check_real("m", value, SLOPE_WIDTH_MIN, SLOPE_WIDTH_MAX)
+
+
 def _slopes_from_m(given, current):
     """The old ``m=`` keyword: Eq. 8's rms slope, ``GaussianSlopes(sigma=m)``."""
-    return GaussianSlopes(sigma=check_real("m", given["m"], 0.0, low_open=True))
+    return GaussianSlopes(sigma=_check_m(given["m"]))
 
 
 class _CookTorranceBase(Model):
@@ -228,23 +235,19 @@ class _CookTorranceBase(Model):
                 f"with coverage 1; got {s!r}"
             )
 
+    def _m_rows(self):
+        """``[m_parallel, m_perpendicular, stroke_angle]`` of the slopes (``[m, m, 0]`` for
+        ``GaussianSlopes(sigma=m)``): :func:`models.kernel_specs.slope_rows` without coverage."""
+        return kernel_specs.slope_rows(self.slopes)[1][:3]
+
     def _d_fn(self):
-        s = self.slopes
-        if isinstance(s, GaussianSlopes):
-            return stroke_d(s.sigma, s.sigma, 0.0)
-        return stroke_d(s.m_parallel, s.m_perpendicular, s.stroke_angle)
+        return stroke_d(*self._m_rows())
 
     def _cook_spec(self, variant, coating):
         """The Cook-Torrance kernel; numpy for Smith shadowing (the kernel has Blinn's G or none)."""
         if self.shadowing == "smith":
             return None
-        s = self.slopes
-        m = (
-            [s.sigma, s.sigma, 0.0]
-            if isinstance(s, GaussianSlopes)
-            else [s.m_parallel, s.m_perpendicular, s.stroke_angle]
-        )
-        rows = [coating, *kernel_specs.index_rows(self.substrate), *m]
+        rows = [coating, *kernel_specs.index_rows(self.substrate), *self._m_rows()]
         return "cook", rows, (variant, int(self.convention == "corrected"), int(self.shadowing == "blinn"))
 
     def _smith(self):

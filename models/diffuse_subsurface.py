@@ -59,24 +59,24 @@ class DiffuseSubsurfaceBRDF(Model):
     aliases = {"n": "coating"}
 
     @cached_property
-    def rbar(self) -> float:
-        """Internal hemispherical reflectance ``R-bar`` (Eq. 22 with 1/pi)."""
-        return internal_hemispherical_reflectance(self.coating)
+    def rbar(self):
+        """Internal hemispherical reflectance ``R-bar`` (Eq. 22 with 1/pi): a float, or an
+        array like ``coating`` in a model set (the quadrature runs once per distinct index
+        and is cached, :func:`models.smooth_interface.internal_hemispherical_reflectance`)."""
+        n = self.coating
+        if isinstance(n, np.ndarray):
+            values, inverse = np.unique(n, return_inverse=True)
+            rbar = np.array([internal_hemispherical_reflectance(v) for v in values])
+            return rbar[inverse.reshape(n.shape)]
+        return internal_hemispherical_reflectance(n)
 
     @cached_property
-    def _scale(self) -> float:
+    def _scale(self):
+        """``(rho / pi) / (1 - rho R-bar)`` (Eq. 27's prefactor; arrays in a model set)."""
         return (self.rho / math.pi) / (1.0 - self.rho * self.rbar)
 
     def _kernel_spec(self):
-        n = self.coating
-        if isinstance(n, np.ndarray):  # R-bar is a quadrature: once per distinct index
-            values, inverse = np.unique(n, return_inverse=True)
-            rbar = np.array([internal_hemispherical_reflectance(float(v)) for v in values])[
-                inverse.reshape(n.shape)
-            ]
-        else:
-            rbar = self.rbar
-        return "diffuse", [n, (self.rho / math.pi) / (1.0 - self.rho * rbar)], (0, 0, 0)
+        return "diffuse", [self.coating, self._scale], (0, 0, 0)
 
     def _amps(self, ti, tr):
         """Interface amplitudes ``(a_s, a_p)``, rows incidence then scattering."""

@@ -40,13 +40,13 @@ import numpy as np
 from . import kernel_specs
 from .base import Model
 from .fresnel import coating_transmission, reflection_rs_k
-from .params import param
+from .params import check_index, param
 from .polarization import mueller16_from_jones
 from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import ExponentialSlopes, SlopeDistribution
 from .thin_film import FilmStack
 
-__all__ = ["FacetBRDF", "facet_jones", "substrate_rs_k"]
+__all__ = ["FacetBRDF", "facet_jones", "local_cosine", "substrate_rs_k"]
 
 
 def substrate_rs_k(cos_i, n, substrate):
@@ -58,6 +58,13 @@ def substrate_rs_k(cos_i, n, substrate):
         return substrate.reflection_rs_k(cos_i, n)
     m = substrate if substrate == math.inf else complex(substrate) / n
     return reflection_rs_k(cos_i, m)
+
+
+def _index_or_stack(name, value):
+    """The ``check`` of a facet model's ``substrate`` (:func:`models.params.param`): a
+    :class:`models.FilmStack` (which validated itself when built) as it is, anything else
+    validated as an index (:func:`models.params.check_index`)."""
+    return value if isinstance(value, FilmStack) else check_index(name, value)
 
 
 def _polar(ti, tr, n):
@@ -78,6 +85,22 @@ def _polar(ti, tr, n):
     return cos_ext, sin_int, cos_int
 
 
+def _bisector(sin_int, cos_int, cp, sp):
+    """``(hx, hy, hz)`` of ``h = k_r' - k_i'``, which bisects the internal directions: the
+    facet normal is ``h / |h|`` and ``|h| = 2 cos(alpha)`` (Eq. 5-7)."""
+    si, sr = sin_int
+    ci, cr = cos_int
+    return sr * cp - si, sr * sp, cr + ci
+
+
+def local_cosine(ti, tr, pr, n):
+    """``cos(alpha)``: the local incidence, in a coating of index ``n``, on the facet that
+    reflects ``ti`` into ``(tr, pr)`` (``|h| / 2``, Eq. 5), as :func:`facet_jones` takes it."""
+    _, sin_int, cos_int = _polar(ti, tr, n)
+    hx, hy, hz = _bisector(sin_int, cos_int, np.cos(pr), np.sin(pr))
+    return 0.5 * np.sqrt(hx * hx + hy * hy + hz * hz)
+
+
 def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     """Jones elements ``(ss, ps, sp, pp)`` as ``(re, im)`` pairs of flat arrays
     (``ps`` = p in, s out), scaled so that their Mueller matrix is the BRDF.
@@ -93,10 +116,7 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     sp, cp = np.sin(pr), np.cos(pr)
     si, sr = sin_int
     ci, cr = cos_int
-    # h = k_r' - k_i' bisects the internal directions: facet normal h/|h| (Eq. 5-7).
-    hx = sr * cp - si
-    hy = sr * sp
-    hz = cr + ci
+    hx, hy, hz = _bisector(sin_int, cos_int, cp, sp)
     g = hx * hx + hy * hy + hz * hz  # |h|^2 = 4 cos^2(alpha), Eq. 5
     inv_hz = 1.0 / hz
     p3 = slopes.p3(hx * inv_hz, hy * inv_hz)
@@ -158,16 +178,6 @@ def _jones_elements(rs, K, root, h_dots, d, cos_ext, n):
 
 class _FacetModel(Model):
     """Shared evaluation of the exposed and the coated facet models."""
-
-    def __post_init__(self):
-        # A FilmStack validates itself; the declared index check applies to plain
-        # indices, so a stack stands aside (its bottom medium in its place) meanwhile.
-        stack = self.substrate if isinstance(self.substrate, FilmStack) else None
-        if stack is not None:
-            object.__setattr__(self, "substrate", stack.indices[1])
-        super().__post_init__()
-        if stack is not None:
-            object.__setattr__(self, "substrate", stack)
 
     def _coating(self) -> float:
         return 1.0
@@ -267,5 +277,10 @@ class FacetBRDF(_FacetModel):
     """
 
     slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
-    substrate: complex = param(1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor)", kind="index")
+    substrate: complex = param(
+        1.37 + 7.62j,
+        "substrate index n + ik (inf: perfect conductor) or a models.FilmStack",
+        kind="index",
+        check=_index_or_stack,
+    )
     shadowing: str = param("none", "shadowing-masking", kind="choice", choices=SHADOWING)

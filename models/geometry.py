@@ -109,16 +109,20 @@ def broadcast_angles(*arrays):
     return shape, [np.ascontiguousarray(x).reshape(-1) for x in b]
 
 
-def disc_quadrature(n, radius):
+def disc_quadrature(n, radius, unit_weights=False):
     """Nodes ``(x, y)`` and weights ``w`` integrating over a disc of ``radius``
     (``sum w f(x, y) ~ integral f dA``): Gauss-Legendre in the radius (``n`` nodes,
     weight ``r dr``) times the periodic trapezoid rule in the azimuth (``2 n``
     nodes), exact for polynomials of degree ``2n - 1`` in ``r`` times trigonometric
     polynomials of degree ``2n - 1``.  Shared by the point source (a disc sample)
-    and the detector aperture (a cone of directions in equal-area coordinates)."""
+    and the detector aperture (a cone of directions in equal-area coordinates).
+
+    ``unit_weights=True``: the weights of the unit disc (``radius^2`` times them are the
+    disc's), for callers that use only their ratios: they never leave the float64 range,
+    however large or small ``radius`` is."""
     x, w = np.polynomial.legendre.leggauss(n)
     r = 0.5 * radius * (x + 1.0)
-    wr = 0.5 * radius * w * r  # r dr
+    wr = 0.5 * w * (0.5 * (x + 1.0)) if unit_weights else 0.5 * radius * w * r  # r dr
     chi = (np.arange(2 * n) + 0.5) * (np.pi / n)
     px = (r[:, None] * np.cos(chi)[None, :]).ravel()
     py = (r[:, None] * np.sin(chi)[None, :]).ravel()

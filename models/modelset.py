@@ -28,10 +28,8 @@ from .params import Declared
 __all__ = [
     "array_leaves",
     "scalar_leaves",
-    "param_shape",
     "with_leaves",
     "rebuilt",
-    "map_leaves",
     "element",
 ]
 
@@ -44,14 +42,17 @@ def _declared_fields(obj):
 
 
 def _walk(obj, path, visit):
-    """Call ``visit(path, value, kind)`` for every declared real/index value under ``obj``."""
+    """Call ``visit(path, value, kind)`` for every declared real/index value under ``obj``.
+
+    A declared object where a value goes (a :class:`models.FilmStack` as a substrate
+    index) is walked into, like an ``object`` field."""
     if isinstance(obj, Declared) and dataclasses.is_dataclass(obj):
         for f in _declared_fields(obj):
             kind = f.metadata["scatterbench"]["kind"]
             value = getattr(obj, f.name)
-            if kind in ARRAY_KINDS:
+            if kind in ARRAY_KINDS and not isinstance(value, Declared):
                 visit(path + (f.name,), value, kind)
-            elif kind == "object":
+            elif kind == "object" or isinstance(value, Declared):
                 _walk(value, path + (f.name,), visit)
     elif isinstance(obj, tuple):
         for i, item in enumerate(obj):
@@ -84,11 +85,6 @@ def check_broadcast(leaves: dict) -> tuple:
     except ValueError:
         shapes = ", ".join(f"{path_text(p)} {a.shape}" for p, a in leaves.items())
         raise ValueError(f"array parameters must broadcast to one parameter shape; got {shapes}") from None
-
-
-def param_shape(obj) -> tuple:
-    """The broadcast shape of the array parameters under ``obj`` (``()``: a single model)."""
-    return np.broadcast_shapes(*(a.shape for a in array_leaves(obj).values()))
 
 
 @functools.cache
@@ -147,12 +143,6 @@ def rebuilt(obj, leaves: dict):
     if isinstance(obj, tuple):
         return _copy_with(obj, changes)
     return obj.replace(**changes)
-
-
-def map_leaves(obj, fn, leaves=None):
-    """``obj`` with every array parameter ``a`` replaced by ``fn(a)`` (trusted)."""
-    leaves = array_leaves(obj) if leaves is None else leaves
-    return with_leaves(obj, {p: fn(a) for p, a in leaves.items()})
 
 
 def scalar_value(value):

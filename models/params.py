@@ -83,7 +83,9 @@ class ParamInfo:
     high_open: bool = False
     aliases: tuple = ()  # old keyword names that still set this parameter
     required: bool = False  # no default: must be given
-    check: Any = field(default=None, repr=False, compare=False)  # validator of an ``object`` parameter
+    check: Any = field(
+        default=None, repr=False, compare=False
+    )  # validator replacing the kind's check (see param)
 
     def range_text(self) -> str:
         if self.kind == "index":
@@ -122,8 +124,9 @@ def param(
     ``default`` may be ``dataclasses.MISSING``: the parameter is then required.
     ``kind`` is one of ``real``, ``int``, ``index`` (complex refractive index,
     ``k >= 0``, ``math.inf`` allowed), ``real_index`` (non-absorbing index
-    ``>= low``), ``choice`` (``choices``), ``object`` (checked by ``check(name, value)``,
-    which returns the value or raises ``ValueError``, or by the model's ``_validate``).
+    ``>= low``), ``choice`` (``choices``), ``object`` (checked by the model's ``_validate``).
+    ``check(name, value)``, when given, replaces the kind's check: it returns the value or
+    raises ``ValueError`` (e.g. an ``index`` that may also be a layer stack).
     """
     info = dict(
         doc=doc,
@@ -462,7 +465,11 @@ class Declared(metaclass=_DeclaredMeta):
 
 
 def _checked(name, value, info):
-    """``value`` validated against a declared parameter's kind and range."""
+    """``value`` validated against a declared parameter's kind and range: by its ``check``
+    when it has one (which may accept more than the kind, e.g. a layer stack where an index
+    goes, and calls the kind's check itself), else by the kind."""
+    if info.get("check") is not None:
+        return info["check"](name, value)
     kind = info["kind"]
     if kind == "real":
         return check_real(name, value, info["low"], info["high"], info["low_open"], info["high_open"])
@@ -491,6 +498,4 @@ def _checked(name, value, info):
             allowed = ", ".join(repr(c) for c in choices)
             raise ValueError(f"{name} must be one of {allowed}; got {value!r}")
         return bool(value) if flags else value
-    if info.get("check") is not None:
-        return info["check"](name, value)
     return value

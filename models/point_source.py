@@ -125,14 +125,15 @@ class PointSourceBRDF(_Wrapper):
 
     # -- source geometry ------------------------------------------------------------
     def _disc_nodes(self):
-        return disc_quadrature(self.resolution, self.sample_radius)
+        """The disc's quadrature nodes and the unit disc's weights: only their ratios matter
+        (``R^2`` leaves the float64 range for an extreme ``sample_radius``)."""
+        return disc_quadrature(self.resolution, self.sample_radius, unit_weights=True)
 
     def source_nodes(self, theta_i):
         """``(psi, Phi, w)``, each ``(n_geom, K)``: incidence polar angle and
         azimuth at each quadrature point of the disc and normalized weights."""
         ti = np.atleast_1d(np.asarray(theta_i, dtype=float))
-        with np.errstate(over="ignore"):  # R^2 overflowing: rescaled below
-            px, py, wa = self._disc_nodes()
+        px, py, wa = self._disc_nodes()
         d = self.distance
         X = px[None, :] + (d * np.tan(np.minimum(ti, 0.5 * math.pi - 1e-12)))[:, None]
         Y = np.broadcast_to(py[None, :], X.shape)
@@ -141,19 +142,8 @@ class PointSourceBRDF(_Wrapper):
         Phi = np.arctan2(Y, X)
         c = np.cos(psi)
         w = wa[None, :] * c * c * c  # irradiance cos^3(psi) / d^2 times dA
-        total = w.sum(axis=1, keepdims=True)
-        if not np.all(np.isfinite(total) & (total > 0)):
-            w = self._rescaled_weights(rho, d)
         w /= w.sum(axis=1, keepdims=True)
         return psi, Phi, w
-
-    def _rescaled_weights(self, rho, d):
-        """The weights ``dA cos^3(psi)`` up to a factor per row, for a disc whose area (R^2)
-        or cosine falloff (d / rho) leaves the float64 range: only their ratios matter."""
-        wa = disc_quadrature(self.resolution, 1.0)[2]
-        c = d / np.hypot(rho, d)
-        c = c / c.max(axis=1, keepdims=True)
-        return wa[None, :] * c * c * c
 
     def incidence_range(self, theta_i):
         """``(psi_min, psi_max)`` of the incidence over the sample (radians)."""

@@ -40,8 +40,6 @@ import numpy as np
 from scipy import integrate, special
 
 from .slopes import (
-    AnisotropicGaussianSlopes,
-    AnisotropicGGXSlopes,
     GaussianSlopes,
     GGXSlopes,
     SlopeDistribution,
@@ -207,9 +205,7 @@ def smith_lambda(slopes, cos_theta, sin_theta, cos_phi, sin_phi):
     cl = cos_phi * cr + sin_phi * sr
     sl = sin_phi * cr - cos_phi * sr
     alpha = np.sqrt((ax * cl) ** 2 + (ay * sl) ** 2)
-    if isinstance(slopes, (AnisotropicGaussianSlopes, AnisotropicGGXSlopes)):
-        return _isotropic_lambda(unit, mu / alpha)
-    return _table(unit)(mu / alpha)
+    return _isotropic_lambda(unit, mu / alpha)
 
 
 def smith_g1(slopes, cos_theta, sin_theta, cos_phi, sin_phi, cos_local=None):

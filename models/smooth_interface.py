@@ -17,6 +17,7 @@ ray leaving at ``theta`` (seed 003 Eq. 11, 25).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -79,9 +80,14 @@ def internal_hemispherical_reflectance(n: float) -> float:
     ``1 - 1/n^2``), and below it the internal reflectance equals the external
     one at the refracted angle (Stokes relations), so with the external cosine
     ``c``: ``R-bar = 1 - (1 - int_0^1 R_ext(c) 2c dc) / n^2``.  The last
-    integrand is analytic on [0, 1] and is integrated adaptively.
+    integrand is analytic on [0, 1] and is integrated adaptively, once per index (cached:
+    a model set, or each chunk of one, asks again for the indices it holds).
     """
-    n = float(n)
+    return _rbar(float(n))
+
+
+@functools.lru_cache(maxsize=4096)
+def _rbar(n: float) -> float:
     if n == 1.0:
         return 0.0
 

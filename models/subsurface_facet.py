@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .facet import _FacetModel
+from .facet import _FacetModel, _index_or_stack
 from .params import param
 from .shadowing import SHADOWING
 from .slopes import ExponentialSlopes, SlopeDistribution
@@ -45,7 +45,10 @@ class SubsurfaceFacetBRDF(_FacetModel):
     slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
     coating: float = param(1.5, "coating index (real, non-absorbing)", kind="real_index", low=1.0)
     substrate: complex = param(
-        1.37 + 7.62j, "flake/substrate index n + ik (inf: perfect conductor)", kind="index"
+        1.37 + 7.62j,
+        "flake/substrate index n + ik (inf: perfect conductor) or a models.FilmStack",
+        kind="index",
+        check=_index_or_stack,
     )
     shadowing: str = param("none", "shadowing-masking (inside the coating)", kind="choice", choices=SHADOWING)
 

@@ -49,12 +49,13 @@ import numpy as np
 from .cook_torrance import (
     _INV_4PI,
     SHADOWING_CT,
+    _check_m,
     _CookTorranceBase,
     _grazing_safe,
     ct_kernel,
     fresnel_average,
 )
-from .params import Alias, check_real, convention_param, param
+from .params import Alias, convention_param, param
 from .slopes import GaussianSlopes
 from .stroke_slopes import StrokeSlopes
 
@@ -97,7 +98,7 @@ def _slopes_from_strokes(given, current):
     if "m" in given:
         if "m_parallel" in given or "m_perpendicular" in given:
             raise ValueError("m: give either m or m_parallel and m_perpendicular, not both")
-        m = check_real("m", given.pop("m"), 0.0, low_open=True)
+        m = _check_m(given.pop("m"))
         given.update(m_parallel=m, m_perpendicular=m)
     if isinstance(current, GaussianSlopes):
         current = StrokeSlopes(m_parallel=current.sigma, m_perpendicular=current.sigma)

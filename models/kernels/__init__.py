@@ -30,7 +30,7 @@ import tempfile
 
 import numpy as np
 
-__all__ = ["Compiled", "PARALLEL_MIN", "cache_dir", "warm_up"]
+__all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 
 #: geometries from which the kernels run on every core (below: the serial loop, which has
 #: no thread start-up cost)
@@ -105,6 +105,7 @@ class Compiled:
     """
 
     def __init__(self, model, code, rows, options):
+        assert len(rows) == len(drive.ROWS[code]), f"{code} kernel rows: {drive.ROWS[code]}"
         self.code = drive.CODES[code]
         length = max((np.size(r) for r in rows), default=1)
         prm = np.empty((len(rows), length))
@@ -134,18 +135,18 @@ class Compiled:
         self.call(ti, tr, pr, out, 0)
         return out
 
-    def fill(self, plan, out, rows, precision):
-        """The whole evaluation of ``plan`` (a single model) into ``out``, chunk by chunk."""
+    def write(self, out, sl, ti, tr, pr, precision):
+        """One chunk of flat float64 angles (length 1 or the chunk's) into ``out[:, sl]``, in
+        ``precision`` (the float32 kernels for ``"float32"``): in place in a C-contiguous
+        ndarray, otherwise (e.g. a memmap) through a chunk-sized buffer."""
         dtype = np.dtype(precision)
-        direct = type(out) is np.ndarray and out.flags.c_contiguous
-        for sl, ti, tr, pr, _ in plan.blocks(fill=False):
-            a, b, c = (x.astype(dtype, copy=False) for x in (ti, tr, pr))
-            if direct:
-                self.call(a, b, c, out, sl.start, precision)
-            else:  # e.g. a memmap: through a chunk-sized buffer
-                buf = np.empty((rows, sl.stop - sl.start), dtype=dtype)
-                self.call(a, b, c, buf, 0, precision)
-                out[:, sl] = buf
+        a, b, c = (x.astype(dtype, copy=False) for x in (ti, tr, pr))
+        if type(out) is np.ndarray and out.flags.c_contiguous:
+            self.call(a, b, c, out, sl.start, precision)
+        else:
+            buf = np.empty((out.shape[0], sl.stop - sl.start), dtype=dtype)
+            self.call(a, b, c, buf, 0, precision)
+            out[:, sl] = buf
 
     def fast(self, theta_i, theta_r, phi_r, rows):
         """The small-call path: floats, or C-contiguous float64 arrays of one shape (or
@@ -177,19 +178,3 @@ class Compiled:
         if rows == 1:
             return out.reshape(shape)
         return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
-
-
-def warm_up() -> None:
-    """Compile (or load from the cache) every kernel specialization the models use."""
-    prm = np.ones((11, 1))
-    for dtype in ("float64", "float32"):
-        a = np.full(1, 0.5, dtype=dtype)
-        p = prm.astype(dtype)
-        iopt = np.zeros(3, dtype=np.int64)
-        for rows in (16, 1):
-            out = np.empty((rows, 1), dtype=dtype)
-            for code in drive.CODES.values():
-                drive.run(code, a, a, a, p, iopt, out, 0)
-                drive.run_parallel(code, a, a, a, p, iopt, out, 0)
-    drive.run_one(0, 0.5, 0.5, 0.5, prm, np.zeros(3, dtype=np.int64), np.empty((16, 1)))
-    drive.angles_ok(np.zeros(1), np.zeros(1), np.zeros(1))

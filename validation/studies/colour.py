@@ -111,15 +111,6 @@ def dominant_wavelength(wavelengths_nm, reflectance):
     return float(wl)
 
 
-def _local_cosine(theta_i, theta_r, phi_r, n):
-    """Cosine of the local incidence angle on the facet bisecting the refracted directions
-    (as :func:`models.facet.facet_jones`: ``|k_r' - k_i'| / 2``)."""
-    si, sr = math.sin(theta_i) / n, math.sin(theta_r) / n
-    ci, cr = math.sqrt(1.0 - si * si), math.sqrt(1.0 - sr * sr)
-    h = (sr * math.cos(phi_r) - si, sr * math.sin(phi_r), cr + ci)
-    return 0.5 * math.sqrt(h[0] ** 2 + h[1] ** 2 + h[2] ** 2)
-
-
 def _model_reflectance(model, theta_i, views, wavelengths_nm):
     """The model's BRDF at in-plane ``views`` and each wavelength over the same model's with
     a perfect-mirror substrate (module docstring): shape ``(len(views), len(wavelengths))``."""
@@ -129,13 +120,6 @@ def _model_reflectance(model, theta_i, views, wavelengths_nm):
     for j, wl in enumerate(wavelengths_nm):
         out[:, j] = model.replace(substrate=model.substrate.at(float(wl))).brdf(theta_i, tr, pr) / mirror
     return out
-
-
-def _viewing(theta_i, aspecular):
-    """In-plane ``(theta_r, phi_r)`` at ``aspecular`` radians from the specular direction,
-    toward the incident side for positive values (the paint industry's convention)."""
-    t = theta_i - aspecular
-    return (t, 0.0) if t >= 0 else (-t, math.pi)
 
 
 def colour_travel(model, theta_i, aspecular_deg=ASPECULAR_DEG, wavelengths_nm=WAVELENGTHS_NM):
@@ -148,11 +132,14 @@ def colour_travel(model, theta_i, aspecular_deg=ASPECULAR_DEG, wavelengths_nm=WA
     n = float(getattr(model, "coating", 1.0))
     locals_, views = [], []
     for a in aspecular_deg:
-        tr, pr = _viewing(theta_i, math.radians(a))
+        # toward the incident side for positive values (the paint industry's convention)
+        tr, pr = (float(v) for v in models.geometry.signed_inplane(theta_i - math.radians(a)))
         if not 0.0 <= tr < 0.5 * math.pi:
             raise ValueError(f"aspecular_deg {a!r} puts the view below the surface at theta_i = {theta_i!r}")
         views.append((tr, pr))
-        locals_.append(math.degrees(math.acos(min(_local_cosine(theta_i, tr, pr, n), 1.0))))
+        locals_.append(
+            math.degrees(math.acos(min(float(models.facet.local_cosine(theta_i, tr, pr, n)), 1.0)))
+        )
     wl = np.asarray(wavelengths_nm, dtype=float)
     refl = _model_reflectance(model, theta_i, views, wl)
     return ColourTravel(

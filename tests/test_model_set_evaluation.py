@@ -1,0 +1,81 @@
+"""How model sets are evaluated: derived per-element quantities computed once per distinct
+element, and the same kernel route (float64 and float32) as single models."""
+
+import math
+
+import numpy as np
+import pytest
+
+import models
+from models import smooth_interface
+
+
+def test_diffuse_subsurface_set_runs_one_quadrature_per_distinct_coating(monkeypatch):
+    """R-bar is a scipy quadrature: a set of 64 coatings evaluated in several chunks runs
+    it 64 times (it ran twice per coating: once deciding on the kernel, once per chunk)."""
+    calls = []
+    quad = smooth_interface.integrate.quad
+    monkeypatch.setattr(smooth_interface.integrate, "quad", lambda *a, **k: calls.append(1) or quad(*a, **k))
+    smooth_interface._rbar.cache_clear()
+    coating = np.linspace(1.1, 1.9, 64).reshape(64, 1)
+    m = models.DiffuseSubsurfaceBRDF(coating=coating, rho=0.9)
+    ti = np.linspace(0.0, 1.4, 2000)  # 128000 geometries: two kernel chunks
+    M = m.mueller(ti, 0.3, 0.0)
+    assert len(calls) == 64
+    for w in (0, 37, 63):
+        one = models.DiffuseSubsurfaceBRDF(coating=float(coating[w, 0]), rho=0.9)
+        assert one.rbar == m.rbar[w, 0]
+        assert np.array_equal(one.mueller(ti, 0.3, 0.0), M[w])
+    assert len(calls) == 64
+
+
+SETS = [
+    (models.FacetBRDF, {"slopes": models.GaussianSlopes(np.array([[0.2], [0.3]]))}),
+    (
+        models.SubsurfaceFacetBRDF,
+        {
+            "slopes": models.ExponentialSlopes(np.array([[0.05], [0.1], [0.3]])),
+            "coating": np.array([[1.2], [1.5], [1.9]]),
+            "substrate": np.array([[1.37 + 7.62j], [1.5 + 0j], [math.inf]]),
+        },
+    ),
+    (models.DiffuseSubsurfaceBRDF, {"coating": np.array([[1.1], [1.5], [1.9]]), "rho": 0.9}),
+    (models.MaxwellBeardBRDF, {"rho_d": np.array([[0.01], [0.1]])}),
+]
+
+
+def _element(kwargs, w):
+    """The keyword arguments of element ``w`` of a set along its first axis."""
+
+    def one(v):
+        if isinstance(v, np.ndarray):
+            return models.modelset.scalar_value(v[w, 0])
+        if isinstance(v, models.GaussianSlopes | models.ExponentialSlopes):
+            return type(v)(one(v.sigma))
+        return v
+
+    return {k: one(v) for k, v in kwargs.items()}
+
+
+@pytest.mark.parametrize("cls, kwargs", SETS, ids=lambda x: getattr(x, "__name__", ""))
+def test_model_sets_use_the_float32_kernels_like_their_elements(cls, kwargs, tmp_path):
+    """A model set's float32 result is its elements' float32 results, bit for bit (the
+    float32 kernels, not the float64 result rounded), in a new array and in a memmap."""
+    m = cls(**kwargs)
+    ti = np.linspace(0.0, 1.5, 300)
+    tr = np.linspace(0.1, 1.4, 300)[::-1].copy()
+    M32 = m.mueller(ti, tr, 0.3, precision="float32")
+    B32 = m.brdf(ti, tr, 0.3, precision="float32")
+    shape, _ = m.mueller16(ti, tr, 0.3)
+    mm = np.lib.format.open_memmap(
+        tmp_path / "m.npy", mode="w+", dtype=np.float32, shape=(16, math.prod(shape))
+    )
+    m.mueller16(ti, tr, 0.3, out=mm, precision="float32")
+    assert M32.dtype == B32.dtype == np.float32
+    assert not np.array_equal(M32, m.mueller(ti, tr, 0.3).astype(np.float32))
+    for w in range(m.param_shape[0]):
+        one = cls(**_element(kwargs, w))
+        assert np.array_equal(M32[w], one.mueller(ti, tr, 0.3, precision="float32"))
+        assert np.array_equal(B32[w], one.brdf(ti, tr, 0.3, precision="float32"))
+        ref = one.mueller16(ti, tr, 0.3, precision="float32")[1]
+        assert np.array_equal(np.asarray(mm).reshape(16, -1, len(ti))[:, w], ref)
