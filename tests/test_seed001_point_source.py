@@ -35,7 +35,7 @@ def test_nodes_and_incidence_range():
     assert psi.max() < math.pi / 4 and psi.max() > math.pi / 4 - 0.02
     assert ps.incidence_range(0.0) == pytest.approx((0.0, math.pi / 4))
     # Quadrature weights integrate the disc area exactly (before the cos^3 weight).
-    px, py, wa = ps._disc_nodes()
+    px, py, wa = ps._disc_nodes(ps.resolution)
     assert wa.sum() == pytest.approx(math.pi, rel=1e-13)
     assert np.sum(wa * (px * px + py * py)) == pytest.approx(math.pi / 2, rel=1e-12)
 
