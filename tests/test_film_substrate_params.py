@@ -2,6 +2,7 @@
 value like any other: the parameter check accepts it, the model-set machinery walks into it,
 and a scene binding and a fit with a free film thickness work (they crashed on it once)."""
 
+import dataclasses
 import math
 import os
 
@@ -55,6 +56,9 @@ def test_a_free_film_thickness_binds_and_its_likelihood_evaluates():
     assert binding.bind(sc, {THICKNESS: (100.0, 160.0)}) is None
     assert binding.bind(sc, {"substrate.sigma": (0.1, 0.2)}) is not None
     data = subsample(load_data(references.data_path("scatmech_flake_measurement.csv")), 20)
+    # the committed data are at 632.8 nm, the scene at 550 nm (a mismatch Likelihood refuses):
+    # the data relabelled at the scene's wavelength, as measurements taken there
+    data = dataclasses.replace(data, meta={**data.meta, "wavelength_nm": sc.wavelength_nm})
     spec = fitspec_from(sc, [f"{THICKNESS}:100:160", "substrate.sigma:0.1:0.2"], ["brdf=0.05"])
     lik = Likelihood(sc, spec, data)
     U = np.array([[130.0, 0.15], [140.0, 0.12], [170.0, 0.15]])
