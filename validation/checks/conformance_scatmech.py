@@ -33,7 +33,7 @@ __all__ = [
 ]
 
 #: max ``|M - M_scatmech| / M00`` per SCATMECH model: one table for the registry's SCATMECH
-#: checks (:mod:`.seed000`, :mod:`.seed003`) and the kit's ``scatmech`` check
+#: checks (:mod:`validation.checks.seed000`, :mod:`validation.checks.seed003`) and the kit's ``scatmech`` check
 SCATMECH_TOL = {
     "Facet_BRDF_Model": 1e-6,
     "Subsurface_Facet_BRDF_Model": 1e-6,
