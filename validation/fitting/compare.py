@@ -172,8 +172,6 @@ def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf")
 def _pairing_cases(rows, terms):
     """The pairing's cases (``{"data", "generator", "terms"}``) and, for each, the
     ``(likelihoods, hypothesis names)`` to compare."""
-    import os
-
     import references
     from models import scene as scene_mod
 
@@ -182,8 +180,7 @@ def _pairing_cases(rows, terms):
     from .likelihood import Likelihood
     from .recovery import subsample
 
-    scene_dir = os.path.join(os.path.dirname(references.__file__), "scenes")
-    scenes = {h: scene_mod.load(os.path.join(scene_dir, f)) for h, f in SEED003_PAIRING["scenes"].items()}
+    scenes = {h: scene_mod.load(references.scene_path(f)) for h, f in SEED003_PAIRING["scenes"].items()}
     cases, groups = [], []
     for generator, fname in SEED003_PAIRING["data"].items():
         data = load_data(references.data_path(fname))
