@@ -23,10 +23,12 @@ __all__ = ["waic", "check_comparable", "compare_fits", "format_comparison", "see
 
 
 def waic(fit, n_draws=200, seed=0):
+    """WAIC of a fit from the per-row log-likelihood of ``n_draws`` posterior draws (all
+    evaluated in one :meth:`~validation.fitting.likelihood.Likelihood.pointwise_batch`)."""
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 5]))
     s = fit.chain.samples()
     pick = rng.choice(len(s), size=min(n_draws, len(s)), replace=False)
-    ll = np.array([fit.lik.pointwise(u) for u in s[pick]])  # (draws, rows)
+    ll = fit.lik.pointwise_batch(s[pick])  # (draws, rows)
     lppd = float(np.sum(logsumexp(ll, axis=0) - math.log(len(pick))))
     p = float(np.sum(np.var(ll, axis=0, ddof=1)))
     return {"WAIC": -2 * (lppd - p), "lppd": lppd, "p_waic": p}
