@@ -142,23 +142,15 @@ def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 3]))
     samples = fit.chain.samples()
     pick = rng.choice(len(samples), size=min(n_draws, len(samples)), replace=False)
-    out = {t: {"model": [], "replicated": []} for t in TERMS}
     U = samples[pick]
-    batch = None
+    values, noise = lik.walkers(U)
     if lik.binding is not None:  # every draw's model at once (a model set)
-        values, _ = lik.walkers(U)
-        batch = lik.predict(lik.model(values), data)
-    for j, u in enumerate(U):  # the replicates draw in the order they always did
-        values = lik.spec.physical(u)
-        if batch is None:
-            pred = lik.predict(lik.model(values), data)
-        else:
-            pred = {t: batch[t][j] for t in TERMS}
-        rep = replicate(pred, term_variances(lik.spec.noise_values(values), data, TERMS), rng)
-        for t in out:
-            out[t]["model"].append(pred[t])
-            out[t]["replicated"].append(rep[t])
-    res = {t: {k: np.array(v) for k, v in d.items()} for t, d in out.items()}
+        pred = lik.predict(lik.model(values), data)
+    else:  # the scene rebuilt at each draw
+        each = [lik.predict(lik.model(lik.spec.physical(u)), data) for u in U]
+        pred = {t: np.array([p[t] for p in each]) for t in TERMS}
+    rep = replicate(pred, term_variances(noise, data, TERMS), rng)
+    res = {t: {"model": pred[t], "replicated": rep[t]} for t in TERMS}
     res["mask"] = lik.spec.mask(data)
     return res
 

@@ -62,13 +62,17 @@ def term_variances(noise: dict, data, terms) -> dict:
 
 def replicate(pred: dict, variances: dict, rng) -> dict:
     """Data drawn from the likelihood's noise model around the model values ``pred``:
-    log-normal BRDF, Gaussian eta (wrapped as an axis), P and P_C; one standard-normal
-    draw per row for each term of ``variances``, in :data:`TERMS` order."""
+    log-normal BRDF, Gaussian eta (wrapped as an axis), P and P_C.  ``pred``'s arrays are
+    ``(rows,)``, or ``(draws, rows)`` for many draws at once; one standard-normal number per
+    row for each term of ``variances``, in :data:`TERMS` order, draw after draw (taken in
+    one call: the same numbers as one call per draw and term)."""
+    terms = [t for t in TERMS if t in variances]
+    shape = np.shape(pred[terms[0]])
+    z = rng.standard_normal(shape[:-1] + (len(terms), shape[-1]))
     out = {}
-    for t in (t for t in TERMS if t in variances):
-        m = pred[t]
-        z = rng.standard_normal(len(m)) * np.sqrt(variances[t])
-        out[t] = m * np.exp(z) if t == "brdf" else (wrap_axis(m + z) if t == "eta" else m + z)
+    for k, t in enumerate(terms):
+        m, e = pred[t], z[..., k, :] * np.sqrt(variances[t])
+        out[t] = m * np.exp(e) if t == "brdf" else (wrap_axis(m + e) if t == "eta" else m + e)
     return out
 
 
