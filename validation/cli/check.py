@@ -6,12 +6,15 @@ import os
 import sys
 import time
 
+from .args import UsageError, writable_file
+
 __all__ = ["register", "run"]
 
 
 def run(spec, json_path=None, quick=False, checks=None) -> int:
     """Check the model ``spec`` names, print the table, write ``json_path`` (strict JSON,
-    atomically) if given; 0 when no check fails, 1 when one does, 2 on a bad argument."""
+    atomically) if given; 0 when no check fails, 1 when one does.  A bad argument raises
+    :class:`~validation.cli.args.UsageError` (the command line: ``error: ...``, exit 2)."""
     from validation.atomic import atomic_write_json
     from validation.testing import check_model, load_model
 
@@ -23,9 +26,8 @@ def run(spec, json_path=None, quick=False, checks=None) -> int:
         names = [c.strip() for c in checks.split(",") if c.strip()] if checks else None
         t0 = time.perf_counter()
         report = check_model(model, checks=names, quick=quick, label=spec)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    except ValueError as exc:  # a model spec that names no model, an unknown check name
+        raise UsageError(str(exc)) from exc
     print(report.format())
     print(f"check finished in {time.perf_counter() - t0:.1f} s")
     if json_path:
@@ -35,8 +37,6 @@ def run(spec, json_path=None, quick=False, checks=None) -> int:
 
 def _cmd_check(args) -> int:
     if args.json:  # refused before the kit runs, not after
-        from .args import writable_file
-
         writable_file(args.json, "--json")
     return run(args.model, json_path=args.json, quick=args.quick, checks=args.checks)
 
