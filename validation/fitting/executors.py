@@ -26,6 +26,8 @@ import hashlib
 import multiprocessing
 import pickle
 
+from .settings import _integer
+
 __all__ = ["SerialExecutor", "ProcessExecutor", "DaskExecutor", "SchedulerError", "make_executor"]
 
 #: seconds :class:`DaskExecutor` waits for a scheduler given by address to answer
@@ -130,9 +132,7 @@ class ProcessExecutor(SerialExecutor):
     kind = "processes"
 
     def __init__(self, workers: int):
-        if not isinstance(workers, int) or workers < 1:
-            raise ValueError(f"workers must be an integer >= 1; got {workers!r}")
-        self.workers = workers
+        self.workers = _integer("workers", workers, 1)
         # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
         self._fn = self._blob = self._key = None
         self._pool = cf.ProcessPoolExecutor(

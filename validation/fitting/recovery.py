@@ -37,7 +37,7 @@ from .fit import run_fit
 from .fitspec import FitSpec
 from .likelihood import Likelihood, replicate, term_variances
 from .sampling import _progress_bar
-from .settings import ChainSettings
+from .settings import ChainSettings, _integer
 
 __all__ = [
     "simulate",
@@ -164,8 +164,7 @@ def check_inputs(spec, chain, noise_extra=None, injections=1):
     injections : int
         Members per cell, >= 1.
     """
-    if isinstance(injections, bool) or not isinstance(injections, int) or injections < 1:
-        raise ValueError(f"injections must be an integer >= 1; got {injections!r}")
+    _integer("injections", injections, 1)
     chain.require_walkers(len(spec.free))
     missing = [
         p.key

@@ -20,8 +20,9 @@ __all__ = ["ChainSettings"]
 
 
 def _integer(name, value, low):
-    """``value`` as an ``int >= low``.  Not :func:`models.params.check_real`: that converts to
-    a float, which an integer above sys.float_info.max overflows (a valid seed here)."""
+    """``value`` as an ``int >= low`` (the settings' fields, a study's injections, a process
+    executor's workers).  Not :func:`models.params.check_real`: that converts to a float,
+    which an integer above sys.float_info.max overflows (a valid seed here)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < low:
         raise ValueError(f"{name} must be an integer >= {low}; got {value!r}")
     return int(value)
