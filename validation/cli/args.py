@@ -138,8 +138,8 @@ def writable_folder(path, flag):
             break
         existing = parent
     if not os.path.isdir(existing):
-        shown = "" if existing == path else f" ({existing} is a file)"
-        raise UsageError(f"{flag} {given}: not a folder{shown}")
+        which = "" if existing == path else f" ({existing} is a file)"
+        raise UsageError(f"{flag} {given}: not a folder{which}")
     problem = write_problem(existing)
     if problem:
         raise UsageError(f"{flag} {given}: cannot write in {existing} ({problem})")
