@@ -14,7 +14,7 @@ from validation.numerics.integrate import integrated_reflectance
 from ..core import figure_block, table_block, text_block
 from ._common import plt
 
-__all__ = ["Seed001Data", "compute", "render"]
+__all__ = ["Seed001Data", "ct_albedo_rows", "point_source_scan", "compute", "render"]
 
 #: source heights d/R of the point source -> collimated table
 DISTANCES = (3.0, 10.0, 30.0, 100.0, 1e3, 1e4)
@@ -57,12 +57,11 @@ class Seed001Data:
     tracked: dict
 
 
-def _ct_albedo():
-    """Published and energy-normalized albedos of the iron plate model, and their ratio."""
-    from validation.checks.seed001 import published_albedos
-
+def ct_albedo_rows(published):
+    """Per incidence of ``published`` (:func:`validation.checks.seed001.published_albedos`' ``{deg:
+    albedo}``), the energy-normalized albedo of the same iron plate model and the ratio / (4 pi)."""
     rows = []
-    for t, v in published_albedos().items():
+    for t, v in published.items():
         e = integrated_reflectance(
             models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="corrected"),
             math.radians(t),
@@ -115,8 +114,9 @@ def _varnish(n_t, n_p):
     return VarnishMaps(np.degrees(tr), np.degrees(pr), published, refracted), tuple(rows)
 
 
-def _point_source_scan(vn, lo, hi):
-    """One printed incidence range: the in-plane scan and its table row."""
+def point_source_scan(vn, lo, hi):
+    """One printed incidence range ``[lo, hi]`` (deg): the in-plane scan of ``vn`` collimated and under
+    the point source that spans it, and its table row."""
     psi_c, d = models.point_source_geometry(lo, hi)
     ps = models.PointSourceBRDF(model=vn, distance=d, sample_radius=1.0, resolution=16)
     a_lo, a_hi = ps.incidence_range(psi_c)
@@ -144,7 +144,7 @@ def _point_source():
 
     _, vn = iron_plate_models()
     scans, rows = zip(
-        *(_point_source_scan(vn, lo, hi) for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]),
+        *(point_source_scan(vn, lo, hi) for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]),
         strict=True,
     )
     conv = point_source_collimated_error(distances=DISTANCES)
@@ -153,10 +153,10 @@ def _point_source():
 
 
 def compute(ctx):
-    from validation.checks.seed001 import published_over_energy_error
+    from validation.checks.seed001 import published_albedos, published_over_energy_error
 
     ratio_err = published_over_energy_error()
-    albedo_rows = _ct_albedo()
+    albedo_rows = ct_albedo_rows(ctx.compute(published_albedos))  # the energy check's integrals
     n_t, n_p = (30, 31) if ctx.quick else (60, 61)
     maps, ratio_rows = _varnish(n_t, n_p)
     scans, point_rows, convergence = _point_source()
