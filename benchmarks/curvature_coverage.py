@@ -40,9 +40,7 @@ def main(argv=None):
     ap.add_argument("--injections", type=int, default=3000)
     ap.add_argument("--seed", type=int, default=7)
     args = ap.parse_args(argv)
-    sc = scene.load(
-        os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
-    )
+    sc = scene.load(references.scene_path("aluminium_flakes_clearcoat.toml"))
     data = load_data(references.data_path("scatmech_flake_measurement.csv"))
     n = args.injections
     se68, se95 = math.sqrt(0.6827 * 0.3173 / n), math.sqrt(0.9545 * 0.0455 / n)

@@ -30,6 +30,7 @@ import numpy as np
 
 import models
 from benchmarks.speed import best_of
+from validation.checks.common import random_geometries
 
 AL = 1.37 + 7.62j
 MODELS = {
@@ -49,8 +50,8 @@ FIRST_CALL = (
 
 
 def geometries(n):
-    rng = np.random.default_rng(0)
-    return rng.uniform(0, 1.5, n), rng.uniform(0, 1.5, n), rng.uniform(-math.pi, math.pi, n)
+    """``(ti, tr, pr)``: polar angles uniform in [0, 1.5] rad, azimuth in [-pi, pi) (seed 0)."""
+    return random_geometries(n, 0, max_deg=math.degrees(1.5))
 
 
 def per_geometry(n, repeat):

@@ -58,6 +58,7 @@ import numba
 import numpy as np
 
 import models
+from validation.checks.common import random_geometries
 from validation.studies.tradeoff import time_call
 
 DEFAULT_OUT = os.path.join(
@@ -98,9 +99,7 @@ class Row:
 
 def geometries(n, seed=2024):
     """``(ti, tr, pr)``: polar angles uniform in [0, 80] deg, azimuth in [-pi, pi)."""
-    rng = np.random.default_rng(seed)
-    ti, tr = rng.uniform(0.0, math.radians(80.0), (2, n))
-    return ti, tr, rng.uniform(-math.pi, math.pi, n)
+    return random_geometries(n, seed, max_deg=80.0)
 
 
 def _us(fn, per=1):

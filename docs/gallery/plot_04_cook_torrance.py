@@ -5,35 +5,26 @@ Seed 001: published versus energy-normalized Cook-Torrance, and the point source
 Eq. 7-8 of Hébert, Emmel and Hersch have no ``1/pi`` in D and no 4 in the
 denominator: the published BRDF is exactly 4 pi times the energy-normalized
 one, so its albedo exceeds 1. :class:`models.CookTorranceBRDF` keeps both
-(``convention="paper"`` and ``"corrected"``). The albedos are the seed 001
-check's (:func:`validation.checks.seed001.published_albedos`), for the paper's
-iron plate (m = 0.03, iron ``2.29+3.37i``, Blinn shadowing).
+(``convention="paper"`` and ``"corrected"``). The published albedos are the seed 001
+check's (:func:`validation.checks.seed001.published_albedos`), the energy-normalized
+ones the report section's (:func:`validation.report.sections.seed001.ct_albedo_rows`),
+for the paper's iron plate (m = 0.03, iron ``2.29+3.37i``, Blinn shadowing).
 """
-
-import math
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-import models
 import references
-import validation
 from validation.checks.seed001 import iron_plate_models, point_source_collimated_error, published_albedos
+from validation.report.sections.seed001 import ct_albedo_rows, point_source_scan
 
 published = published_albedos()
-energy = {
-    t: validation.integrated_reflectance(
-        models.CookTorranceBRDF(
-            slopes=models.GaussianSlopes(0.03), substrate=2.29 + 3.37j, convention="corrected"
-        ),
-        math.radians(t),
-        tol=1e-3,
-    ).value
-    for t in published
-}
-for t, v in published.items():
+rows = ct_albedo_rows(published)  # the report section's table: the energy-normalized albedos beside them
+energy = {r["theta_i (deg)"]: r["energy albedo"] for r in rows}
+for r in rows:
     print(
-        f"theta_i = {t:g} deg: published albedo {v:.4f}, energy {energy[t]:.4f}, ratio/(4 pi) {v / energy[t] / (4 * math.pi):.6f}"
+        f"theta_i = {r['theta_i (deg)']:g} deg: published albedo {r['published albedo']:.4f}, "
+        f"energy {r['energy albedo']:.4f}, ratio/(4 pi) {r['ratio / (4 pi)']:.6f}"
     )
 
 fig, ax = plt.subplots(figsize=(6, 3.5))
@@ -51,17 +42,14 @@ fig.tight_layout()
 # The point-source effect. The iron plate under a point source whose disc
 # spans the printed incidence range (:func:`models.point_source_geometry`),
 # in-plane, beside the collimated BRDF (:class:`models.PointSourceBRDF`, the
-# exact superposition of Eq. 28).
+# exact superposition of Eq. 28; the report section's scan,
+# :func:`validation.report.sections.seed001.point_source_scan`).
 _, varnished = iron_plate_models()  # references.IRON_PLATE under its varnish, as printed
 lo, hi = references.IRON_PLATE["incidence_ranges_deg"][0]
-psi_c, d = models.point_source_geometry(lo, hi)
-point = models.PointSourceBRDF(model=varnished, distance=d, sample_radius=1.0, resolution=8)
-tr = np.radians(np.linspace(max(math.degrees(psi_c) - 10.0, 0.0), math.degrees(psi_c) + 10.0, 401))
+scan, _ = point_source_scan(varnished, lo, hi)  # the report section's scan
 fig, ax = plt.subplots(figsize=(6, 3.5))
-ax.semilogy(np.degrees(tr), varnished.brdf(psi_c, tr, 0.0), label="collimated")
-ax.semilogy(
-    np.degrees(tr), np.maximum(point.brdf(psi_c, tr, 0.0), 1e-6), "--", label=f"point source, d/R = {d:.1f}"
-)
+ax.semilogy(scan.theta_r_deg, scan.collimated, label="collimated")
+ax.semilogy(scan.theta_r_deg, np.maximum(scan.point, 1e-6), "--", label=f"point source, d/R = {scan.d:.1f}")
 ax.set_title(f"incidence range [{lo:g}, {hi:g}] deg")
 ax.set_xlabel("theta_r in plane (deg)")
 ax.set_ylabel("BRDF (1/sr)")

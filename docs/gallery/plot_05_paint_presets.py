@@ -10,11 +10,12 @@ Carlo under a rough interface). The presets are scene files listed by
 :func:`references.seed003_presets`; each is built with :mod:`models.scene`. Beside
 each, the empirical Maxwell-Beard BRDF (:class:`models.MaxwellBeardBRDF`) is
 fitted by least squares in log10 to the preset's in-plane BRDF for unpolarized
-light (M00) at its incidence, 60 deg (sigma, rho_d and rho_v free). The curves
-and the fits are the report section's
-(:func:`validation.report.sections.seed003_presets.compute`, quick: the green
-CARC at 200 facet pairs per geometry); as there, they are drawn for incident
-light polarized at 45 deg (seed 003 Sec. 3), which in the plane of incidence
+light (M00) at its incidence, 60 deg (sigma, rho_d and rho_v free). The curves,
+the fits and the figure are the report section's
+(:func:`validation.report.sections.seed003_presets.compute` and
+:func:`~validation.report.sections.seed003_presets.draw`, quick: the green
+CARC at 200 facet pairs per geometry); as there, the BRDF, the principal angle eta
+and the degree of polarization P are drawn for incident light polarized at 45 deg (seed 003 Sec. 3), which in the plane of incidence
 gives M00 where M02 vanishes (the printed max ``|M02|/M00`` says how nearly it
 does). The red paint's parameters are not
 printed in the paper: its preset carries placeholders (the preset's provenance
@@ -22,7 +23,6 @@ says which).
 """
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 from validation.report.core import Context
 from validation.report.sections import seed003_presets
@@ -35,15 +35,5 @@ for row in d.fit_rows:
         f"max |M02|/M00 in plane {row['max |M02|/M00 in plane']:.1e}"
     )
 
-fig, axes = plt.subplots(1, 3, figsize=(12, 3.8), sharey=True)
-for ax, c in zip(axes, d.curves, strict=True):
-    ax.semilogy(d.x, c.brdf, label=c.label)
-    if np.any(c.se > 0):
-        ax.fill_between(d.x, np.maximum(c.brdf - 2 * c.se, 1e-12), c.brdf + 2 * c.se, alpha=0.3, lw=0)
-    ax.semilogy(d.x, c.mb_brdf, "--", label="Maxwell-Beard (fitted)")
-    ax.set_title(c.title, fontsize=9)
-    ax.set_xlabel("signed theta_r (deg)")
-    ax.legend(fontsize=7)
-axes[0].set_ylabel("BRDF (1/sr), 45 deg in")
-fig.tight_layout()
+fig = seed003_presets.draw(d)
 plt.show()

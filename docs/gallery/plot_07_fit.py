@@ -11,8 +11,6 @@ JSON sidecar). The same calls ``scatterbench fit`` makes, with a short chain
 intervals are indicative only; ``scatterbench fit`` runs to convergence.
 """
 
-import os
-
 import matplotlib.pyplot as plt
 
 import references
@@ -23,7 +21,7 @@ from validation.fitting.fitspec import fitspec_from
 from validation.fitting.likelihood import Likelihood
 from validation.fitting.settings import ChainSettings
 
-sc = scene.load(os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_fit.toml"))
+sc = scene.load(references.scene_path("aluminium_flakes_fit.toml"))
 data = load_data(references.data_path("scatmech_flake_measurement.csv"))
 lik = Likelihood(sc, fitspec_from(sc), data)
 fit = run_fit(lik, ChainSettings(walkers=16, seed=0, max_steps=300, check_every=100, starts=2))

@@ -10,7 +10,7 @@ import numpy as np
 
 from validation.checks.shadowing import ANGLES_DEG, QUICK_ANGLES_DEG, conductor_albedo_curves
 from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
+from validation.numerics.reciprocity import reciprocity_errors
 
 from ..core import figure_block, table_block, text_block
 from ._common import default_models, finish, is_heavy, plt
@@ -37,14 +37,22 @@ class ConservationData:
     smith_rows: tuple
 
 
+def _worst(errors, live):
+    return float(np.max(errors[live])) if live.any() else 0.0
+
+
 def _reciprocity(m, t):
+    """The relative reciprocity errors over the theta_i x theta_r grid: the map, and its row of
+    maxima (scalar, Mueller, Jones) over the same geometries."""
     TI, TR = np.meshgrid(t, t, indexing="ij")
-    fwd = m.brdf(TI, TR, PHI_R)
-    rev = reversed_mueller(m, TI, TR, PHI_R)[..., 0, 0]  # the reversed path, rotated sample if anisotropic
-    scale = np.maximum(np.abs(fwd), np.abs(rev))
-    err = np.where(scale > 0, np.abs(fwd - rev) / np.where(scale > 0, scale, 1), 0.0)
-    r = reciprocity_error(m, TI.ravel()[::7], TR.ravel()[::7], np.full(TI.size, PHI_R)[::7])
-    return err, {"model": type(m).__name__, "scalar": r.scalar, "Mueller": r.mueller, "Jones": r.jones}
+    e = reciprocity_errors(m, TI, TR, PHI_R)  # the reversed path, rotated sample if anisotropic
+    row = {
+        "model": type(m).__name__,
+        "scalar": _worst(e.scalar, e.live),
+        "Mueller": _worst(e.mueller, e.live),
+    }
+    row["Jones"] = None if e.jones is None else _worst(e.jones, e.live)
+    return e.scalar.reshape(TI.shape), row
 
 
 def _albedo(ms, tis):

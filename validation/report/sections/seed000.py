@@ -13,7 +13,7 @@ from validation.numerics.integrate import integrated_reflectance
 from ..core import figure_block, table_block
 from ._common import AL, inplane, plt
 
-__all__ = ["Seed000Data", "compute", "render"]
+__all__ = ["Seed000Data", "compute", "draw_fig2", "draw_fig3", "render"]
 
 THETA_I = math.radians(60)
 SIGMAS = (0.1, 0.2)
@@ -86,7 +86,8 @@ def compute(ctx):
     return Seed000Data(x, fig2, fig2_rows, fig3, fig3_rows, tracked)
 
 
-def _draw_fig2(d):
+def draw_fig2(d):
+    """Fig. 2: the in-plane BRDF per sigma and coating (the section's figure; also the gallery's)."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
     for ax, (sigma, curves) in zip(axes, d.fig2, strict=True):
         for (n, f), style in zip(curves, ("-", "--", ":"), strict=True):
@@ -99,7 +100,8 @@ def _draw_fig2(d):
     return fig
 
 
-def _draw_fig3(d):
+def draw_fig3(d):
+    """Fig. 3: eta, P and P_C for 45 deg light (the section's figure; also the gallery's)."""
     fig, axes = plt.subplots(3, 1, figsize=(7.5, 8), sharex=True)
     for (label, eta, p, pc), style in zip(d.fig3, ("-", "--"), strict=True):
         axes[0].plot(d.x, eta, style, label=label)
@@ -118,7 +120,7 @@ def render(s, d: Seed000Data):
     s.tracked.update(d.tracked)
     s.blocks.append(
         figure_block(
-            _draw_fig2(d),
+            draw_fig2(d),
             "Fig. 2: BRDF for unpolarized light at theta_i = 60 deg, coatings 1.0, 1.5, 2.0 on aluminium",
         )
     )
@@ -126,7 +128,7 @@ def render(s, d: Seed000Data):
     s.blocks.append(table_block(s, "fig2", columns, d.fig2_rows))
     s.blocks.append(
         figure_block(
-            _draw_fig3(d),
+            draw_fig3(d),
             "Fig. 3 style: principal angle eta, degree of polarization P and of circular polarization P_C for "
             "incident light polarized at 45 deg (theta_i = 60 deg, sigma = 0.2)",
         )

@@ -14,10 +14,15 @@ from validation.numerics.integrate import integrated_reflectance
 from ..core import figure_block, table_block, text_block
 from ._common import plt
 
-__all__ = ["Seed001Data", "compute", "render"]
+__all__ = ["Seed001Data", "ct_albedo_rows", "point_source_scan", "compute", "render"]
 
 #: source heights d/R of the point source -> collimated table
 DISTANCES = (3.0, 10.0, 30.0, 100.0, 1e3, 1e4)
+#: random geometries of the published / energy ratio
+RATIO_GEOMETRIES = 20000
+#: radial disc nodes of the point-source scans (2 x as many in azimuth) and their in-plane angles
+SCAN_RESOLUTION = 16
+SCAN_ANGLES = 801
 
 
 @dataclass(frozen=True)
@@ -57,12 +62,11 @@ class Seed001Data:
     tracked: dict
 
 
-def _ct_albedo():
-    """Published and energy-normalized albedos of the iron plate model, and their ratio."""
-    from validation.checks.seed001 import published_albedos
-
+def ct_albedo_rows(published):
+    """Per incidence of ``published`` (:func:`validation.checks.seed001.published_albedos`' ``{deg:
+    albedo}``), the energy-normalized albedo of the same iron plate model and the ratio / (4 pi)."""
     rows = []
-    for t, v in published_albedos().items():
+    for t, v in published.items():
         e = integrated_reflectance(
             models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.03), convention="corrected"),
             math.radians(t),
@@ -115,12 +119,15 @@ def _varnish(n_t, n_p):
     return VarnishMaps(np.degrees(tr), np.degrees(pr), published, refracted), tuple(rows)
 
 
-def _point_source_scan(vn, lo, hi):
-    """One printed incidence range: the in-plane scan and its table row."""
+def point_source_scan(vn, lo, hi):
+    """One printed incidence range ``[lo, hi]`` (deg): the in-plane scan of ``vn`` collimated and under
+    the point source that spans it, and its table row."""
     psi_c, d = models.point_source_geometry(lo, hi)
-    ps = models.PointSourceBRDF(model=vn, distance=d, sample_radius=1.0, resolution=16)
+    ps = models.PointSourceBRDF(model=vn, distance=d, sample_radius=1.0, resolution=SCAN_RESOLUTION)
     a_lo, a_hi = ps.incidence_range(psi_c)
-    tr = np.radians(np.linspace(max(math.degrees(psi_c) - 10.0, 0.0), math.degrees(psi_c) + 10.0, 801))
+    tr = np.radians(
+        np.linspace(max(math.degrees(psi_c) - 10.0, 0.0), math.degrees(psi_c) + 10.0, SCAN_ANGLES)
+    )
     fc = vn.brdf(psi_c, tr, 0.0)
     fp = ps.brdf(psi_c, tr, 0.0)
     kc, kp = int(np.argmax(fc)), int(np.argmax(fp))
@@ -144,7 +151,7 @@ def _point_source():
 
     _, vn = iron_plate_models()
     scans, rows = zip(
-        *(_point_source_scan(vn, lo, hi) for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]),
+        *(point_source_scan(vn, lo, hi) for lo, hi in references.IRON_PLATE["incidence_ranges_deg"]),
         strict=True,
     )
     conv = point_source_collimated_error(distances=DISTANCES)
@@ -153,10 +160,10 @@ def _point_source():
 
 
 def compute(ctx):
-    from validation.checks.seed001 import published_over_energy_error
+    from validation.checks.seed001 import published_albedos, published_over_energy_error
 
-    ratio_err = published_over_energy_error()
-    albedo_rows = _ct_albedo()
+    ratio_err = published_over_energy_error(n=RATIO_GEOMETRIES)
+    albedo_rows = ct_albedo_rows(ctx.compute(published_albedos))  # the energy check's integrals
     n_t, n_p = (30, 31) if ctx.quick else (60, 61)
     maps, ratio_rows = _varnish(n_t, n_p)
     scans, point_rows, convergence = _point_source()
@@ -206,7 +213,7 @@ def _render_albedo(s, d):
         text_block(
             "Eq. 7-8 as printed have no 1/pi in D and no 4 in the denominator: the published BRDF is 4 pi times "
             f"the energy-normalized one. Measured max |published / energy / (4 pi) - 1| = {d.ratio_err:.2e} over "
-            "20000 random geometries (CookTorranceBRDF m = 0.2 and an anisotropic varnished model, its refraction "
+            f"{RATIO_GEOMETRIES} random geometries (CookTorranceBRDF m = 0.2 and an anisotropic varnished model, its refraction "
             "Jacobian divided out). Albedos "
             "(hemispherical integral of M00 cos theta_r, tol 1e-3) of the iron plate model (m = 0.03, iron "
             "2.29+3.37i, Blinn shadowing):"
@@ -232,13 +239,14 @@ def _render_varnish(s, d):
 
 
 def _render_point_source(s, d):
+    step = float(np.diff(d.scans[0].theta_r_deg[:2])[0])
     s.blocks.append(
         figure_block(
             _draw_point_source(d.scans),
             "Iron plate (references.IRON_PLATE: m = 0.03, n_v = 1.5, iron 2.29+3.37i, published normalization), "
             "in-plane varnished BRDF for a collimated beam and for a point source at the height d/R that makes "
             "a disc of radius R span the printed incidence range (PointSourceBRDF exact Eq. 28 superposition, "
-            "16 x 32 disc nodes; 0.025 deg grid).",
+            f"{SCAN_RESOLUTION} x {2 * SCAN_RESOLUTION} disc nodes; {step:g} deg grid).",
         )
     )
     s.blocks.append(table_block(s, "point_source_preset", list(d.point_rows[0]), d.point_rows))

@@ -124,6 +124,8 @@ def render(s, d: Fig1Data):
             "1/slope of sin(mean theta_t) = sin(theta_i)/n_eff (validation/checks/fig1.py)."
         )
     )
-    caption = f"peak angles at theta_i = 60 deg (Snell: {d.snell_deg:.3f} deg) and effective indices"
+    caption = (
+        f"peak angles at theta_i = {d.theta_i_deg:g} deg (Snell: {d.snell_deg:.3f} deg) and effective indices"
+    )
     s.blocks.append(table_block(s, "fig1", list(d.rows[0]), d.rows, caption=caption, fmt=_FMT))
     s.tracked.update(d.tracked)

@@ -16,7 +16,7 @@ from models.polarization import ellipsometric, stokes
 from ..core import figure_block, table_block, text_block
 from ._common import plt, signed
 
-__all__ = ["PresetsData", "PresetCurves", "fit_maxwell_beard", "compute", "render"]
+__all__ = ["PresetsData", "PresetCurves", "fit_maxwell_beard", "compute", "draw", "render"]
 
 INCIDENT = "linear:45"  # Sec. 3: "using 45 deg incident polarization"
 #: the tabulated in-plane angles (signed, deg)
@@ -167,7 +167,8 @@ def compute(ctx):
     return PresetsData(x, tuple(curves), tuple(fit_rows), tuple(table_rows), carc_pairs, ctx.seed, tracked)
 
 
-def _draw(d):
+def draw(d):
+    """BRDF, eta and P per preset beside its Maxwell-Beard fit (the section's figure; also the gallery's)."""
     fig, axes = plt.subplots(3, 3, figsize=(13, 9), sharex=True)
     x = d.x
     for j, c in enumerate(d.curves):
@@ -210,7 +211,7 @@ def render(s, d: PresetsData):
     s.tracked.update(d.tracked)
     s.blocks.append(
         figure_block(
-            _draw(d),
+            draw(d),
             "In-plane BRDF, principal angle eta and degree of polarization P at theta_i = 60 deg for light "
             "polarized at 45 deg (seed 003 Sec. 3), for the presets of references/data/presets.toml (solid) and "
             "the polarized Maxwell-Beard model fitted to each preset's in-plane BRDF (dashed). Green CARC: "

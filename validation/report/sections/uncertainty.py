@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import tempfile
 from dataclasses import dataclass
 
@@ -105,7 +104,7 @@ def _fit(ctx):
     from validation.fitting.fitspec import fitspec_from
     from validation.fitting.likelihood import Likelihood
 
-    sc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", FIT_SCENE))
+    sc = scene_mod.load(references.scene_path(FIT_SCENE))
     data = load_data(references.data_path(FIT_DATA))
     spec = fitspec_from(sc)
     st = _fit_settings(ctx.quick, ctx.seed)
