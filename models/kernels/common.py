@@ -95,6 +95,14 @@ def rs_k(c, mr, mi, pec):
 
 
 @njit(cache=True)
+def coating_cos(c, n):
+    """Cosine of the refracted angle in a non-absorbing coating ``n`` from the external cosine
+    ``c`` (:func:`models.fresnel.coating_cos`: no cancellation near grazing)."""
+    T = type(c)
+    return math.sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)
+
+
+@njit(cache=True)
 def coating_t(c, n):
     """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`models.fresnel.coating_transmission`)."""
     T = type(c)

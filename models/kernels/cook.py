@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import cdiv, csqrt, stroke_d, write_diag
+from .common import cdiv, coating_cos, csqrt, stroke_d, write_diag
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
@@ -70,9 +70,7 @@ def cook(ti, tr, pr, prm, j, iopt, out, i):
         scale = T(1.0 / (4.0 * math.pi)) if iopt[1] == 1 else T(1.0)
         write_diag(out, i, val * (scale / (ci * cr)))
         return
-    inv_nv = T(1.0) / nv
-    cii = math.sqrt(nv * nv - T(1.0) + ci * ci) * inv_nv
-    cri = math.sqrt(nv * nv - T(1.0) + cr * cr) * inv_nv
+    cii, cri = coating_cos(ci, nv), coating_cos(cr, nv)
     val = ct_value(cii, cri, cp, sp, prm, j, sub_r / nv, sub_i / nv, iopt[2] == 1)
     if nv != T(1.0):
         ti_ = T(1.0) - fresnel_average(ci, nv, T(0.0), False)

@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import write_mueller
+from .common import coating_cos, write_mueller
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
 SINGLE_ROWS = ("coating", "g")
@@ -25,7 +25,7 @@ def amplitudes(c, n):
     if c < (T(1e-15) if double else T(2.4e-7)):
         c = T(0.0)
     s_int = math.sqrt(T(1.0) - c * c) * (T(1.0) / n)
-    c_int = math.sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)  # why this form: the numpy path
+    c_int = coating_cos(c, n)
     root = T(2.0) * math.sqrt(c * c_int)
     tiny = T(1e-300) if double else T(1e-38)
     return s_int, c_int, root / max(c + n * c_int, tiny), root / max(n * c + c_int, tiny)
