@@ -144,9 +144,13 @@ class Model(Declared):
     def _has_kernel(self) -> bool:
         return self._kernel_spec() is not None
 
+    def _kernel_path(self) -> bool:
+        """True when chunks go through the kernels here (a model set's chunks each build
+        their own, so the whole set's :attr:`_kernel` is never built)."""
+        return self._has_kernel and evaluation.current_backend() == "numba"
+
     def _plan(self, theta_i, theta_r, phi_r):
-        kernel = self._has_kernel and evaluation.current_backend() == "numba"
-        chunk = evaluation.KERNEL_CHUNK if kernel else evaluation.CHUNK
+        chunk = evaluation.KERNEL_CHUNK if self._kernel_path() else evaluation.CHUNK
         return evaluation.Plan(self, theta_i, theta_r, phi_r, chunk)
 
     def iter_mueller(self, theta_i, theta_r, phi_r=0.0):
@@ -207,7 +211,7 @@ class Model(Declared):
         """Evaluate ``plan`` into ``out`` chunk by chunk: the kernel where one covers the model
         (a model set's chunk is a model with flat parameters, with its own kernel rows),
         otherwise the numpy implementation (rounded to ``out``'s dtype)."""
-        kernel = self._has_kernel and evaluation.current_backend() == "numba"
+        kernel = self._kernel_path()
         for sl, ti, tr, pr, m in plan.blocks(fill=not kernel):
             if kernel:
                 m._kernel.write(out, sl, ti, tr, pr, precision)
