@@ -25,7 +25,7 @@ from . import evaluation, modelset
 from .evaluation import CHUNK
 from .geometry import broadcast_angles
 from .modelset import array_leaves
-from .params import Declared, check_finite_array, check_polar_angle, param
+from .params import Declared, param
 from .polarization import ellipsometric, stokes
 
 __all__ = ["Model", "Sum", "CHUNK"]
@@ -134,11 +134,7 @@ class Model(Declared):
 
     # -- validation and chunked evaluation ----------------------------------------
     def _angles(self, theta_i, theta_r, phi_r):
-        n1, n2, n3 = self._angle_names
-        ti = check_polar_angle(n1, theta_i)
-        tr = check_polar_angle(n2, theta_r)
-        pr = check_finite_array(n3, phi_r)
-        return broadcast_angles(ti, tr, pr)
+        return broadcast_angles(*evaluation.checked_angles(self, theta_i, theta_r, phi_r))
 
     @cached_property
     def _has_kernel(self) -> bool:
