@@ -98,7 +98,7 @@ def rs_k(c, mr, mi, pec):
     cwr, cwi = c + wr, wi
     rsr, rsi = cdiv(c - wr, -wi, cwr, cwi)
     # 2 (1 - m^2) / (m^2 c + w) / (c + w): two divisions, not one by the product, which
-    # overflows float32 from |m| ~ 1e10 (|m^2 c + w| |c + w| ~ |m|^3)
+    # overflows float32 from |m| ~ 7e12 (|m^2 c + w| |c + w| ~ |m|^3; float32's largest: 3.4e38)
     qr, qi = cdiv(T(2.0) * (T(1.0) - m2r), -T(2.0) * m2i, m2r * c + wr, m2i * c + wi)
     kr, ki = cdiv(qr, qi, cwr, cwi)
     return rsr, rsi, kr, ki

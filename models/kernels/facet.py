@@ -111,8 +111,8 @@ def transmission_factors(c, mr):
     inv_s = T(1.0) / den_s
     inv_p = T(1.0) / (mr * mr * c + w)
     ts = T(2.0) * c * inv_s
-    # each factor paired with its denominator: (mr - 1)(mr^2 - 1) alone overflows float32
-    # from mr ~ 1e13
+    # each factor paired with its denominator: (mr - 1)(mr^2 - 1) ~ mr^3 alone overflows
+    # float32 from mr ~ 7e12 (float32's largest: 3.4e38)
     delta = T(2.0) * c * ((mr - T(1.0)) * inv_s) * ((mr * mr - T(1.0)) * inv_p)
     return ts, delta * (T(1.0) / (w + mr * c))
 
