@@ -25,7 +25,7 @@ from . import evaluation, modelset
 from .evaluation import CHUNK
 from .geometry import broadcast_angles
 from .modelset import array_leaves
-from .params import Declared, check_finite_array, check_polar_angle, param
+from .params import Declared, param
 from .polarization import ellipsometric, stokes
 
 __all__ = ["Model", "Sum", "CHUNK"]
@@ -134,19 +134,19 @@ class Model(Declared):
 
     # -- validation and chunked evaluation ----------------------------------------
     def _angles(self, theta_i, theta_r, phi_r):
-        n1, n2, n3 = self._angle_names
-        ti = check_polar_angle(n1, theta_i)
-        tr = check_polar_angle(n2, theta_r)
-        pr = check_finite_array(n3, phi_r)
-        return broadcast_angles(ti, tr, pr)
+        return broadcast_angles(*evaluation.checked_angles(self, theta_i, theta_r, phi_r))
 
     @cached_property
     def _has_kernel(self) -> bool:
         return self._kernel_spec() is not None
 
+    def _kernel_path(self) -> bool:
+        """True when chunks go through the kernels here (a model set's chunks each build
+        their own, so the whole set's :attr:`_kernel` is never built)."""
+        return self._has_kernel and evaluation.current_backend() == "numba"
+
     def _plan(self, theta_i, theta_r, phi_r):
-        kernel = self._has_kernel and evaluation.current_backend() == "numba"
-        chunk = evaluation.KERNEL_CHUNK if kernel else evaluation.CHUNK
+        chunk = evaluation.KERNEL_CHUNK if self._kernel_path() else evaluation.CHUNK
         return evaluation.Plan(self, theta_i, theta_r, phi_r, chunk)
 
     def iter_mueller(self, theta_i, theta_r, phi_r=0.0):
@@ -207,7 +207,7 @@ class Model(Declared):
         """Evaluate ``plan`` into ``out`` chunk by chunk: the kernel where one covers the model
         (a model set's chunk is a model with flat parameters, with its own kernel rows),
         otherwise the numpy implementation (rounded to ``out``'s dtype)."""
-        kernel = self._has_kernel and evaluation.current_backend() == "numba"
+        kernel = self._kernel_path()
         for sl, ti, tr, pr, m in plan.blocks(fill=not kernel):
             if kernel:
                 m._kernel.write(out, sl, ti, tr, pr, precision)

@@ -69,6 +69,13 @@ def check_precision(precision):
     return precision
 
 
+def checked_angles(model, theta_i, theta_r, phi_r):
+    """The three angle inputs as float64 arrays, each validated under ``model``'s names for
+    them (two polar angles in [0, pi/2], a finite azimuth)."""
+    n1, n2, n3 = model._angle_names
+    return [check_polar_angle(n1, theta_i), check_polar_angle(n2, theta_r), check_finite_array(n3, phi_r)]
+
+
 class Plan:
     """The validated, broadcast evaluation of ``model`` at three angle inputs.
 
@@ -81,13 +88,8 @@ class Plan:
     """
 
     def __init__(self, model, theta_i, theta_r, phi_r, chunk):
-        n1, n2, n3 = model._angle_names
         self.model = model
-        self.inputs = [
-            check_polar_angle(n1, theta_i),
-            check_polar_angle(n2, theta_r),
-            check_finite_array(n3, phi_r),
-        ]
+        self.inputs = checked_angles(model, theta_i, theta_r, phi_r)
         self.leaves = model._sets
         shapes = [a.shape for a in self.inputs] + [a.shape for a in self.leaves.values()]
         self.shape = np.broadcast_shapes(*shapes)

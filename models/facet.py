@@ -39,7 +39,7 @@ import numpy as np
 
 from . import kernel_specs
 from .base import Model
-from .fresnel import coating_transmission, reflection_rs_k
+from .fresnel import coating_cos, coating_transmission, reflection_rs_k
 from .params import check_index, param
 from .polarization import mueller16_from_jones
 from .shadowing import SHADOWING, check_shadowing, smith_g
@@ -80,9 +80,7 @@ def _polar(ti, tr, n):
     if n == 1.0:
         return cos_ext, sin_ext, cos_ext
     sin_int = sin_ext * (1.0 / n)  # Eq. 2-3
-    # cos' = sqrt(n^2 - 1 + cos^2) / n: no cancellation at grazing incidence
-    cos_int = np.sqrt(n * n - 1.0 + cos_ext * cos_ext) * (1.0 / n)
-    return cos_ext, sin_int, cos_int
+    return cos_ext, sin_int, coating_cos(cos_ext, n)
 
 
 def _bisector(sin_int, cos_int, cp, sp):

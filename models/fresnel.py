@@ -30,6 +30,7 @@ __all__ = [
     "fresnel_transmittance",
     "reflection_rs_k",
     "coating_transmission",
+    "coating_cos",
     "critical_angle",
 ]
 
@@ -113,6 +114,17 @@ def reflection_rs_k(cos_i, m):
     rs = (c - w) / cw
     k = 2.0 * (1.0 - m2) / (cw * (m2 * c + w))
     return rs, k
+
+
+def coating_cos(cos_theta, n):
+    """Cosine of the refracted angle inside a non-absorbing coating ``n >= 1`` entered from
+    the ambient (index 1) at external cosine ``cos_theta``: ``sqrt(n^2 - 1 + c^2) / n``.
+
+    This form, not ``sqrt(1 - sin^2 / n^2)``: near grazing under a thin coating (``n ~ 1``)
+    the difference of two numbers near 1 loses the digits of ``c^2`` (in float32 all of
+    them), and for ``n = 1`` it is ``c`` exactly.  :mod:`models.kernels.common` has its
+    scalar twin."""
+    return np.sqrt(n * n - 1.0 + cos_theta * cos_theta) * (1.0 / n)
 
 
 def coating_transmission(cos_theta, n):

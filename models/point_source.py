@@ -29,16 +29,16 @@ in the radius (``resolution`` nodes, weight ``rho d rho``) times the periodic
 trapezoid rule in the azimuth (``2 resolution`` nodes) over the disc.
 
 Resolution.  The nodes must resolve the collimated lobe as the incidence sweeps over the
-disc: a fixed 16 leaves Cook-Torrance m = 0.01 at d/R = 3 off by 63% of the peak.  The
-default ``resolution="auto"`` takes ``N = max(16, ceil(10 s / w))`` per incidence, with
-``s`` the incidence spread over the sample (:meth:`incidence_range`) and ``w`` the inner
-model's lobe width (:meth:`Model.lobe`; 16 for a model without a narrow lobe).  For smooth
-lobes (Gaussian and Cook-Torrance slopes, GGX) of width 0.02 to 0.2 rad at d/R 1 to 10 the
-change on doubling ``N`` is at most 1e-6 of the peak (``tests/test_point_source_resolution.py``
-holds it there).  A cusped lobe (exponential slopes) converges only algebraically: ``"auto"``
-still leaves ~1e-2 of the peak at d/R <= 3; give a larger ``resolution`` and measure it
-(``scatterbench tradeoff``'s point-source resolution knob).  The cost grows as ``N^2``
-inner evaluations per geometry.
+disc: a fixed 16 leaves Cook-Torrance m = 0.01 at d/R = 3 off by more than half the peak
+(``tests/test_point_source_resolution.py`` shows it).  The default ``resolution="auto"``
+takes ``N = max(16, ceil(10 s / w))`` per incidence, with ``s`` the incidence spread over
+the sample (:meth:`incidence_range`) and ``w`` the inner model's lobe width
+(:meth:`Model.lobe`; 16 for a model without a narrow lobe).  For smooth lobes (Gaussian
+and Cook-Torrance slopes, GGX) of width 0.02 to 0.2 rad at d/R 1 and 3 the change on
+doubling ``N`` is at most 1e-6 of the peak (the same test holds it there).  A cusped lobe
+(exponential slopes) converges only algebraically and is not held to that bound: give a
+larger ``resolution`` and measure it (``scatterbench tradeoff``'s point-source resolution
+knob).  The cost grows as ``N^2`` inner evaluations per geometry.
 
 Shift approximation (Eq. 29-30).  Every local BRDF is taken to be the central
 one ``f_c = f(psi_c, ., .)`` shifted so that its specular direction follows the

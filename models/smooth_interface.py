@@ -23,7 +23,7 @@ import math
 import numpy as np
 from scipy import integrate
 
-from .fresnel import fresnel_reflectance
+from .fresnel import coating_cos, fresnel_reflectance
 
 __all__ = ["interface_amplitudes", "internal_hemispherical_reflectance", "depolarized_between"]
 
@@ -37,10 +37,7 @@ def interface_amplitudes(cos_ext, n):
     # ulps of pi/2) are exactly grazing, so theta = pi/2 gives exact zeros.
     c = np.where(c < 1e-15, 0.0, c)
     s_int = np.sqrt(1.0 - c * c) * (1.0 / n)
-    # cos_int from n^2 - sin^2 = n^2 - 1 + c^2, not 1 - sin_int^2: near grazing under a thin
-    # coating (n ~ 1) the difference of two numbers near 1 loses the digits of c^2 (in float32
-    # all of them: 60% off at 89.99 deg for n = 1)
-    c_int = np.sqrt(n * n - 1.0 + c * c) * (1.0 / n)
+    c_int = coating_cos(c, n)  # not sqrt(1 - s_int^2): that cancels near grazing
     root = 2.0 * np.sqrt(c * c_int)
     # For n = 1 at grazing both terms of the denominators vanish with the numerator
     # (a = 1 in the limit, but the ray carries no projected flux): 0/tiny = 0.

@@ -55,6 +55,7 @@ from .cook_torrance import (
     ct_kernel,
     fresnel_average,
 )
+from .fresnel import coating_cos
 from .params import Alias, convention_param, param
 from .slopes import GaussianSlopes
 from .stroke_slopes import StrokeSlopes
@@ -165,10 +166,7 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
         ci, cr, live = _grazing_safe(ti, tr)
         nv = self.coating
         ext = np.stack([ci, cr])
-        # Eq. 20-21: internal cosines (no TIR entering from air).
-        # cos' = sqrt(n_v^2 - 1 + cos^2) / n_v: exact for n_v = 1 and free of the
-        # cancellation of sqrt(1 - sin^2/n_v^2) at grazing incidence.
-        c_int = np.sqrt(nv * nv - 1.0 + ext * ext) * (1.0 / nv)
+        c_int = coating_cos(ext, nv)  # Eq. 20-21: internal cosines (no TIR entering from air)
         index = self.substrate if self.substrate == math.inf else complex(self.substrate) / nv  # Eq. 22
         val = ct_kernel(
             c_int[0], c_int[1], np.cos(pr), np.sin(pr), self._d_fn(), index, self.shadowing, self._smith()

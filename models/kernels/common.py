@@ -74,6 +74,18 @@ def cdiv(a, b, c, d):
 
 
 @njit(cache=True)
+def refraction_w(c, mr, mi):
+    """``m^2`` and ``w = m cos(theta_t) = sqrt(m^2 - 1 + c^2)`` (principal branch) as
+    ``(re, im)`` pairs, for cosine ``c`` and relative index ``m = mr + i mi``
+    (:mod:`models.fresnel`'s ``w``)."""
+    T = type(c)
+    m2r = mr * mr - mi * mi
+    m2i = mr * mi + mi * mr
+    wr, wi = csqrt(m2r - T(1.0) + c * c, m2i)
+    return m2r, m2i, wr, wi
+
+
+@njit(cache=True)
 def rs_k(c, mr, mi, pec):
     """``r_s`` and ``K = (r_s + r_p) / sin^2`` at cosine ``c`` for relative index ``m = mr + i mi``
     (:func:`models.fresnel.reflection_rs_k`); ``pec``: a perfect conductor."""
@@ -82,16 +94,22 @@ def rs_k(c, mr, mi, pec):
         return T(-1.0), T(0.0), T(0.0), T(0.0)
     if mr == T(1.0) and mi == T(0.0):
         return T(0.0), T(0.0), T(0.0), T(0.0)
-    m2r = mr * mr - mi * mi
-    m2i = mr * mi + mi * mr
-    wr, wi = csqrt(m2r - T(1.0) + c * c, m2i)
+    m2r, m2i, wr, wi = refraction_w(c, mr, mi)
     cwr, cwi = c + wr, wi
     rsr, rsi = cdiv(c - wr, -wi, cwr, cwi)
     # 2 (1 - m^2) / (m^2 c + w) / (c + w): two divisions, not one by the product, which
-    # overflows float32 from |m| ~ 1e10 (|m^2 c + w| |c + w| ~ |m|^3)
+    # overflows float32 from |m| ~ 7e12 (|m^2 c + w| |c + w| ~ |m|^3; float32's largest: 3.4e38)
     qr, qi = cdiv(T(2.0) * (T(1.0) - m2r), -T(2.0) * m2i, m2r * c + wr, m2i * c + wi)
     kr, ki = cdiv(qr, qi, cwr, cwi)
     return rsr, rsi, kr, ki
+
+
+@njit(cache=True)
+def coating_cos(c, n):
+    """Cosine of the refracted angle in a non-absorbing coating ``n`` from the external cosine
+    ``c`` (:func:`models.fresnel.coating_cos`: no cancellation near grazing)."""
+    T = type(c)
+    return math.sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)
 
 
 @njit(cache=True)

@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import cdiv, csqrt, stroke_d, write_diag
+from .common import cdiv, coating_cos, refraction_w, stroke_d, write_diag
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
@@ -23,9 +23,7 @@ def fresnel_average(c, mr, mi, pec):
         return T(1.0)
     if mr == T(1.0) and mi == T(0.0):
         return T(0.0)
-    m2r = mr * mr - mi * mi
-    m2i = mr * mi + mi * mr
-    wr, wi = csqrt(m2r - T(1.0) + c * c, m2i)
+    m2r, m2i, wr, wi = refraction_w(c, mr, mi)
     rsr, rsi = cdiv(c - wr, -wi, c + wr, wi)
     ar, ai = m2r * c, m2i * c
     rpr, rpi = cdiv(ar - wr, ai - wi, ar + wr, ai + wi)
@@ -70,9 +68,7 @@ def cook(ti, tr, pr, prm, j, iopt, out, i):
         scale = T(1.0 / (4.0 * math.pi)) if iopt[1] == 1 else T(1.0)
         write_diag(out, i, val * (scale / (ci * cr)))
         return
-    inv_nv = T(1.0) / nv
-    cii = math.sqrt(nv * nv - T(1.0) + ci * ci) * inv_nv
-    cri = math.sqrt(nv * nv - T(1.0) + cr * cr) * inv_nv
+    cii, cri = coating_cos(ci, nv), coating_cos(cr, nv)
     val = ct_value(cii, cri, cp, sp, prm, j, sub_r / nv, sub_i / nv, iopt[2] == 1)
     if nv != T(1.0):
         ti_ = T(1.0) - fresnel_average(ci, nv, T(0.0), False)

@@ -9,7 +9,7 @@ import math
 
 from numba import njit
 
-from .common import NO_SHADOWING, coating_t, p3, rs_k, smith_g, write_mueller
+from .common import NO_SHADOWING, coating_cos, coating_t, p3, rs_k, smith_g, write_mueller
 
 #: parameter rows of the facet reflection kernel
 FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
@@ -29,8 +29,7 @@ def facet_jones(ti, tr, pr, prm, j, iopt):
     else:
         inv_n = T(1.0) / n
         si, sr = si_e * inv_n, sr_e * inv_n
-        ci = math.sqrt(n * n - T(1.0) + ci_e * ci_e) * inv_n
-        cr = math.sqrt(n * n - T(1.0) + cr_e * cr_e) * inv_n
+        ci, cr = coating_cos(ci_e, n), coating_cos(cr_e, n)
     sp, cp = math.sin(pr), math.cos(pr)
     hx = sr * cp - si
     hy = sr * sp
@@ -112,8 +111,8 @@ def transmission_factors(c, mr):
     inv_s = T(1.0) / den_s
     inv_p = T(1.0) / (mr * mr * c + w)
     ts = T(2.0) * c * inv_s
-    # each factor paired with its denominator: (mr - 1)(mr^2 - 1) alone overflows float32
-    # from mr ~ 1e13
+    # each factor paired with its denominator: (mr - 1)(mr^2 - 1) ~ mr^3 alone overflows
+    # float32 from mr ~ 7e12 (float32's largest: 3.4e38)
     delta = T(2.0) * c * ((mr - T(1.0)) * inv_s) * ((mr * mr - T(1.0)) * inv_p)
     return ts, delta * (T(1.0) / (w + mr * c))
 

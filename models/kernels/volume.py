@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import write_mueller
+from .common import coating_cos, write_mueller
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
 SINGLE_ROWS = ("coating", "g")
@@ -19,16 +19,19 @@ DIFFUSE_ROWS = ("coating", "scale")
 def amplitudes(c, n):
     """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`."""
     T = type(c)
-    double = T(1e-300) > T(0.0)
     # a few ulps of pi/2 from grazing is grazing (as the numpy path); float32's pi/2 is 1.2e-7
-    # wide and rounds above pi/2 (a negative cosine)
-    if c < (T(1e-15) if double else T(2.4e-7)):
+    # wide and rounds above pi/2 (a negative cosine).  T(1e-300) is 0 in float32.
+    if c < (T(1e-15) if T(1e-300) > T(0.0) else T(2.4e-7)):
         c = T(0.0)
     s_int = math.sqrt(T(1.0) - c * c) * (T(1.0) / n)
-    c_int = math.sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)  # why this form: the numpy path
+    c_int = coating_cos(c, n)
     root = T(2.0) * math.sqrt(c * c_int)
-    tiny = T(1e-300) if double else T(1e-38)
-    return s_int, c_int, root / max(c + n * c_int, tiny), root / max(n * c + c_int, tiny)
+    # n = 1 at grazing: both denominators vanish with the numerator (no projected flux): 0;
+    # otherwise root / den <= 1 (den >= c + c_int >= root for n >= 1), so no guard is needed
+    den_s, den_p = c + n * c_int, n * c + c_int
+    a_s = root / den_s if den_s > T(0.0) else T(0.0)
+    a_p = root / den_p if den_p > T(0.0) else T(0.0)
+    return s_int, c_int, a_s, a_p
 
 
 @njit(cache=True, inline="always")

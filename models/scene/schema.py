@@ -26,6 +26,7 @@ __all__ = [
     "parse",
     "check_structure",
     "shown",
+    "is_number",
     "where",
     "long_digits",
     "read_utf8",
@@ -110,19 +111,21 @@ def check_structure(data, path: str) -> None:
                 stack.append((keys + (k,), x))
         elif isinstance(v, list):
             stack.extend((keys + (i,), x) for i, x in enumerate(v))
-        elif isinstance(v, int) and not isinstance(v, bool) and not _float_holds(v):
+        elif isinstance(v, int) and not isinstance(v, bool) and not is_number(v):
             raise _err(
                 path, _key_path(keys), f"{str(v)[:20]}... ({len(str(v))} digits) is too large a number"
             )
 
 
-def _float_holds(v: int) -> bool:
-    """True when ``float(v)`` is finite (Python rounds; past the largest float it overflows)."""
+def is_number(value) -> bool:
+    """True for a finite real number a file can give (an int or a float, not a bool) that a
+    float can hold (an integer past the largest float overflows, and is no number here)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
     try:
-        float(v)
+        return math.isfinite(value)
     except OverflowError:
         return False
-    return True
 
 
 def parse(data: dict, path: str) -> dict:
@@ -169,7 +172,7 @@ def _unknown(path, section, table, allowed):
 
 def _number(path, key, value, low=None, high=None, low_open=False):
     """A quantity of the scene itself (not a model parameter): a finite number in range."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if not is_number(value):
         raise _err(path, key, f"must be a finite number; got {shown(value)}")
     if low is not None and (value < low or (low_open and value == low)):
         raise _err(path, key, f"must be {'>' if low_open else '>='} {low:g}; got {shown(value)}")

@@ -61,7 +61,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from models.polarization import ellipsometric, stokes
-from models.scene.schema import long_digits, read_utf8, shown, where
+from models.scene.schema import is_number, long_digits, read_utf8, shown, where
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -243,9 +243,9 @@ def _sidecar_problem(key, value):
         return f"format must be {FORMAT!r}; got {shown(value)}"
     if key in ("sample", "instrument", "description") and not isinstance(value, str):
         return f"{key} must be a string; got {shown(value)}"
-    if key == "wavelength_nm" and not (_is_num(value) and value > 0):
+    if key == "wavelength_nm" and not (is_number(value) and value > 0):
         return f"wavelength_nm must be a finite number > 0; got {shown(value)}"
-    if key == "aperture_deg" and not (_is_num(value) and 0 <= value <= 90):
+    if key == "aperture_deg" and not (is_number(value) and 0 <= value <= 90):
         return f"aperture_deg must be a number in [0, 90]; got {shown(value)}"
     if key == "incident_polarization":
         try:
@@ -256,18 +256,9 @@ def _sidecar_problem(key, value):
         if not isinstance(value, dict):
             return "truth must be an object {scene key: value}"
         for k, v in value.items():
-            if not _is_num(v):
+            if not is_number(v):
                 return f"truth: {k}: must be a finite number (the true value); got {shown(v)}"
     return None
-
-
-def _is_num(v):
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        return False
-    try:
-        return math.isfinite(v)
-    except OverflowError:  # an integer no float can hold
-        return False
 
 
 def _range_text(lo, hi, lo_open, hi_open):
