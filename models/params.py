@@ -193,7 +193,10 @@ def check_real(name, value, low=None, high=None, low_open=False, high_open=False
             value = complex(value).real
         else:
             raise ValueError(f"{name} must be {rng}; got {value!r}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an integer no float can hold
+        v = math.inf
     if not math.isfinite(v):
         raise ValueError(f"{name} must be {rng}; got {value!r}")
     bad = (low is not None and (v < low or (low_open and v == low))) or (

@@ -35,7 +35,7 @@ def _positive(name, value):
     try:
         if isinstance(value, numbers.Real):
             return check_real(name, value, low=0.0, low_open=True)
-    except (ValueError, OverflowError):  # OverflowError: an integer no float can hold
+    except ValueError:
         pass
     raise ValueError(f"{name} must be a finite number > 0; got {value!r}")
 
