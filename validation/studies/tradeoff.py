@@ -325,9 +325,9 @@ def knob_precision(quick=False, model=None):
             f"{type(model).__name__} has no float32 kernel: it evaluates in float64 (and rounds a "
             "float32 request), so there is no float32 cost to measure"
         )
-    rng = np.random.default_rng(12)
-    ti, tr = rng.uniform(0, math.radians(85), (2, 4096))
-    pr = rng.uniform(-math.pi, math.pi, 4096)
+    from validation.checks.common import random_geometries  # not at import: it loads every check
+
+    ti, tr, pr = random_geometries(4096, seed=12, max_deg=85.0)
     measured = {
         bits: time_call(functools.partial(at_precision(model, f"float{bits}"), ti, tr, pr))
         for bits in (32, 64)  # cheaper and coarser first, as on every knob
