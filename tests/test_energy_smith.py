@@ -90,5 +90,7 @@ def test_smith_albedo_check_passes_and_goes_red_on_a_broken_input():
     broken = [_curve((0.99, 1.01, 0.98)), ok[1]]  # 1e-2 above 1, error 1e-4
     r = spec.func(CheckContext(), curves=broken)
     assert r.status == "fail" and r.measured == pytest.approx(0.01 - 1e-4)
-    unconverged = [dataclasses.replace(ok[0], converged=(True, False, True)), ok[1]]
-    assert spec.func(CheckContext(), curves=unconverged).status == "fail"
+    unconverged = dataclasses.replace(ok[0], converged=(True, False, True))
+    assert spec.func(CheckContext(), curves=[unconverged, ok[1]]).status == "fail"
+    # wherever the unconverged curve stands among the Smith curves
+    assert spec.func(CheckContext(), curves=[ok[0], unconverged, ok[1]]).status == "fail"

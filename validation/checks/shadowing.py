@@ -96,13 +96,19 @@ def conductor_albedo_curves(widths=WIDTHS, angles_deg=ANGLES_DEG, shadowings=("n
     return out
 
 
+def _worst_first(x):
+    """Sort key of an excess: NaN (an integral that did not converge) above everything, so a
+    maximum keeps it wherever it stands (``max`` alone keeps a NaN only when it comes first)."""
+    return math.inf if math.isnan(x) else x
+
+
 def _excess(curve):
     """Largest ``albedo - 1 - error`` of a curve (NaN where an integral did not converge)."""
     vals = [
         v - 1.0 - e if ok else math.nan
         for v, e, ok in zip(curve.albedo, curve.error, curve.converged, strict=True)
     ]
-    return max(vals, key=lambda x: math.inf if math.isnan(x) else x)
+    return max(vals, key=_worst_first)
 
 
 @check(paper="issue 15: Smith shadowing-masking keeps a perfect conductor's albedo <= 1")
@@ -114,7 +120,7 @@ def check_smith_albedo(ctx, curves=None):
         curves = ctx.compute(conductor_albedo_curves, angles_deg=angles)
     smith = [c for c in curves if c.shadowing == "smith"]
     none = [c for c in curves if c.shadowing == "none"]
-    worst = max(smith, key=_excess)
+    worst = max(smith, key=lambda c: _worst_first(_excess(c)))
     top = max(none, key=lambda c: max(c.albedo), default=None)
     unshadowed = "" if top is None else f"; without shadowing up to {max(top.albedo):.4g} ({top.label})"
     return judge(

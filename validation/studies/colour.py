@@ -111,12 +111,11 @@ def dominant_wavelength(wavelengths_nm, reflectance):
     return float(wl)
 
 
-def _model_reflectance(model, theta_i, views, wavelengths_nm):
-    """The model's BRDF at in-plane ``views`` and each wavelength over the same model's with
-    a perfect-mirror substrate (module docstring): shape ``(len(views), len(wavelengths))``."""
-    tr, pr = (np.array(v) for v in zip(*views, strict=True))
+def _model_reflectance(model, theta_i, tr, pr, wavelengths_nm):
+    """The model's BRDF at the views ``(tr, pr)`` and each wavelength over the same model's
+    with a perfect-mirror substrate (module docstring): shape ``(len(tr), len(wavelengths))``."""
     mirror = model.replace(substrate=math.inf).brdf(theta_i, tr, pr)
-    out = np.empty((len(views), len(wavelengths_nm)))
+    out = np.empty((len(tr), len(wavelengths_nm)))
     for j, wl in enumerate(wavelengths_nm):
         out[:, j] = model.replace(substrate=model.substrate.at(float(wl))).brdf(theta_i, tr, pr) / mirror
     return out
@@ -130,22 +129,20 @@ def colour_travel(model, theta_i, aspecular_deg=ASPECULAR_DEG, wavelengths_nm=WA
     if not isinstance(stack, models.FilmStack):
         raise ValueError(f"model must be a facet model with a FilmStack substrate; got {model!r}")
     n = float(getattr(model, "coating", 1.0))
-    locals_, views = [], []
-    for a in aspecular_deg:
-        # toward the incident side for positive values (the paint industry's convention)
-        tr, pr = (float(v) for v in models.geometry.signed_inplane(theta_i - math.radians(a)))
-        if not 0.0 <= tr < 0.5 * math.pi:
-            raise ValueError(f"aspecular_deg {a!r} puts the view below the surface at theta_i = {theta_i!r}")
-        views.append((tr, pr))
-        locals_.append(
-            math.degrees(math.acos(min(float(models.facet.local_cosine(theta_i, tr, pr, n)), 1.0)))
-        )
+    aspecular = np.asarray(aspecular_deg, dtype=float).reshape(-1)
+    # toward the incident side for positive values (the paint industry's convention)
+    tr, pr = models.geometry.signed_inplane(theta_i - np.radians(aspecular))
+    below = ~((tr >= 0.0) & (tr < 0.5 * math.pi))
+    if below.any():
+        a = float(aspecular[np.argmax(below)])
+        raise ValueError(f"aspecular_deg {a!r} puts the view below the surface at theta_i = {theta_i!r}")
+    cos_local = models.facet.local_cosine(np.full_like(tr, theta_i), tr, pr, n)
     wl = np.asarray(wavelengths_nm, dtype=float)
-    refl = _model_reflectance(model, theta_i, views, wl)
+    refl = _model_reflectance(model, theta_i, tr, pr, wl)
     return ColourTravel(
         float(math.degrees(theta_i)),
-        tuple(float(a) for a in aspecular_deg),
-        tuple(locals_),
+        tuple(float(a) for a in aspecular),
+        tuple(float(d) for d in np.degrees(np.arccos(np.minimum(cos_local, 1.0)))),
         wl,
         refl,
         srgb(wl, refl),

@@ -56,15 +56,10 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
 
 def _pick(knob, tol, notes, **kw):
     """The cheapest measured setting of ``knob`` (run with ``kw``) meeting ``tol`` (the most
-    accurate when none does, said so in ``notes``); ``None``, said so, when the knob cannot
-    be measured."""
-    from .tradeoff import KNOBS, KnobUnavailable, choose
+    accurate when none does, said so in ``notes``)."""
+    from .tradeoff import KNOBS, choose
 
-    try:
-        r = KNOBS[knob](quick=True, **kw)
-    except KnobUnavailable as exc:
-        notes.append(f"{knob}: not measured ({exc})")
-        return None
+    r = KNOBS[knob](quick=True, **kw)
     p = choose(r, tol)
     if p is None:
         p = min(r.points, key=lambda q: q.error)

@@ -21,9 +21,8 @@ Costs are per call, the best over repeated short batches (:func:`time_call`): a
 setting is called in batches of about :data:`BATCH` seconds until at least
 :data:`MIN_WORK` seconds of work have accumulated over at least :data:`MIN_BATCHES`
 batches, after one untimed warm-up call.  A single timing of a sub-millisecond call
-measures the machine's noise, not the setting (the grid curve ran backwards that
-way: 91 points "cost" more than 361).  Each point keeps the spread of its batches
-beside the best.
+measures the machine's noise, not the setting.  Each point keeps the spread of its
+batches beside the best.
 
 ``pareto`` keeps the settings no other setting beats on both cost and error;
 ``choose(knob, tol)`` returns the cheapest setting whose *measured* error meets
@@ -70,9 +69,9 @@ __all__ = [
 MIN_WORK = 0.2
 #: The fewest timed batches per setting.
 MIN_BATCHES = 3
-#: Target length of one timed batch (s): ~1e4 times perf_counter's resolution, and short
-#: enough that on a busy machine some batches run undisturbed (with 40 ms batches at load 16
-#: on 2 cores every batch was preempted and a 130 us call measured 1.7 ms).
+#: Target length of one timed batch (s): far above the clocks' resolution (perf_counter and
+#: process_time: 1e-9 s on Linux, ``time.get_clock_info``), and short enough that on a busy
+#: machine some batches run undisturbed (the cost is the best batch).
 BATCH = 2e-3
 
 
@@ -325,9 +324,9 @@ def knob_precision(quick=False, model=None):
             f"{type(model).__name__} has no float32 kernel: it evaluates in float64 (and rounds a "
             "float32 request), so there is no float32 cost to measure"
         )
-    rng = np.random.default_rng(12)
-    ti, tr = rng.uniform(0, math.radians(85), (2, 4096))
-    pr = rng.uniform(-math.pi, math.pi, 4096)
+    from validation.checks.common import random_geometries  # not at import: it loads every check
+
+    ti, tr, pr = random_geometries(4096, seed=12, max_deg=85.0)
     measured = {
         bits: time_call(functools.partial(at_precision(model, f"float{bits}"), ti, tr, pr))
         for bits in (32, 64)  # cheaper and coarser first, as on every knob
