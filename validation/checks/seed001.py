@@ -14,6 +14,7 @@ import numpy as np
 import models
 import references
 from models.cook_torrance import fresnel_real_printed
+from models.facet import local_cosine
 from models.geometry import refracted_cos
 from validation.numerics.integrate import integrated_reflectance
 from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
@@ -373,13 +374,9 @@ def varnish_ratio_map(m=0.1, nv=1.5, sub=IRON, ti_deg=(0.0, 30.0, 60.0, 80.0), n
         T, P = np.meshgrid(tr, pr, indexing="ij")
         a, b, c = v.brdf(ti, T, P), s.brdf(ti, T, P), vr.brdf(ti, T, P)
         live = (a > 0) & (b > 0)
-        ci, cr = math.cos(ti), np.cos(T)
-        cI = math.sqrt(1 - (math.sin(ti) / nv) ** 2)
-        cR = np.sqrt(1 - (np.sin(T) / nv) ** 2)
-        jac = nv * nv * cI * cR / (ci * cr)
         out[t] = {
             "ratio": a[live] / b[live],
-            "jacobian": jac[live],
+            "jacobian": _jacobian(ti, T, nv)[live],
             "residual": c[live] / b[live],
             "n": int(live.sum()),
         }
@@ -399,12 +396,7 @@ def inplane_coupling_error(m=0.1, nv=1.5, sub=IRON, n=4000, seed=6):
     pr = rng.choice([0.0, math.pi], n)
     vr, s = _pair(m, nv, sub, "refracted")
     a, b = vr.brdf(ti, tr, pr), s.brdf(ti, tr, pr)
-    # local angle inside the varnish (internal bisector)
-    si, sr = np.sin(ti) / nv, np.sin(tr) / nv
-    ci, cr = np.sqrt(1 - si * si), np.sqrt(1 - sr * sr)
-    hx = sr * np.cos(pr) - si
-    hz = ci + cr
-    c_loc = 0.5 * np.sqrt(hx * hx + hz * hz)
+    c_loc = local_cosine(ti, tr, pr, nv)  # local angle inside the varnish (internal bisector)
     Rs, Rp = models.fresnel_reflectance(c_loc, nv, sub)
     Tis, Tip = (1 - r for r in models.fresnel_reflectance(np.cos(ti), 1.0, nv))
     Tos, Top = (1 - r for r in models.fresnel_reflectance(np.cos(tr), 1.0, nv))
