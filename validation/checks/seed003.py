@@ -24,7 +24,7 @@ from validation.numerics.reciprocity import reciprocity_error
 
 from .common import count_extremes, random_geometries
 from .conformance_scatmech import SCATMECH_FLOOR, scatmech_tolerance
-from .fig1 import SIGMAS, fig1
+from .fig1 import N_INDEX, SIGMAS, THETA_I, fig1
 from .registry import Finding, check, judge, text_section
 
 __all__ = ["scatmech_seed003_errors", "scatmech_error_distributions", "mc_energy_samples"]
@@ -223,12 +223,17 @@ def fig1_rows():
     return tuple(fig1(SIGMAS))
 
 
+def _snell_deg():
+    """Snell's refraction angle of Fig. 1's incidence into its index (degrees)."""
+    return math.degrees(math.asin(math.sin(THETA_I) / N_INDEX))
+
+
 @check(paper="seed 003 Fig. 1 (Snell shift of facet transmission)")
 def check_fig1(ctx):
     rows = fig1_rows()
     peaks = [r["peak_deg"] for r in rows]
     neff = [r["n_eff"] for r in rows]
-    snell = math.degrees(math.asin(math.sin(math.radians(60.0)) / 1.5))
+    snell = _snell_deg()
     out = []
     p01 = next(r["peak_deg"] for r in rows if r["sigma"] == 0.1)
     out.append(
@@ -243,7 +248,7 @@ def check_fig1(ctx):
     out.append(
         judge(
             "Fig. 1: peak moves monotonically toward theta_i",
-            float(max(0.0, -steps.min())) + float(max(0.0, peaks[-1] - 60.0)),
+            float(max(0.0, -steps.min())) + float(max(0.0, peaks[-1] - math.degrees(THETA_I))),
             0.0,
             "peaks (deg): " + ", ".join(f"{p:.1f}" for p in peaks),
         )
@@ -251,7 +256,7 @@ def check_fig1(ctx):
     out.append(
         judge(
             "Fig. 1: narrow sigma follows Snell (n_eff = n)",
-            abs(neff[0] - 1.5) / 1.5,
+            abs(neff[0] - N_INDEX) / N_INDEX,
             0.01,
             f"sigma 0.05: n_eff {neff[0]:.4f}, max residual from the line {rows[0]['linear_residual']:.4f}",
         )
@@ -279,8 +284,8 @@ def fig1_text(ctx):
             f" {r['sigma']:5.2f}   {r['peak_deg']:10.2f}   {r['n_eff']:6.3f}   {r['linear_residual']:16.4f}"
         )
     lines.append(
-        " (Gaussian slopes, n = 1.5; peaks at theta_i = 60 deg, Snell 35.26 deg; n_eff from sin(mean theta_t)"
-        " = sin(theta_i)/n_eff over theta_i = 0..80 deg)"
+        f" (Gaussian slopes, n = {N_INDEX:g}; peaks at theta_i = {math.degrees(THETA_I):g} deg, Snell"
+        f" {_snell_deg():.2f} deg; n_eff from sin(mean theta_t) = sin(theta_i)/n_eff over theta_i = 0..80 deg)"
     )
     return "Seed 003 Fig. 1: Snell shift of facet transmission", "\n".join(lines)
 
