@@ -99,6 +99,15 @@ def local_cosine(ti, tr, pr, n):
     return 0.5 * np.sqrt(hx * hx + hy * hy + hz * hz)
 
 
+def facet_slopes(ti, tr, pr, n):
+    """``(zeta_x, zeta_y)``: the slopes of the facet that reflects ``ti`` into ``(tr, pr)``
+    in a coating of index ``n`` (``h_xy / h_z``, Eq. 2-7), where :func:`facet_jones` reads
+    the slope density."""
+    _, sin_int, cos_int = _polar(ti, tr, n)
+    hx, hy, hz = _bisector(sin_int, cos_int, np.cos(pr), np.sin(pr))
+    return hx / hz, hy / hz
+
+
 def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     """Jones elements ``(ss, ps, sp, pp)`` as ``(re, im)`` pairs of flat arrays
     (``ps`` = p in, s out), scaled so that their Mueller matrix is the BRDF.

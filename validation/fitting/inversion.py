@@ -30,7 +30,7 @@ import numpy as np
 from scipy import integrate, interpolate
 
 from models.base import Sum
-from models.facet import _FacetModel
+from models.facet import _FacetModel, facet_slopes
 from models.slopes import UnitSlopes
 
 __all__ = [
@@ -61,13 +61,7 @@ def facet_term(model):
 
 def probed_slopes(model, ti, tr, pr):
     """``(zeta_x, zeta_y)`` of the facet that connects the directions (seed 000 Eq. 2-7)."""
-    n = facet_term(model)._coating()
-    si, sr = np.sin(ti) / n, np.sin(tr) / n
-    ci, cr = np.sqrt(1 - si * si), np.sqrt(1 - sr * sr)
-    hx = sr * np.cos(pr) - si
-    hy = sr * np.sin(pr)
-    hz = cr + ci
-    return hx / hz, hy / hz
+    return facet_slopes(ti, tr, pr, facet_term(model)._coating())
 
 
 def unit_response(model, data):
