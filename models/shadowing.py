@@ -46,6 +46,7 @@ from .slopes import (
 )
 
 __all__ = [
+    "azimuthal_width",
     "SHADOWING",
     "LambdaTable",
     "lambda_gaussian",
@@ -199,13 +200,20 @@ def smith_lambda(slopes, cos_theta, sin_theta, cos_phi, sin_phi):
         mu = np.where(s > 0, c / np.where(s > 0, s, 1.0), np.inf)  # |cot theta|
     if slopes.isotropic:
         return _isotropic_lambda(slopes, mu)
+    unit, alpha = azimuthal_width(slopes, cos_phi, sin_phi)
+    return _isotropic_lambda(unit, mu / alpha)
+
+
+def azimuthal_width(slopes, cos_phi, sin_phi):
+    """``(unit, alpha)`` of elliptical slopes: their isotropic unit distribution, and their
+    width along azimuth ``phi`` (the slope component along ``phi`` is ``alpha`` times the
+    unit distribution's), ``alpha^2 = (sigma_x cos phi')^2 + (sigma_y sin phi')^2`` with
+    ``phi' = phi - rotation``."""
     unit, ax, ay, rot = _unit(slopes)
-    # azimuth in the distribution's axes: phi' = phi - rotation
     cr, sr = math.cos(rot), math.sin(rot)
     cl = cos_phi * cr + sin_phi * sr
     sl = sin_phi * cr - cos_phi * sr
-    alpha = np.sqrt((ax * cl) ** 2 + (ay * sl) ** 2)
-    return _isotropic_lambda(unit, mu / alpha)
+    return unit, np.sqrt((ax * cl) ** 2 + (ay * sl) ** 2)
 
 
 def smith_g1(slopes, cos_theta, sin_theta, cos_phi, sin_phi, cos_local=None):

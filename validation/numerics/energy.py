@@ -47,6 +47,7 @@ import math
 import numpy as np
 
 from models.fresnel import fresnel_reflectance
+from models.shadowing import azimuthal_width
 from models.slopes import AnisotropicGGXSlopes, GGXSlopes
 
 __all__ = ["hit_fraction", "exposed_reflectance", "tail_radius", "TAIL_TOL"]
@@ -107,10 +108,8 @@ def hit_fraction(slopes, theta_i, coating=1.0):
     ti = math.asin(math.sin(theta_i) / coating)
     tan = math.tan(ti)
     if hasattr(slopes, "_isotropic_unit"):
-        alpha_b = math.hypot(
-            slopes.sigma_x * math.cos(slopes.rotation), slopes.sigma_y * math.sin(slopes.rotation)
-        )
-        return slopes.coverage * _hit_fraction(slopes._isotropic_unit(), tan * alpha_b)
+        unit, alpha_b = azimuthal_width(slopes, 1.0, 0.0)  # the beam's azimuth, phi = 0
+        return slopes.coverage * _hit_fraction(unit, tan * float(alpha_b))
     return _hit_fraction(slopes, tan)
 
 
