@@ -31,6 +31,7 @@ import numpy as np
 import models
 from benchmarks.speed import best_of
 from validation.checks.common import random_geometries
+from validation.studies.tradeoff import precision_error
 
 AL = 1.37 + 7.62j
 MODELS = {
@@ -89,17 +90,14 @@ def small_calls(repeat):
 
 
 def float32(n, repeat):
-    """``(float64 us, float32 us, error)`` per geometry, SubsurfaceFacetBRDF; the error as
-    :func:`validation.studies.tradeoff.knob_precision` defines it: max |M32 - M64| over every
-    element and geometry, divided by max M64_00."""
+    """``(float64 us, float32 us, error)`` per geometry, SubsurfaceFacetBRDF; the error is
+    the precision knob's (:func:`validation.studies.tradeoff.precision_error`)."""
     m = models.SubsurfaceFacetBRDF()
     ti, tr, pr = geometries(n)
     m.mueller(ti[:10], tr[:10], pr[:10], precision="float32")
     t64 = best_of(lambda: m.mueller(ti, tr, pr), repeat)[0]
     t32 = best_of(lambda: m.mueller(ti, tr, pr, precision="float32"), repeat)[0]
-    M64 = m.mueller(ti, tr, pr)
-    M32 = m.mueller(ti, tr, pr, precision="float32").astype(float)
-    err = float(np.max(np.abs(M32 - M64)) / np.max(M64[..., 0, 0]))
+    err = precision_error(m.mueller(ti, tr, pr, precision="float32"), m.mueller(ti, tr, pr))
     return 1e6 * t64 / n, 1e6 * t32 / n, err
 
 

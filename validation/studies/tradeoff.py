@@ -51,6 +51,7 @@ __all__ = [
     "Point",
     "KnobResult",
     "KnobUnavailable",
+    "precision_error",
     "register_knob",
     "KNOBS",
     "MIN_WORK",
@@ -309,6 +310,12 @@ def at_precision(model, precision):
     return functools.partial(model.mueller, precision=precision)
 
 
+def precision_error(mueller, reference):
+    """The precision knob's error: max ``|M - M_ref|`` over every element and geometry, divided
+    by max ``M00_ref`` (``reference``: the float64 evaluation)."""
+    return float(np.max(np.abs(mueller.astype(np.float64) - reference)) / np.max(reference[..., 0, 0]))
+
+
 @register_knob("precision")
 def knob_precision(quick=False, model=None):
     """The Mueller matrix in float32 and float64 on 4096 random geometries, against the
@@ -332,11 +339,7 @@ def knob_precision(quick=False, model=None):
         for bits in (32, 64)  # cheaper and coarser first, as on every knob
     }
     ref = measured[64][0]
-    scale = np.max(ref[..., 0, 0])
-    points = [
-        _point(bits, np.max(np.abs(M.astype(np.float64) - ref)) / scale, cost, ti.size)
-        for bits, (M, cost) in measured.items()
-    ]
+    points = [_point(bits, precision_error(M, ref), cost, ti.size) for bits, (M, cost) in measured.items()]
     return KnobResult(
         "precision",
         f"Mueller matrix of {model!r} on 4096 random geometries (theta < 85 deg); "
