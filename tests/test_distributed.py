@@ -6,6 +6,7 @@ processes and in-process."""
 import json
 from dataclasses import dataclass
 
+import command_files
 import numpy as np
 import pytest
 
@@ -125,16 +126,6 @@ def test_stability_command_rejects_a_bad_worker_count(capsys):
     assert "error: argument --workers: must be an integer >= 1; got 0" in capsys.readouterr().err
 
 
-FACETS = """name = "facets"
-[illumination]
-theta_i_deg = 45.0
-[substrate]
-index = 1.5
-distribution = "gaussian"
-sigma = 0.2
-"""
-
-
 @pytest.mark.parametrize("command", ["fit", "stability"])
 def test_an_unreachable_scheduler_is_an_input_error(command, monkeypatch, tmp_path, capsys):
     """No scheduler at the address: ``error: scheduler: ...``, exit 2 (not an internal error)."""
@@ -143,19 +134,10 @@ def test_an_unreachable_scheduler_is_an_input_error(command, monkeypatch, tmp_pa
     monkeypatch.setattr(executors, "SCHEDULER_TIMEOUT", 2)
     flags = ["--scheduler", "tcp://127.0.0.1:1"]
     if command == "fit":
-        (tmp_path / "s.toml").write_text(FACETS)
-        rows = "".join(f"45,{t},0,0.1,unpolarized\n" for t in (10, 20, 30, 40))
-        (tmp_path / "d.csv").write_text("theta_i_deg,theta_r_deg,phi_r_deg,brdf,incident\n" + rows)
-        argv = [
-            "fit",
-            str(tmp_path / "d.csv"),
-            "--scene",
-            str(tmp_path / "s.toml"),
-            "--out",
-            str(tmp_path / "o"),
-        ]
-        argv += ["--free", "sigma:0.01:1:log", "--noise", "brdf=0.1", "--walkers", "4", "--max-steps", "4"]
-        argv += ["--starts", "1", "--no-progress", "--no-plots", *flags]
+        (tmp_path / "s.toml").write_text(command_files.SCENE)
+        (tmp_path / "d.csv").write_text(command_files.DATA)
+        argv = ["fit", str(tmp_path / "d.csv"), "--scene", str(tmp_path / "s.toml")]
+        argv += ["--out", str(tmp_path / "o"), *command_files.FAST, *flags]
     else:
         argv = ["stability", "--no-energy", *flags]
     assert main(argv) == 2

@@ -60,7 +60,9 @@ def site(tmp_path_factory):
 def test_build_has_no_warnings(site):
     out, seconds = site
     assert (out / "index.html").is_file()
-    assert seconds < 900  # a quarter of CI's 90-minute budget at most; about 2 minutes here
+    # a cap against a build gone wrong (a gallery example that hangs, say), far above the time
+    # it takes: 37.9 s on the two shared cores here (the fixture prints it; pytest -s)
+    assert seconds < 900
 
 
 def test_api_reference_covers_every_public_name(site):

@@ -54,11 +54,13 @@ def test_tail_radius_is_derived_for_power_law_slopes_only():
 
 
 def test_exposed_reflectance_of_ggx_matches_the_integrator():
+    # within 3 x the integrator's own error estimate (measured: |difference| <= 0.51 of it,
+    # 3.3e-6 to 4.6e-6 against estimates of 8.8e-6 to 9.2e-6)
     for alpha, deg in ((0.1, 30.0), (0.3, 60.0), (1.0, 75.0)):
         ti = math.radians(deg)
         s = models.GGXSlopes(alpha)
         r = integrated_reflectance(models.FacetBRDF(slopes=s, substrate=math.inf), ti, tol=1e-5)
-        assert abs(exposed_reflectance(s, ti, math.inf) - r.value) <= 3 * r.error + 1e-6
+        assert abs(exposed_reflectance(s, ti, math.inf) - r.value) <= 3 * r.error
 
 
 def test_albedo_curves_with_and_without_smith():

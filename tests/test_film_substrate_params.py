@@ -4,7 +4,6 @@ and a scene binding and a fit with a free film thickness work (they crashed on i
 
 import dataclasses
 import math
-import os
 
 import numpy as np
 import pytest
@@ -18,7 +17,7 @@ from validation.fitting.fitspec import fitspec_from
 from validation.fitting.likelihood import Likelihood
 from validation.fitting.recovery import subsample
 
-PEARL = os.path.join(os.path.dirname(references.__file__), "scenes", "pearlescent_mica_tio2.toml")
+PEARL = references.scene_path("pearlescent_mica_tio2.toml")
 THICKNESS = "substrate.film.layers[0].thickness_nm"
 STACK = models.FilmStack(layers=((2.6, 130.0),), substrate=1.58, wavelength_nm=550.0)
 

@@ -25,9 +25,8 @@ from validation.fitting.sampling import (
     run_chain,
 )
 
-SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
-COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
-FITSCENE = os.path.join(SCENES, "aluminium_flakes_fit.toml")
+COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
+FITSCENE = references.scene_path("aluminium_flakes_fit.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
 
 
@@ -116,7 +115,7 @@ def test_likelihood_prefers_the_truth_and_uses_declared_terms(coated, data):
     with pytest.raises(ValueError, match="noise.brdf"):
         Likelihood(coated, spec, data)
     # "off" drops a term the scene's [fit.noise] declares (a BRDF-only fit of polarimetric data)
-    sc = scene.load(os.path.join(SCENES, "aluminium_flakes_fit.toml"))
+    sc = scene.load(FITSCENE)
     assert Likelihood(sc, fitspec_from(sc), data).terms == ("brdf", "eta", "P", "P_C")
     off = fitspec_from(sc, None, ["eta_deg=off", "P=off"])
     assert off.off == ("eta_deg", "P") and "eta_deg" not in off.noise
@@ -137,7 +136,7 @@ def test_batched_likelihood_equals_the_scene_rebuilt_per_walker(scene_file, data
     """All walkers in one call (a model set bound to the scene's keys) give the ln L of the
     scene rebuilt and validated per walker, to 1e-12; a single position is a batch of one,
     so the two agree bit for bit whatever the batch."""
-    sc = scene.load(os.path.join(SCENES, scene_file))
+    sc = scene.load(references.scene_path(scene_file))
     lik = Likelihood(sc, fitspec_from(sc), subsample(load_data(references.data_path(data_file)), 60))
     assert lik.binding is not None
     b = lik.spec.u_bounds()

@@ -9,6 +9,7 @@ import pytest
 
 import models
 from models.params import INDEX_MAX, INDEX_MIN
+from validation.checks.common import random_geometries
 
 S = models
 HALF = 0.5 * math.pi
@@ -39,9 +40,7 @@ def _extreme_models():
 
 
 def _geometries():
-    rng = np.random.default_rng(3)
-    ti, tr = rng.uniform(0, HALF, (2, 300))
-    pr = rng.uniform(-math.pi, math.pi, 300)
+    ti, tr, pr = random_geometries(300, seed=3, max_deg=90.0)
     grazing = math.radians(89.99)
     edge_t = [0.0, HALF, HALF, grazing, grazing, 0.6, 1.2, HALF - 1e-9]
     edge_r = [0.0, HALF, 0.3, grazing, grazing, 0.6, 1.2, HALF - 1e-9]

@@ -16,7 +16,7 @@ from validation.fitting.inversion import UnitSlopes, bootstrap, fit_curve, inver
 from validation.fitting.likelihood import scene_for_data
 
 DATA = references.data_path("scatmech_flake_measurement.csv")
-COATED = os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
+COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 
 
 def _synthetic(model):

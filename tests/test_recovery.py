@@ -17,8 +17,7 @@ from validation.fitting.likelihood import Likelihood
 from validation.fitting.recovery import recovery_study, subsample
 from validation.fitting.settings import ChainSettings
 
-SCENES = os.path.join(os.path.dirname(references.__file__), "scenes")
-COATED = os.path.join(SCENES, "aluminium_flakes_clearcoat.toml")
+COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
 
 

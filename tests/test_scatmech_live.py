@@ -63,7 +63,7 @@ def test_comparison_scenes_at_the_truth_reproduce_their_scatmech_generators(scen
     from make_scatmech_flake_data import geometries
 
     truth = mk.MB_TRUTH if generator == "mb_mueller" else mk.PAINT_TRUTH
-    sc = scene.load(os.path.join(os.path.dirname(references.__file__), "scenes", scene_name))
+    sc = scene.load(references.scene_path(scene_name))
     sc = sc.with_values({k: v for k, v in truth.items() if not k.endswith("index")})  # the index is fixed
     g = np.radians(geometries()[:, :3])
     M = sc.build().mueller(g[:, 0], g[:, 1], g[:, 2])

@@ -27,9 +27,7 @@ def test_example_scenes_load_build_and_explain(path):
 
 
 def test_coated_flakes_build_only_the_subsurface_facet_model():
-    sc = scene.load(
-        os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
-    )
+    sc = scene.load(references.scene_path("aluminium_flakes_clearcoat.toml"))
     assert [type(m.model) for m in sc.mechanisms()] == [models.SubsurfaceFacetBRDF]
     m = sc.build()
     # the 0.7 deg detector averages the exponential distribution's cusp at the specular peak
@@ -90,7 +88,7 @@ def test_missing_file():
 
 
 def test_scene_command_writes_csv_and_png(tmp_path):
-    path = os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
+    path = references.scene_path("aluminium_flakes_clearcoat.toml")
     assert main(["scene", path, "--out", str(tmp_path)]) == 0
     rows = list(
         csv.reader(
@@ -158,7 +156,7 @@ def test_cook_torrance_scene_errors(extra_sub, key):
 
 
 def _scene(name):
-    return scene.load(os.path.join(os.path.dirname(references.__file__), "scenes", name))
+    return scene.load(references.scene_path(name))
 
 
 def test_volume_scenes_build_only_what_they_declare():

@@ -8,6 +8,7 @@ import pytest
 import models
 import references
 from models import scene
+from models.geometry import incident_direction
 from validation.checks import seed003 as c3
 
 KW = dict(slopes=models.ExponentialSlopes(0.5), coating=1.5, phase=models.HenyeyGreenstein(0.3), rho=0.3)
@@ -63,7 +64,7 @@ def test_acceptance_generator_matches_weights():
     describe the same distribution of struck facets: compare moments."""
     s = models.ExponentialSlopes(0.5)
     ti = math.radians(60)
-    k = np.array([math.sin(ti), 0.0, -math.cos(ti)])
+    k = incident_direction(ti)
     zx, zy = models.rough_diffuse.sample_normals_seen_by(s, k, 40000, seed=1)
     x, y = s.sample(400000, 2)
     w = np.maximum(math.cos(ti) - k[0] * x, 0.0)

@@ -23,6 +23,13 @@ from validation.checks.common import random_geometries
 # is far above it (thicknesses scaled by 1 + 1e-11 already give 1.8e-9).
 TMM_TOL = 1e-12
 
+# R + T + A = 1 by an independent path: A integrates the fields propagated down from the
+# top's (1, r), which carries r's round-off through the films, growing as the field decays
+# across them: measured |R + T + A - 1| <= 13 eps e^(G/2), G = sum k0 |Im q| d over the films.
+# The data's largest G, 23.8 (four absorbing films, T ~ 1e-21), gives eps e^(G/2) = 3.2e-11 and
+# the worst measured 3.4e-11 (the next case 5.9e-12, all others <= 6.4e-13): 1e-10 is 3x that.
+ENERGY_TOL = 1e-10
+
 
 def _stack(case):
     return FilmStack(
@@ -108,7 +115,7 @@ def test_energy_r_plus_t_plus_a(cases):
             worst = max(worst, abs(R + T + A - 1.0))
             count += A > 1e-3
     assert count > 50  # the absorption term matters in many cases
-    assert worst <= 1e-10
+    assert worst <= ENERGY_TOL
 
 
 def test_energy_on_a_perfect_conductor():

@@ -3,6 +3,7 @@
 import json
 import math
 import os
+import types
 from dataclasses import dataclass
 
 import numpy as np
@@ -139,12 +140,38 @@ def test_costs_are_resolved_best_of_batches(results):
     assert grid[-1].seconds > grid[0].seconds  # 361 points cost more than 19
 
 
-def test_time_call_measures_the_work_of_one_call():
-    x = np.linspace(0, 1, 20_000)
-    out, small = time_call(lambda: np.sin(x).sum())
-    _, large = time_call(lambda: np.sin(np.concatenate([x] * 8)).sum())
-    assert out == pytest.approx(np.sin(x).sum())
-    assert 3 < large.seconds / small.seconds < 20  # 8 x the work, per call
+class _Clock:
+    """time_call's two clocks, moved only by the work: a call of ``cost`` adds ``cost`` of CPU
+    time and twice that of wall time (a loaded machine). Powers of two keep the sums exact."""
+
+    def __init__(self):
+        self.cpu = self.wall = 0.0
+
+    def work(self, cost):
+        self.cpu += cost
+        self.wall += 2 * cost
+        return cost
+
+
+def test_time_call_measures_the_work_of_one_call(monkeypatch):
+    from validation.studies import tradeoff
+
+    clock = _Clock()
+    fake = types.SimpleNamespace(perf_counter=lambda: clock.wall, process_time=lambda: clock.cpu)
+    monkeypatch.setattr(tradeoff, "time", fake)
+    c = 2.0**-13
+    out, small = time_call(lambda: clock.work(c))
+    _, large = time_call(lambda: clock.work(8 * c))
+    assert out == c
+    for t, cost in ((small, c), (large, 8 * c)):
+        # the cost is the CPU time of one call, the wall time beside it
+        assert (t.seconds, t.wall_seconds, t.spread) == (cost, 2 * cost, 0.0)
+        # batches of ceil(BATCH / warm-up wall time) calls, until MIN_WORK and MIN_BATCHES
+        number = math.ceil(tradeoff.BATCH / (2 * cost))
+        batches, rest = divmod(t.calls, number)
+        assert rest == 0 and batches >= MIN_BATCHES and t.cpu_total == t.calls * cost >= MIN_WORK
+        assert batches == MIN_BATCHES or (batches - 1) * number * cost < MIN_WORK  # and no more
+    assert large.seconds == 8 * small.seconds  # 8 x the work, per call
     assert small.calls > large.calls >= MIN_BATCHES
 
 
