@@ -58,6 +58,7 @@ import numba
 import numpy as np
 
 import models
+from models.geometry import incident_direction, scattered_direction
 from validation.checks.common import random_geometries
 from validation.studies.tradeoff import time_call
 
@@ -188,9 +189,9 @@ def scatmech_rows(g, loop):
 def _directions(mi, ti, tr, pr):
     """Mitsuba's ``(si.wi, wo)`` for our geometry: ``si.wi`` our reflected direction, ``wo``
     the reverse of our incident ray (towards the light)."""
-    wi = mi.Vector3f(np.sin(tr) * np.cos(pr), np.sin(tr) * np.sin(pr), np.cos(tr))
-    wo = mi.Vector3f(-np.sin(ti), 0.0 * ti, np.cos(ti))
-    return wi, wo
+    wi = scattered_direction(tr, pr)
+    wo = -incident_direction(ti)
+    return mi.Vector3f(*np.moveaxis(wi, -1, 0)), mi.Vector3f(*np.moveaxis(wo, -1, 0))
 
 
 def _interaction(mi, polarized):
