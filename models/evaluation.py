@@ -30,7 +30,8 @@ from .params import check_finite_array, check_polar_angle
 __all__ = ["backend", "current_backend", "BACKENDS", "PRECISIONS", "CHUNK", "KERNEL_CHUNK", "Plan"]
 
 #: Geometries per chunk on the numpy path, chosen so a model's float64 temporaries stay in
-#: L2 cache (measured best of 1024..32768 for the facet models on this machine).
+#: L2 cache: the smallest size of the flat optimum (``python benchmarks/chunk_size.py``:
+#: 4096-32768 within 4% of each other for the facet models here, 1024 32-38% slower).
 CHUNK = 4096
 #: Geometries per chunk on the kernel path (no temporaries; bounds the gathered inputs and,
 #: when streaming, the blocks handed out: 16 x 8 bytes x 65536 = 8 MB).
