@@ -42,7 +42,6 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 import models
-from models import evaluation
 from models.geometry import signed_inplane
 from validation.numerics.energy import exposed_reflectance
 from validation.numerics.integrate import integrated_reflectance
@@ -295,7 +294,7 @@ def precision_option(model):
     if "precision" not in inspect.signature(model.mueller).parameters:
         return None
     if isinstance(model, models.Model):
-        if model._kernel_spec() is None or evaluation.current_backend() != "numba":
+        if not model._kernel_path():
             return None
     return "keyword"
 
