@@ -122,3 +122,8 @@ def test_bad_arguments():
         integrated_reflectance(Lambert(), 0.1, tol=0)
     with pytest.raises(ValueError, match="theta_i"):
         integrated_reflectance(Lambert(), 2.0)
+    # a bool is no tolerance: True would integrate to tol = 1 without a word
+    with pytest.raises(ValueError, match="tol .*bool"):
+        integrated_reflectance(Lambert(), 0.1, tol=True)
+    with pytest.raises(ValueError, match="theta_i"):
+        integrated_reflectance(Lambert(), math.nan)

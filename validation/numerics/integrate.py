@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from models.params import check_real
 from models.polarization import stokes
 
 __all__ = ["IntegralResult", "integrated_reflectance", "gauss_kronrod_15"]
@@ -155,11 +156,9 @@ def integrated_reflectance(
     >>> round(float(r.value + (rs + rp) / 2), 6), r.converged
     (1.0, True)
     """
-    if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be a finite number > 0; got {tol!r}")
-    theta_i = float(theta_i)
-    if not (0.0 <= theta_i <= math.pi / 2):
-        raise ValueError(f"theta_i must lie in [0, pi/2] radians; got {theta_i!r}")
+    # check_real: a bool is no tolerance (True would integrate to tol = 1)
+    tol = check_real("tol", tol, 0.0, low_open=True)
+    theta_i = check_real("theta_i", theta_i, 0.0, 0.5 * math.pi)
     s_in = np.asarray(stokes(incident), dtype=float)
     if symmetric is None:
         symmetric = bool(getattr(model, "mirror_symmetric", False)) and s_in[2] == 0 and s_in[3] == 0
