@@ -9,6 +9,7 @@ import pytest
 
 import references
 from models import scene
+from validation.checks.fitting import InterruptAfter
 from validation.cli import main
 from validation.fitting.datafile import load_data
 from validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor
@@ -205,19 +206,6 @@ def _small(coated, data, n=30):
     return Likelihood(coated, spec, subsample(data, n))
 
 
-class Crash:
-    """Log-probability that raises after ``after`` calls: a simulated interruption."""
-
-    def __init__(self, lik, after):
-        self.lik, self.after, self.calls = lik, after, 0
-
-    def __call__(self, u):
-        self.calls += 1
-        if self.calls > self.after:
-            raise KeyboardInterrupt("simulated interruption")
-        return self.lik(u)
-
-
 def test_resume_after_interruption_gives_the_same_chain_bit_for_bit(coated, data, tmp_path):
     lik = _small(coated, data)
     u0, _, _ = optimize(lik, 7, n_starts=1)
@@ -226,7 +214,7 @@ def test_resume_after_interruption_gives_the_same_chain_bit_for_bit(coated, data
     full = run_chain(lik, st, p0=p0, backend=CheckpointBackend(str(tmp_path / "a.npz"), "f"))
     ck = str(tmp_path / "b.npz")
     with pytest.raises(KeyboardInterrupt):  # dies in step ~35
-        run_chain(Crash(lik, 8 + 8 * 35), st, p0=p0, backend=CheckpointBackend(ck, "f"))
+        run_chain(InterruptAfter(lik, 8 + 8 * 35), st, p0=p0, backend=CheckpointBackend(ck, "f"))
     with np.load(ck) as z:
         assert z["chain"].shape[0] == 20  # the last complete segment survived
     resumed = run_chain(lik, st, backend=CheckpointBackend.load(ck, "f"))

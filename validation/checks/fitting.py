@@ -82,14 +82,17 @@ def check_inversion_round_trip(ctx):
     return out
 
 
-class _Crash:
+class InterruptAfter:
+    """A log-probability ``f`` that raises KeyboardInterrupt after ``after`` calls: a simulated
+    Ctrl-C or kill in the middle of a chain (the resume check here and tests/test_fit.py)."""
+
     def __init__(self, f, after):
         self.f, self.after, self.calls = f, after, 0
 
     def __call__(self, u):
         self.calls += 1
         if self.calls > self.after:
-            raise KeyboardInterrupt
+            raise KeyboardInterrupt("simulated interruption")
         return self.f(u)
 
 
@@ -115,7 +118,7 @@ def check_resume_identity(ctx):
         # emcee prints the interrupted call's traceback; keep validate's table clean
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             try:
-                run_chain(_Crash(lik, 6 + 6 * 15), st, p0=p0, backend=CheckpointBackend(ck, "x"))
+                run_chain(InterruptAfter(lik, 6 + 6 * 15), st, p0=p0, backend=CheckpointBackend(ck, "x"))
             except KeyboardInterrupt:
                 pass
         resumed = run_chain(lik, st, backend=CheckpointBackend.load(ck, "x"))
