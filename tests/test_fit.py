@@ -13,7 +13,7 @@ from validation.checks.fitting import InterruptAfter
 from validation.cli import main
 from validation.fitting.datafile import load_data
 from validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor
-from validation.fitting.fit import run_fit
+from validation.fitting.fit import fingerprint, run_fit
 from validation.fitting.fitspec import FitSpecError, fitspec_from, parse_free
 from validation.fitting.likelihood import Likelihood
 from validation.fitting.recovery import subsample
@@ -320,6 +320,8 @@ def test_chain_settings_name_the_field_and_its_range():
         ("tau_rtol", -0.1, "> 0"),
         ("starts", 0, ">= 1"),
         ("starts", True, "integer"),
+        ("moves", "gibbs", "one of stretch, de"),
+        ("moves", None, "one of stretch, de"),
     ]:
         with pytest.raises(ValueError, match=f"^{field} must be .*{words}"):
             ChainSettings(**{field: bad})
@@ -332,6 +334,27 @@ def test_chain_settings_name_the_field_and_its_range():
         st.replace(max_steps=-5)
     with pytest.raises(AttributeError):
         st.walkers = 8  # frozen
+
+
+def test_de_moves_are_seeded_resumable_and_executor_independent(coated, data, tmp_path):
+    """The differential-evolution moves draw from the sampler's seeded random state like the
+    stretch move: a resumed chain equals the uninterrupted one, the process executor the serial
+    one, and the chain is not the stretch move's."""
+    lik = _small(coated, data, 20)
+    p0 = initial_ball(np.array([math.log(0.1), 1.5]), 8, 5, lik.spec.u_bounds())
+    st = ChainSettings(walkers=8, seed=5, max_steps=40, check_every=20, moves="de")
+    full = run_chain(lik, st, p0=p0, backend=CheckpointBackend(str(tmp_path / "a.npz"), "f"))
+    ck = str(tmp_path / "b.npz")
+    with pytest.raises(KeyboardInterrupt):  # dies in step ~30, after the step-20 checkpoint
+        run_chain(InterruptAfter(lik, 8 + 8 * 30), st, p0=p0, backend=CheckpointBackend(ck, "f"))
+    resumed = run_chain(lik, st, backend=CheckpointBackend.load(ck, "f"))
+    assert np.array_equal(resumed.chain, full.chain)
+    with ProcessExecutor(2) as ex:
+        assert np.array_equal(run_chain(lik, st, p0=p0, executor=ex).chain, full.chain)
+    stretch = run_chain(lik, st.replace(moves="stretch"), p0=p0)
+    assert not np.array_equal(stretch.chain, full.chain)
+    # a checkpoint of one move is not resumed with the other: the fit's fingerprint differs
+    assert fingerprint(lik, st) != fingerprint(lik, st.replace(moves="stretch"))
 
 
 def test_same_seed_same_chain_whatever_the_executor(coated, data):

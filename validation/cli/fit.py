@@ -93,7 +93,7 @@ def _spec_args(p):
 
 def _mcmc_args(p, walkers=None, max_steps=None):
     """The sampler flags; defaults: :class:`ChainSettings`' unless ``walkers``/``max_steps`` given."""
-    from validation.fitting.settings import ChainSettings
+    from validation.fitting.settings import MOVES, ChainSettings
 
     d = ChainSettings()
     p.add_argument("--walkers", type=int, default=walkers or d.walkers)
@@ -104,6 +104,12 @@ def _mcmc_args(p, walkers=None, max_steps=None):
     )
     p.add_argument("--tau-factor", type=float, default=d.tau_factor, help="stop when steps >= this x tau")
     p.add_argument("--starts", type=int, default=d.starts, help="least-squares starts for the optimum")
+    p.add_argument(
+        "--moves",
+        choices=MOVES,
+        default=d.moves,
+        help="ensemble proposal: emcee's stretch move, or differential evolution (DE 80%%, snooker 20%%)",
+    )
 
 
 def _load(args):
@@ -149,6 +155,7 @@ def _chain_settings(args):
             check_every=args.check_every,
             tau_factor=args.tau_factor,
             starts=args.starts,
+            moves=args.moves,
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from exc

@@ -5,7 +5,8 @@ whitened residuals (noise terms held at their starting values) from several
 seeded starts, then, when noise terms are free, a bounded maximization of the
 full log posterior from the best of them.
 
-``run_chain`` runs an :class:`emcee.EnsembleSampler` (stretch move) in
+``run_chain`` runs an :class:`emcee.EnsembleSampler` (the stretch move, or
+differential evolution: ``ChainSettings.moves``) in
 segments of ``check_every`` steps (:class:`~validation.fitting.settings.ChainSettings`),
 storing the chain in a :class:`~validation.fitting.checkpoint.CheckpointBackend`.
 After each segment the backend estimates the integrated autocorrelation time
@@ -18,7 +19,7 @@ stops when ``N >= tau_factor * max(tau)`` and ``max(tau)`` moved by less than
 resumed from its checkpoint produces the same chain, bit for bit, as an
 uninterrupted one.
 
-All random draws (walker initialization, the stretch move) happen in this
+All random draws (walker initialization, the moves) happen in this
 process from the seed; the executor only maps the log-probability over walkers.
 """
 
@@ -308,6 +309,14 @@ class _Batched:
         return np.concatenate(self.executor.map(self.fn, shares))
 
 
+def _moves(name):
+    """emcee's moves for :attr:`ChainSettings.moves` (new objects: a move holds no state
+    across steps, but one per sampler keeps runs independent)."""
+    if name == "de":
+        return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    return emcee.moves.StretchMove()
+
+
 def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, progress=False):
     """Run (or resume) the ensemble until converged or out of steps; see the module docstring.
 
@@ -338,14 +347,13 @@ def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, 
     settings = ChainSettings() if settings is None else settings
     backend = CheckpointBackend() if backend is None else backend
     state = _first_state(backend, settings, p0)
+    common = dict(backend=backend, moves=_moves(settings.moves))
     if vectorized(log_prob):
         fn = _Batched(log_prob, executor)
-        sampler = emcee.EnsembleSampler(
-            settings.walkers, state.coords.shape[1], fn, vectorize=True, backend=backend
-        )
+        sampler = emcee.EnsembleSampler(settings.walkers, state.coords.shape[1], fn, vectorize=True, **common)
     else:
         sampler = emcee.EnsembleSampler(
-            settings.walkers, state.coords.shape[1], log_prob, pool=executor, backend=backend
+            settings.walkers, state.coords.shape[1], log_prob, pool=executor, **common
         )
     with _progress_bar(progress, settings.max_steps, backend.iteration) as bar:
         while backend.iteration < settings.max_steps and not _converged(backend.tau_history, settings):
