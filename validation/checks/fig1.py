@@ -69,19 +69,32 @@ def mean_transmitted_angle(sigma, theta_i, n=N_INDEX, points=2000):
     return num / den
 
 
-def effective_index(sigma, n=N_INDEX, theta_i_deg=tuple(range(0, 81, 5))):
-    """``(n_eff, max |residual|)`` of ``sin(mean tt) = sin(ti)/n_eff`` (least squares through 0)."""
-    theta_i_deg = np.asarray(theta_i_deg, dtype=float)
-    s_in = np.sin(np.radians(theta_i_deg))
-    s_out = np.array([math.sin(mean_transmitted_angle(sigma, math.radians(t), n)) for t in theta_i_deg])
+#: incidences (deg) of the effective-index fit
+EFFECTIVE_INDEX_DEG = tuple(range(0, 81, 5))
+
+
+def sin_mean_angles(sigma, n=N_INDEX, theta_i_deg=EFFECTIVE_INDEX_DEG):
+    """``sin(mean theta_t)`` (:func:`mean_transmitted_angle`) at each of ``theta_i_deg``."""
+    return np.array([math.sin(mean_transmitted_angle(sigma, math.radians(t), n)) for t in theta_i_deg])
+
+
+def effective_index(sigma, n=N_INDEX, theta_i_deg=EFFECTIVE_INDEX_DEG, s_out=None):
+    """``(n_eff, max |residual|)`` of ``sin(mean tt) = sin(ti)/n_eff`` (least squares through 0);
+    ``s_out``: :func:`sin_mean_angles` if already computed."""
+    s_in = np.sin(np.radians(np.asarray(theta_i_deg, dtype=float)))
+    s_out = sin_mean_angles(sigma, n, theta_i_deg) if s_out is None else s_out
     slope = float(np.sum(s_in * s_out) / np.sum(s_in * s_in))
     return 1.0 / slope, float(np.max(np.abs(s_out - slope * s_in)))
 
 
 def fig1(sigmas=SIGMAS):
-    """Rows ``dict(sigma, peak_deg, n_eff, linear_residual)`` for each sigma."""
+    """Rows ``dict(sigma, peak_deg, n_eff, linear_residual, sin_out)`` for each sigma;
+    ``sin_out``: ``sin(mean theta_t)`` at :data:`EFFECTIVE_INDEX_DEG` (the fit's points)."""
     rows = []
     for s in sigmas:
-        n_eff, res = effective_index(s)
-        rows.append({"sigma": s, "peak_deg": peak_angle(s), "n_eff": n_eff, "linear_residual": res})
+        s_out = sin_mean_angles(s)
+        n_eff, res = effective_index(s, s_out=s_out)
+        rows.append(
+            {"sigma": s, "peak_deg": peak_angle(s), "n_eff": n_eff, "linear_residual": res, "sin_out": s_out}
+        )
     return rows

@@ -40,17 +40,17 @@ class Fig1Data:
     tracked: dict
 
 
-def _curves(rows, x, ti_deg):
-    """Per sigma: the in-plane BTDF over ``x`` divided by its peak, and sin(mean theta_t) at ``ti_deg``."""
-    from validation.checks.fig1 import N_INDEX, THETA_I, mean_transmitted_angle
+def _curves(rows, x):
+    """Per sigma: the in-plane BTDF over ``x`` divided by its peak, and sin(mean theta_t) at
+    :data:`validation.checks.fig1.EFFECTIVE_INDEX_DEG`."""
+    from validation.checks.fig1 import N_INDEX, THETA_I
 
-    curves, sin_out = [], []
+    curves = []
     for r in rows:
         m = models.FacetBTDF(slopes=models.GaussianSlopes(sigma=r["sigma"]), substrate=N_INDEX)
         f = m.brdf(THETA_I, *signed(x))
         curves.append((r["sigma"], f / f.max(), r["n_eff"]))
-        sin_out.append(np.array([math.sin(mean_transmitted_angle(r["sigma"], t * DEG)) for t in ti_deg]))
-    return tuple(curves), tuple(sin_out)
+    return tuple(curves), tuple(r["sin_out"] for r in rows)  # the check's points, not recomputed
 
 
 def _table_row(r, snell):
@@ -64,14 +64,14 @@ def _table_row(r, snell):
 
 
 def compute(ctx):
-    from validation.checks.fig1 import N_INDEX, SIGMAS, THETA_I
+    from validation.checks.fig1 import EFFECTIVE_INDEX_DEG, N_INDEX, SIGMAS, THETA_I
     from validation.checks.seed003 import fig1_rows
 
     rows = [dict(r) for r in fig1_rows()]  # the Fig. 1 check's analysis (validation/checks/fig1.py)
     snell = math.degrees(math.asin(math.sin(THETA_I) / N_INDEX))
     x = np.linspace(-89.0, 89.0, 357 if ctx.quick else 1781)
-    ti_deg = np.arange(0.0, 81.0, 5.0)
-    curves, sin_out = _curves(rows, x, ti_deg)
+    ti_deg = np.asarray(EFFECTIVE_INDEX_DEG, dtype=float)
+    curves, sin_out = _curves(rows, x)
     tracked = {}
     for r in rows:
         tracked[f"fig1|{r['sigma']:g}|peak_deg"] = {"value": r["peak_deg"], "tol": 0.01}
