@@ -126,7 +126,6 @@ class DiffuseSubsurfaceBRDF(Model):
 
     def _brdf_flat(self, ti, tr, pr):
         a_s, a_p = self._amps(ti, tr)
-        S = 0.5 * (
-            squared_modulus(a_s) + squared_modulus(a_p)
-        )  # (|t_s|^2 + |t_p|^2)/2 * cos'/cos, row i then row r
+        # (|t_s|^2 + |t_p|^2)/2 * cos'/cos, row i then row r
+        S = 0.5 * (squared_modulus(a_s) + squared_modulus(a_p))
         return self._scale * S[1] * S[0]
