@@ -49,12 +49,13 @@ from .slopes import (
     TabulatedSlopes,
     UnitSlopes,
 )
-from .thin_film import FilmStack, TabulatedIndex
+from .thin_film import Films, FilmStack, TabulatedIndex
 
 __all__ = [
     "backend",
     "shadowing",
     "FilmStack",
+    "Films",
     "TabulatedIndex",
     "CHUNK",
     "Model",

@@ -17,6 +17,15 @@ it, at ``rho = 1`` the specular reflectance plus the integrated diffuse BRDF is
 exactly 1 (derivation: the diffuse term integrates to ``T(ti)``; tests check it
 numerically).  SCATMECH: ``Diffuse_Subsurface_BRDF_Model``
 (``reflectance.table = rho``).
+
+Films on the interface (``coating_films``: ambient | films | binder).  Both crossings take
+the stack's amplitudes (:mod:`models.smooth_interface`, F1-F3: ``n |a|^2`` is the stack's
+transmittance in, and out), and ``R-bar`` is the stack's internal reflectance seen from
+inside the binder, averaged with Eq. 22's ``1/pi`` (F5,
+:func:`models.smooth_interface.film_hemispherical_reflectance`).  The unit-albedo argument
+carries over for lossless films: at ``rho = 1`` the diffuse term integrates to the stack's
+transmittance ``T_01(ti)``, so with its reflectance ``R_01(ti)`` the total is 1 (tested);
+an absorbing film keeps it below 1.
 """
 
 from __future__ import annotations
@@ -29,7 +38,15 @@ import numpy as np
 
 from .base import Model
 from .params import param
-from .smooth_interface import depolarized_between, interface_amplitudes, internal_hemispherical_reflectance
+from .smooth_interface import (
+    depolarized_between,
+    film_amplitudes,
+    film_hemispherical_reflectance,
+    interface_amplitudes,
+    internal_hemispherical_reflectance,
+    squared_modulus,
+)
+from .thin_film import Films, check_films
 
 __all__ = ["DiffuseSubsurfaceBRDF"]
 
@@ -45,6 +62,9 @@ class DiffuseSubsurfaceBRDF(Model):
         the smooth interface (``1``: a bare Lambertian).  Old name ``n``.
     rho : float
         Diffuse reflectance of the underlying material, in [0, 1].
+    coating_films : Films or None
+        Thin films on the interface (:class:`models.Films`, from the ambient down), on the
+        index ``coating``; ``None`` (default): the bare interface of seed 003.
     """
 
     coating: float = param(
@@ -54,15 +74,26 @@ class DiffuseSubsurfaceBRDF(Model):
         low=1.0,
     )
     rho: float = param(0.93, "diffuse reflectance of the material under the interface", low=0.0, high=1.0)
+    coating_films: Films = param(
+        None, "thin films on the smooth interface (None: bare)", kind="object", check=check_films
+    )
 
     depolarizing = True
     aliases = {"n": "coating"}
 
     @cached_property
+    def _top_stack(self):
+        """``coating_films`` on the coating index (a :class:`models.FilmStack`), or ``None``."""
+        return None if self.coating_films is None else self.coating_films.on(self.coating)
+
+    @cached_property
     def rbar(self):
         """Internal hemispherical reflectance ``R-bar`` (Eq. 22 with 1/pi): a float, or an
         array like ``coating`` in a model set (the quadrature runs once per distinct index
-        and is cached, :func:`models.smooth_interface.internal_hemispherical_reflectance`)."""
+        and is cached, :func:`models.smooth_interface.internal_hemispherical_reflectance`);
+        through films, the stack's (:func:`models.smooth_interface.film_hemispherical_reflectance`)."""
+        if self._top_stack is not None:
+            return film_hemispherical_reflectance(self._top_stack)
         n = self.coating
         if isinstance(n, np.ndarray):
             values, inverse = np.unique(n, return_inverse=True)
@@ -76,12 +107,18 @@ class DiffuseSubsurfaceBRDF(Model):
         return (self.rho / math.pi) / (1.0 - self.rho * self.rbar)
 
     def _kernel_spec(self):
+        if self.coating_films is not None:
+            return None  # films: numpy
         return "diffuse", [self.coating, self._scale], (0, 0, 0)
 
     def _amps(self, ti, tr):
-        """Interface amplitudes ``(a_s, a_p)``, rows incidence then scattering."""
-        _, _, a_s, a_p = interface_amplitudes(np.cos(np.stack([ti, tr])), self.coating)
-        return a_s, a_p
+        """Interface amplitudes ``(a_s, a_p)``, rows incidence then scattering (the exit's)."""
+        cos_ext = np.cos(np.stack([ti, tr]))
+        if self._top_stack is None:
+            _, _, a_s, a_p = interface_amplitudes(cos_ext, self.coating)
+            return a_s, a_p
+        _, _, (a_s, a_p), (b_s, b_p) = film_amplitudes(cos_ext, self._top_stack)
+        return np.stack([a_s[0], b_s[1]]), np.stack([a_p[0], b_p[1]])
 
     def _mueller16(self, ti, tr, pr):
         (asi, asr), (api, apr) = self._amps(ti, tr)
@@ -89,5 +126,6 @@ class DiffuseSubsurfaceBRDF(Model):
 
     def _brdf_flat(self, ti, tr, pr):
         a_s, a_p = self._amps(ti, tr)
-        S = 0.5 * (a_s * a_s + a_p * a_p)  # (|t_s|^2 + |t_p|^2)/2 * cos'/cos, row i then row r
+        # (|t_s|^2 + |t_p|^2)/2 * cos'/cos, row i then row r
+        S = 0.5 * (squared_modulus(a_s) + squared_modulus(a_p))
         return self._scale * S[1] * S[0]

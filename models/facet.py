@@ -44,6 +44,7 @@ from .params import check_index, param
 from .polarization import mueller16_from_jones
 from .shadowing import SHADOWING, check_shadowing, smith_g
 from .slopes import ExponentialSlopes, SlopeDistribution
+from .smooth_interface import film_transmission
 from .thin_film import FilmStack
 
 __all__ = ["FacetBRDF", "facet_jones", "local_cosine", "substrate_rs_k"]
@@ -108,7 +109,7 @@ def facet_slopes(ti, tr, pr, n):
     return hx / hz, hy / hz
 
 
-def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
+def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none", top=None):
     """Jones elements ``(ss, ps, sp, pp)`` as ``(re, im)`` pairs of flat arrays
     (``ps`` = p in, s out), scaled so that their Mueller matrix is the BRDF.
 
@@ -117,7 +118,10 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     ``substrate`` is an index or a :class:`models.FilmStack`
     (:func:`substrate_rs_k`); ``shadowing`` one of
     :data:`models.shadowing.SHADOWING` (``"none"``: seed 000's model, untouched),
-    applied with the internal directions (in the coating).
+    applied with the internal directions (in the coating).  ``top``: ``None`` (the bare
+    coating, Eq. 14-15) or a :class:`models.FilmStack` of films on the coating's top
+    surface (substrate ``n``), whose complex crossing amplitudes replace ``t(theta; 1, n)``
+    (:func:`models.smooth_interface.film_transmission`).
     """
     cos_ext, sin_int, cos_int = _polar(ti, tr, n)
     sp, cp = np.sin(pr), np.cos(pr)
@@ -142,12 +146,29 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none"):
     inv_g = 1.0 / g
     h_dots = (si * sp, cr * cp * si + sr * ci, sr * sp * inv_g, (ci * sr * cp + si * cr) * inv_g)
     d = (cp, -sp * ci, -cr * sp, sr * si - cr * cp * ci)  # e_a . e_b for ss, ps, sp, pp
-    return _jones_elements(rs, K, np.sqrt(S), h_dots, d, cos_ext, n)
+    if top is None:
+        return _jones_elements(rs, K, np.sqrt(S), h_dots, d, cos_ext, n)
+    return _through_films(_jones_elements(rs, K, np.sqrt(S), h_dots, d, cos_ext, 1.0), cos_ext, top)
+
+
+def _through_films(parts, cos_ext, top):
+    """The facet's Jones elements ``(re, im)`` times the complex crossing amplitudes of the
+    films on the coating, ``t_out,a(theta_r) t_in,b(theta_i)`` for element ``ab``
+    (:func:`models.smooth_interface.film_transmission`, F1-F2): complex products, so the
+    relative s/p phase of the films' transmission reaches the Mueller matrix."""
+    (ts_in, tp_in), (ts_out, tp_out) = film_transmission(cos_ext, top)  # rows: incidence, scattering
+    tsi, tpi, tsr, tpr = ts_in[0], tp_in[0], ts_out[1], tp_out[1]
+    out = []
+    for (re, im), f in zip(parts, (tsr * tsi, tsr * tpi, tpr * tsi, tpr * tpi), strict=True):
+        z = (re + 1j * im) * f
+        out.append((z.real, z.imag))
+    return tuple(out)
 
 
 def _jones_elements(rs, K, root, h_dots, d, cos_ext, n):
     """``q_ab = r_s D_ab + (K - 2 r_s) (e_a.h)(e_b.h)/|h|^2`` (module docstring) as
-    ``(re, im)`` pairs scaled by ``root``, with the coating's transmission factors."""
+    ``(re, im)`` pairs scaled by ``root``, with the coating's transmission factors
+    (none for ``n = 1``)."""
     r_re = rs.real * root
     r_im = rs.imag * root
     k_re = K.real * root
@@ -189,17 +210,23 @@ class _FacetModel(Model):
     def _coating(self) -> float:
         return 1.0
 
+    def _top(self):
+        """The films on the coating's top surface as a :class:`models.FilmStack`, or ``None``."""
+        return None
+
     def _parts(self, ti, tr, pr):
-        return facet_jones(ti, tr, pr, self._coating(), self.substrate, self.slopes, self.shadowing)
+        return facet_jones(
+            ti, tr, pr, self._coating(), self.substrate, self.slopes, self.shadowing, self._top()
+        )
 
     def _mueller16(self, ti, tr, pr):
         return mueller16_from_jones(*self._parts(ti, tr, pr))
 
     def _kernel_spec(self):
-        """The facet kernel; numpy for film stacks and slopes or shadowing it does not cover
-        (:mod:`models.kernel_specs`)."""
+        """The facet kernel; numpy for films (on the facets or the coating) and slopes or
+        shadowing it does not cover (:mod:`models.kernel_specs`)."""
         slopes = kernel_specs.slope_rows(self.slopes)
-        if slopes is None or isinstance(self.substrate, FilmStack):
+        if slopes is None or isinstance(self.substrate, FilmStack) or self._top() is not None:
             return None
         shadowing = kernel_specs.shadowing_kind(self.shadowing, slopes[0])
         if shadowing is None:

@@ -26,11 +26,21 @@ only ``|t|^2`` enter and the model is SCATMECH's ``First_Diffuse_BRDF_Model``
 1e-12.  The ``cos'/cos`` factors are carried by the amplitudes of
 :func:`models.smooth_interface.interface_amplitudes`, so grazing geometries give
 exact zeros.
+
+Films on the interface (``coating_films``: ambient | films | binder).  The amplitudes
+``t_r``, ``t_i`` of Eq. 20 become the stack's complex crossing amplitudes, ``t_01`` in and
+``t_10 kz_0 / kz_s`` out (:mod:`models.smooth_interface`, F1-F2; with the ``sqrt(cos'/cos)``
+factor, :func:`models.smooth_interface.film_amplitudes`).  The Jones elements above become
+complex products ``a_out,a J_ab a_in,b`` (the films' s/p phase difference reaches the
+polarized model's U and V rows); the depolarizing phase sees only ``|a|^2``, the stack's
+transmittances over ``n`` (F3).  Directions, the phase function and the depth integral
+(Eq. 16-19) are the bare interface's: planar films bend no ray.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -38,7 +48,8 @@ from .base import Model
 from .params import param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
-from .smooth_interface import depolarized_between, interface_amplitudes
+from .smooth_interface import depolarized_between, film_amplitudes, interface_amplitudes, squared_modulus
+from .thin_film import Films, check_films
 
 __all__ = ["SingleScatterBRDF"]
 
@@ -56,6 +67,9 @@ class SingleScatterBRDF(Model):
         through the smooth interface (``1``: no interface).  Old name ``n``.
     phase : HenyeyGreenstein
         Phase function (polarized Eq. 7 or depolarizing).
+    coating_films : Films or None
+        Thin films on the interface (:class:`models.Films`, from the ambient down), on the
+        index ``coating``; ``None`` (default): the bare interface of seed 003.
     """
 
     coating: float = param(
@@ -65,8 +79,16 @@ class SingleScatterBRDF(Model):
         low=1.0,
     )
     phase: HenyeyGreenstein = param(HenyeyGreenstein(0.3), "volume phase function", kind="object")
+    coating_films: Films = param(
+        None, "thin films on the smooth interface (None: bare)", kind="object", check=check_films
+    )
 
     aliases = {"n": "coating"}
+
+    @cached_property
+    def _top_stack(self):
+        """``coating_films`` on the coating index (a :class:`models.FilmStack`), or ``None``."""
+        return None if self.coating_films is None else self.coating_films.on(self.coating)
 
     def _validate(self):
         if not isinstance(self.phase, HenyeyGreenstein):
@@ -77,10 +99,14 @@ class SingleScatterBRDF(Model):
         return not self.phase.polarized
 
     def _parts(self, ti, tr, pr):
-        """Internal geometry, the amplitude factors and the scalar weight ``K``."""
-        (si, sr), (ci, cr), (asi, asr), (api, apr) = interface_amplitudes(
-            np.cos(np.stack([ti, tr])), self.coating
-        )
+        """Internal geometry, the amplitude factors (complex through films) and the scalar
+        weight ``K``."""
+        cos_ext = np.cos(np.stack([ti, tr]))
+        if self._top_stack is None:
+            (si, sr), (ci, cr), (asi, asr), (api, apr) = interface_amplitudes(cos_ext, self.coating)
+        else:
+            (si, sr), (ci, cr), (a_s, a_p), (b_s, b_p) = film_amplitudes(cos_ext, self._top_stack)
+            asi, api, asr, apr = a_s[0], a_p[0], b_s[1], b_p[1]  # in at theta_i, out at theta_r
         cp, sp = np.cos(pr), np.sin(pr)
         cos_scat = si * sr * cp - ci * cr  # k_i' . k_r'
         # Eq. 19-20: p4 / cos(tr) with the solid-angle factor, cos'/cos carried by the amplitudes.
@@ -90,11 +116,13 @@ class SingleScatterBRDF(Model):
     def _jones_parts(self, ti, tr, pr):
         si, sr, ci, cr, cp, sp, cos_scat, asi, asr, api, apr, K = self._parts(ti, tr, pr)
         root = np.sqrt(2.0 * K / (1.0 + cos_scat * cos_scat))  # Eq. 6-7 normalization
-        zero = 0.0  # real Jones matrix: a scalar imaginary part saves array work in the map
         ss = asr * asi * root * cp
         ps = -(asr * api * root) * sp * ci
         sp_ = -(apr * asi * root) * sp * cr
         pp = apr * api * root * (si * sr - ci * cr * cp)
+        if self._top_stack is not None:  # complex amplitudes through the films
+            return tuple((z.real, z.imag) for z in (ss, ps, sp_, pp))
+        zero = 0.0  # real Jones matrix: a scalar imaginary part saves array work in the map
         return (ss, zero), (ps, zero), (sp_, zero), (pp, zero)
 
     def _mueller16(self, ti, tr, pr):
@@ -104,23 +132,27 @@ class SingleScatterBRDF(Model):
         return depolarized_between(asi, api, asr, apr, K)  # a depolarizing phase between the crossings
 
     def _kernel_spec(self):
+        if self.coating_films is not None:
+            return None  # films: numpy
         return "single", [self.coating, self.phase.g], (int(self.phase.polarized), 0, 0)
 
     def _brdf_flat(self, ti, tr, pr):
         if self.phase.polarized:
             # M00 of the Jones matrix: the product form below holds for the depolarizing phase
             # only (with s and p transmitted differently the polarized phase weighs them apart)
-            return 0.5 * sum(re * re for re, _ in self._jones_parts(ti, tr, pr))
+            return 0.5 * sum(re * re + im * im for re, im in self._jones_parts(ti, tr, pr))
         _, _, _, _, _, _, _, asi, asr, api, apr, K = self._parts(ti, tr, pr)
-        return 0.25 * K * (asr * asr + apr * apr) * (asi * asi + api * api)
+        q = squared_modulus
+        return 0.25 * K * (q(asr) + q(apr)) * (q(asi) + q(api))
 
     def _jones_flat(self, ti, tr, pr):
         if not self.phase.polarized:
             return Model._jones_flat(self, ti, tr, pr)
         parts = self._jones_parts(ti, tr, pr)
         J = np.empty(ti.shape + (4,), dtype=complex)
-        for k, (re, _) in enumerate(parts):
+        for k, (re, im) in enumerate(parts):
             J[:, k] = re
+            J[:, k].imag = im
         return J.reshape(ti.shape + (2, 2))
 
     def lobe(self, theta_i):

@@ -13,6 +13,40 @@ have no division by ``cos(theta)`` and vanish at grazing incidence, so the
 models need no special case there.  ``n a^2 = T`` (intensity transmittance).
 By reciprocity of the transmittance the same amplitudes describe the exit of a
 ray leaving at ``theta`` (seed 003 Eq. 11, 25).
+
+Thin films on the interface (ambient | films | coating, ``coating_films`` of the coated
+models; :mod:`models.thin_film`).  The films change neither direction (the Snell invariant
+``sin theta`` is the same in every layer) nor the solid-angle and projection factors; they
+change the amplitudes of the two crossings, which become complex:
+
+* entrance (F1): ``t_in = t_01(theta)``, the stack's transmission from the ambient into the
+  coating (:meth:`models.FilmStack.transmission`, down);
+* exit (F2): the ray leaves the coating at ``theta'`` and emerges at ``theta`` with the
+  stack's upward amplitude ``t_10``.  Seed 000 Eq. 14-15 and seed 003 Eq. 11, 25 write the
+  exit with ``t(theta; 1, n)``, which for one interface is ``t_10 kz_0 / kz_s`` (``kz_0 =
+  cos theta``, ``kz_s = n cos theta'``): the Fresnel exit amplitude with the ratio of the
+  normal wavevectors that the radiance bookkeeping (``n^2`` and the ``cos'/cos`` of the
+  refracted solid angle) puts beside it.  With films the exit factor is therefore
+  ``t_out = t_10 kz_0 / kz_s``, in both polarizations, complex.
+
+Flux (F3): ``n |a|^2`` with ``a = t sqrt(c'/c)`` is the transmittance of the crossing, for
+either factor: ``T_01 = (kz_s / kz_0) |t_01|^2`` and ``T_10 = (kz_0 / kz_s) |t_10|^2``, the
+ratios of the normal Poynting fluxes (``Re(kz)`` of real outer media is ``kz``).  An
+absorbing film lowers both below ``1 - R``, so the models' energy still balances.
+Reciprocity (F4): the stack obeys ``t_10 kz_0 = t_01 kz_s`` (:mod:`models.thin_film`,
+(R)), so ``t_out(theta) = t_in(theta)`` and a model built from (F1)-(F2) keeps the bare
+model's Helmholtz reciprocity; the exit is nonetheless computed from ``t_10`` (the
+physics), and the reciprocity tests compare the two crossings.  The relative s/p phase
+of ``t`` enters the Jones matrices (polarized models); only ``|a|^2`` enters the
+depolarizing ones.  A zero-thickness film, or one whose index is the coating's or the
+ambient's, gives the bare interface.
+
+R-bar with films (F5): seed 003 Eq. 22's average (``1/pi``) of the internal reflectance
+``R_10`` of the stack seen from inside the coating (:meth:`models.FilmStack.upward`),
+``int_0^1 R_10 du`` over ``u = sin^2 theta'``.  With films the Stokes shortcut of
+:func:`internal_hemispherical_reflectance` does not hold (an absorbing film makes
+``R_10 != R_01`` and ``R_10 < 1`` beyond the critical angle), so it is integrated:
+:func:`film_hemispherical_reflectance`.
 """
 
 from __future__ import annotations
@@ -24,8 +58,17 @@ import numpy as np
 from scipy import integrate
 
 from .fresnel import coating_cos, fresnel_reflectance
+from .thin_film import FilmStack
 
-__all__ = ["interface_amplitudes", "internal_hemispherical_reflectance", "depolarized_between"]
+__all__ = [
+    "interface_amplitudes",
+    "internal_hemispherical_reflectance",
+    "depolarized_between",
+    "squared_modulus",
+    "film_transmission",
+    "film_amplitudes",
+    "film_hemispherical_reflectance",
+]
 
 _TINY = 1e-300
 
@@ -46,13 +89,22 @@ def interface_amplitudes(cos_ext, n):
     return s_int, c_int, a_s, a_p
 
 
+def squared_modulus(a):
+    """``|a|^2``: ``a * a`` for the real amplitudes of a bare interface (as before films), the
+    squared modulus for the complex ones through films."""
+    if np.iscomplexobj(a):
+        return a.real * a.real + a.imag * a.imag
+    return a * a
+
+
 def depolarized_between(a_s_in, a_p_in, a_s_out, a_p_out, scale):
     """Mueller elements ``(16, n)`` of light transmitted in, fully depolarized, and transmitted
     out: ``scale x M(t_out)[:, 0] (x) M(t_in)[0, :]`` (seed 003 Eq. 28's structure) from the
-    interface amplitudes (:func:`interface_amplitudes`) of the two crossings.  Only the
-    intensity and the linear s/p diattenuation survive (elements 00, 01, 10, 11)."""
-    a, b = a_s_out * a_s_out, a_p_out * a_p_out
-    c, d = a_s_in * a_s_in, a_p_in * a_p_in
+    interface amplitudes (:func:`interface_amplitudes`, or complex ones through films,
+    :func:`film_amplitudes`) of the two crossings.  Only the intensity and the linear s/p
+    diattenuation survive (elements 00, 01, 10, 11)."""
+    a, b = squared_modulus(a_s_out), squared_modulus(a_p_out)
+    c, d = squared_modulus(a_s_in), squared_modulus(a_p_in)
     s_out, d_out = 0.5 * (a + b) * scale, 0.5 * (a - b) * scale
     s_in, d_in = 0.5 * (c + d), 0.5 * (c - d)
     out = np.zeros((16,) + np.shape(s_in * s_out))
@@ -97,3 +149,74 @@ def _rbar(n: float) -> float:
     pts = [min(0.5, 10.0 * math.sqrt(n * n - 1.0))]
     val, _ = integrate.quad(f, 0.0, 1.0, points=pts, epsabs=1e-14, epsrel=1e-12, limit=200)
     return 1.0 - (1.0 - val) / (n * n)
+
+
+def film_transmission(cos_ext, stack: FilmStack):
+    """``((t_s, t_p) in, (t_s, t_p) out)``: the complex amplitudes (F1)-(F2) (module docstring)
+    that replace ``t(theta; 1, n)`` for a ray entering, and one leaving, at the external
+    cosine ``cos_ext`` through the films of ``stack`` (a :class:`models.FilmStack` on the
+    coating's index, under the ambient 1)."""
+    c = np.asarray(cos_ext, dtype=float)
+    (ts, tp), (us, up) = stack.transmission(c, 1.0)
+    n = stack.indices[1].real
+    kz_s = n * coating_cos(c, n)
+    # kz_0 / kz_s; kz_s = 0 only for n = 1 at grazing, where the ray carries no flux
+    ratio = np.where(kz_s > 0.0, c / np.where(kz_s > 0.0, kz_s, 1.0), 0.0)
+    return (ts, tp), (us * ratio, up * ratio)
+
+
+def film_amplitudes(cos_ext, stack: FilmStack):
+    """``(sin_int, cos_int, (a_s, a_p) in, (a_s, a_p) out)``: :func:`interface_amplitudes` with
+    films, ``a = t sqrt(c'/c)`` of each crossing of :func:`film_transmission` (complex)."""
+    c = np.asarray(cos_ext, dtype=float)
+    c = np.where(c < 1e-15, 0.0, c)  # exactly grazing, as interface_amplitudes
+    n = stack.indices[1].real
+    s_int = np.sqrt(1.0 - c * c) * (1.0 / n)
+    c_int = coating_cos(c, n)
+    # sqrt(c'/c): t_in and the exit's kz_0 / kz_s vanish like c, so a -> 0 at grazing
+    g = np.where(c > 0.0, np.sqrt(c_int / np.where(c > 0.0, c, 1.0)), 0.0)
+    (ts, tp), (us, up) = film_transmission(c, stack)
+    return s_int, c_int, (ts * g, tp * g), (us * g, up * g)
+
+
+def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> float:
+    """``R-bar`` (F5): ``int_0^1 R_10 du``, ``u = sin^2 theta'`` inside the coating (``1/pi``
+    normalization, as :func:`internal_hemispherical_reflectance`), for the films of
+    ``stack`` (a :class:`models.FilmStack` on the coating's real index) under the ambient 1.
+
+    ``R_10`` has square-root branch points where the ambient's and the coating's normal
+    wavevectors vanish (the critical angle and internal grazing; the films' own are even in
+    their ``kz`` and cancel).  Two substitutions make each part smooth on ``phi in [0, pi/2]``:
+    ``u = sin^2(phi) / n^2`` below the critical angle and ``u = 1/n^2 + (1 - 1/n^2) sin^2(phi)``
+    beyond it (``kz`` of the ambient and of the coating are then ``cos phi``, ``sin phi``
+    times constants).  Composite 16-point Gauss-Legendre, panels doubled until two estimates
+    differ by at most ``tol`` (interference fringes of thick films need many panels); at
+    2^14 panels the last estimate stands (a film thousands of wavelengths thick, whose
+    fringes are finer than any measurement resolves).
+    """
+    n = stack.indices[1].real
+    up = stack.upward(1.0)
+    x, w = np.polynomial.legendre.leggauss(16)
+
+    def estimate(panels):
+        edges = np.linspace(0.0, 0.5 * math.pi, panels + 1)
+        half = 0.5 * np.diff(edges)
+        phi = ((edges[:-1] + half)[:, None] + half[:, None] * x).ravel()
+        weight = (half[:, None] * w).ravel() * np.sin(2.0 * phi)
+        total = 0.0
+        parts = [(1.0 / (n * n), np.sqrt(1.0 - (np.sin(phi) / n) ** 2))]  # below the critical angle
+        if n > 1.0:
+            parts.append((1.0 - 1.0 / (n * n), math.sqrt(1.0 - 1.0 / (n * n)) * np.cos(phi)))
+        for du, cos_int in parts:
+            rs, rp, _, _ = up.coefficients(cos_int, n)
+            total += du * float(np.dot(weight, 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)))
+        return total
+
+    panels, last = 4, estimate(4)
+    while panels < 2**14:
+        panels *= 2
+        new = estimate(panels)
+        if abs(new - last) <= tol:
+            return new
+        last = new
+    return last

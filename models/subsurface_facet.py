@@ -1,13 +1,37 @@
-"""Facets under a smooth, non-absorbing coating (seed 000, the paper's model)."""
+"""Facets under a smooth, non-absorbing coating (seed 000, the paper's model), optionally
+with thin films on the coating's top surface.
+
+Films on the coating (``coating_films``, ambient | films | coating).  Seed 000 Eq. 16-18
+write the Jones matrix as ``q = diag(t_r) Q diag(t_i)`` with ``t_i = t(theta_i; 1, n)``
+(Eq. 14, entrance) and ``t_r = t(theta_r; 1, n)`` (Eq. 15, exit) for s and p, ``Q`` the
+facet's reflection in the internal rays' bases.  With films each factor becomes the
+stack's complex amplitude (:mod:`models.smooth_interface`, F1-F2):
+
+    t_i -> t_01(theta_i)                        entrance: ambient -> films -> coating
+    t_r -> t_10(theta_r') kz_0 / kz_s           exit: coating -> films -> ambient,
+                                                kz_0 = cos theta_r, kz_s = n cos theta_r'
+
+so ``q_ab = t_r,a Q_ab t_i,b`` is a product of complex numbers (the films' s/p phase
+difference reaches the Mueller matrix's U and V rows).  Nothing else of Eq. 2-13, 19 and 49
+changes: planar films bend no ray, so the internal directions, the facet, its slope density
+and the Jacobian are the bare coating's.  Energy: ``|t|^2`` times the ``kz`` ratios are the
+stack's transmittances (F3), below ``1 - R`` with an absorbing film; reciprocity: the stack
+has ``t_10 kz_0 = t_01 kz_s`` (:mod:`models.thin_film`, (R)), so the exit factor at
+``theta`` equals the entrance factor at ``theta`` and ``q`` keeps Eq. 16-18's symmetry
+(F4; tested to the bare model's tolerance).  Without films the model is seed 000's, the
+compiled kernel included.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 from .facet import _FacetModel, _index_or_stack
 from .params import param
 from .shadowing import SHADOWING
 from .slopes import ExponentialSlopes, SlopeDistribution
+from .thin_film import Films, check_films
 
 __all__ = ["SubsurfaceFacetBRDF"]
 
@@ -40,6 +64,11 @@ class SubsurfaceFacetBRDF(_FacetModel):
         ``"none"`` (seed 000), ``"smith"`` or ``"smith-correlated"``
         (:mod:`models.shadowing`), evaluated inside the coating with the refracted
         directions: the facets mask the internal rays.
+    coating_films : Films or None
+        Thin films on the coating's top surface (:class:`models.Films`: layers from the
+        ambient down, and the wavelength), on the index ``coating``: e.g. an anti-reflection
+        film.  ``None`` (default): the bare coating of seed 000.  Module docstring: the
+        films' complex transmission amplitudes replace Eq. 14-15's ``t(theta; 1, n)``.
     """
 
     slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
@@ -51,6 +80,17 @@ class SubsurfaceFacetBRDF(_FacetModel):
         check=_index_or_stack,
     )
     shadowing: str = param("none", "shadowing-masking (inside the coating)", kind="choice", choices=SHADOWING)
+    coating_films: Films = param(
+        None, "thin films on the coating's top surface (None: bare)", kind="object", check=check_films
+    )
 
     def _coating(self) -> float:
         return self.coating
+
+    def _top(self):
+        return self._top_stack
+
+    @cached_property
+    def _top_stack(self):
+        """``coating_films`` on the coating index (a :class:`models.FilmStack`), or ``None``."""
+        return None if self.coating_films is None else self.coating_films.on(self.coating)

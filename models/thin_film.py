@@ -33,6 +33,24 @@ itself.  A perfect-conductor substrate (``math.inf``) has ``r_s = -1``,
 Dispersion: every index (films and substrate) may be a number or a callable
 of the wavelength in nm returning ``n + ik`` (e.g. :class:`TabulatedIndex`);
 :meth:`FilmStack.at` gives the same stack at another wavelength.
+
+Transmission both ways (:meth:`FilmStack.transmission`).  Between a real top medium
+``n_0`` (the ambient) and a real substrate ``n_s >= n_0`` (a coating), light crosses the
+films down, ``t_01`` (the recursion above), and up, ``t_10``: the same recursion on the
+reversed stack, incident from ``n_s``, at the same Snell invariant ``n_0 sin theta_0``.
+The stack is reciprocal (isotropic films, absorbing or not: Lorentz reciprocity), so in
+this field-amplitude convention, for s and p alike,
+
+    t_10 kz_0 = t_01 kz_s,    kz_0 = n_0 cos theta_0,  kz_s = n_s cos theta_s,          (R)
+
+as for one Fresnel interface (``t_s = 2 kz_j / (kz_j + kz_j1)`` and its reverse); the
+tests check (R) on absorbing stacks rather than assume it.  The fluxes are
+``T_01 = kz_s / kz_0 |t_01|^2`` and ``T_10 = kz_0 / kz_s |t_10|^2`` (both media real, so
+``Re(kz) = kz``), each ``<= 1 - R`` with the difference absorbed in the films.
+
+:class:`Films` are films with no substrate of their own: the layers and wavelength of a
+stack that a model places on an index it holds (``coating_films`` of the coated models
+sits on their ``coating``, :meth:`Films.on`), so that index is stated once.
 """
 
 from __future__ import annotations
@@ -46,7 +64,7 @@ import numpy as np
 from .fresnel import _w, fresnel_coefficients, reflection_rs_k
 from .params import Declared, check_index, check_real, param
 
-__all__ = ["FilmStack", "TabulatedIndex"]
+__all__ = ["FilmStack", "Films", "TabulatedIndex", "check_films"]
 
 
 @dataclass(frozen=True)
@@ -87,6 +105,29 @@ def _resolve(name, value, wavelength_nm):
     return check_index(name, value)
 
 
+def _checked_layers(layers):
+    """``layers`` as a tuple of ``(index, thickness_nm)`` pairs, thicknesses checked (>= 0)."""
+    try:
+        pairs = tuple((idx, d) for idx, d in layers)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"layers must be a sequence of (index, thickness_nm) pairs; got {layers!r}"
+        ) from None
+    # check_real, not float(): a bool or a string is no thickness (float(True) is 1.0)
+    return tuple((idx, check_real(f"layers[{j}] thickness_nm", d, 0.0)) for j, (idx, d) in enumerate(pairs))
+
+
+def _film_indices(layers, wavelength_nm):
+    """The films' indices at ``wavelength_nm``, validated and finite."""
+    films = []
+    for j, (idx, _) in enumerate(layers):
+        n = _resolve(f"layers[{j}] index", idx, wavelength_nm)
+        if n == math.inf:
+            raise ValueError(f"layers[{j}] index must be finite (n + ik); got inf")
+        films.append(n)
+    return tuple(films)
+
+
 @dataclass(frozen=True)
 class FilmStack(Declared):
     """Thin films on a substrate, usable wherever a substrate index is (module docstring).
@@ -107,29 +148,15 @@ class FilmStack(Declared):
     wavelength_nm: float = param(550.0, "vacuum wavelength (nm)", low=0.0, low_open=True)
 
     def _validate(self):
-        try:
-            pairs = tuple((idx, d) for idx, d in self.layers)
-        except (TypeError, ValueError):
-            raise ValueError(
-                f"layers must be a sequence of (index, thickness_nm) pairs; got {self.layers!r}"
-            ) from None
-        # check_real, not float(): a bool or a string is no thickness (float(True) is 1.0)
-        layers = tuple(
-            (idx, check_real(f"layers[{j}] thickness_nm", d, 0.0)) for j, (idx, d) in enumerate(pairs)
-        )
-        object.__setattr__(self, "layers", layers)
+        object.__setattr__(self, "layers", _checked_layers(self.layers))
         _ = self.indices  # validates every index at this wavelength
 
     @cached_property
     def indices(self):
         """``(film indices, substrate index)`` at :attr:`wavelength_nm` (films finite)."""
-        films = []
-        for j, (idx, _) in enumerate(self.layers):
-            n = _resolve(f"layers[{j}] index", idx, self.wavelength_nm)
-            if n == math.inf:
-                raise ValueError(f"layers[{j}] index must be finite (n + ik); got inf")
-            films.append(n)
-        return tuple(films), _resolve("substrate", self.substrate, self.wavelength_nm)
+        return _film_indices(self.layers, self.wavelength_nm), _resolve(
+            "substrate", self.substrate, self.wavelength_nm
+        )
 
     def at(self, wavelength_nm):
         """The same stack at another vacuum wavelength (nm)."""
@@ -145,14 +172,7 @@ class FilmStack(Declared):
         kz = [n0 * c + 0j] + [n0 * _w(c, n / n0) for n in films]  # n_j cos(theta_j), Im >= 0
         ns = [complex(n0)] + list(films)
         r, t = _bottom(kz[-1], ns[-1], c, n0, sub)
-        for j in range(len(films), 0, -1):
-            e_half = np.exp(2j * math.pi * self.layers[j - 1][1] / self.wavelength_nm * kz[j])
-            e = e_half * e_half
-            rj, tj = _interface(kz[j - 1], kz[j], ns[j - 1], ns[j])
-            den = [1.0 + rj[q] * r[q] * e for q in (0, 1)]
-            r = [(rj[q] + r[q] * e) / den[q] for q in (0, 1)]
-            t = [tj[q] * t[q] * e_half / den[q] for q in (0, 1)]
-        return r[0], r[1], t[0], t[1]
+        return _rouard(kz, ns, [d for _, d in self.layers], self.wavelength_nm, r, t)
 
     def reflection_rs_k(self, cos_i, n_incident):
         """``r_s`` and ``K = (r_s + r_p) / sin^2(theta)`` (:func:`models.fresnel.reflection_rs_k`).
@@ -185,6 +205,109 @@ class FilmStack(Declared):
         ts2 = kz.real * np.abs(ts) ** 2 * inv
         tp2 = (np.conj(sub) * kz / sub).real * np.abs(tp) ** 2 * inv
         return np.abs(rs) ** 2, np.abs(rp) ** 2, ts2, tp2
+
+    def transmission(self, cos_top, n_top=1.0):
+        """``((t_s, t_p) down, (t_s, t_p) up)``: field transmission amplitudes through the films
+        between the real ``n_top`` and this stack's substrate (module docstring, ``t_01`` and
+        ``t_10``).
+
+        ``cos_top`` is the cosine in ``n_top`` of both rays: the one arriving from above, and
+        the one leaving the substrate upwards that emerges there.  The substrate must be real
+        and ``>= n_top`` (a coating under the ambient), so that every direction above has a
+        propagating partner below.  The upward amplitudes come from the same recursion as
+        :meth:`coefficients` (not a second transfer-matrix code) run on the reversed layers
+        from the substrate, with every layer's ``kz`` computed from ``cos_top`` as the downward
+        ones are: ``kz_0 = n_top cos_top`` exactly.  (From the substrate's cosine,
+        ``kz_0 = sqrt(n_s^2 cos^2 theta_s - n_s^2 + n_0^2)`` cancels near grazing exit: at
+        ``theta_0 = pi/2 - 1e-9`` under ``n_s = 1.5`` it came out 0 instead of 1e-9, and the
+        exit amplitudes erred by 2e-9 relative, a reciprocity error the stability sweep
+        flagged.)
+        """
+        n0 = check_real("n_top", n_top, 0.0, low_open=True)
+        films, sub = self.indices
+        if sub == math.inf or sub.imag != 0 or sub.real < n0:
+            raise ValueError(
+                f"substrate must be a real index >= n_top ({n0:g}) for transmission both ways; got {sub!r}"
+            )
+        c = np.asarray(cos_top, dtype=float)
+        _, _, ts, tp = self.coefficients(c, n0)
+        kz = [n0 * _w(c, sub / n0)] + [n0 * _w(c, n / n0) for n in films[::-1]]
+        ns = [sub] + list(films[::-1])
+        r, t = (list(x) for x in _interface(kz[-1], n0 * c + 0j, ns[-1], complex(n0)))
+        _, _, us, up = _rouard(kz, ns, [d for _, d in self.layers[::-1]], self.wavelength_nm, r, t)
+        return (ts, tp), (us, up)
+
+    def upward(self, n_top=1.0):
+        """The stack as light leaving the substrate meets it: the films in reverse order on
+        ``n_top``; its :meth:`coefficients` take the substrate's (real) index as ``n_incident``."""
+        return FilmStack(layers=self.layers[::-1], substrate=n_top, wavelength_nm=self.wavelength_nm)
+
+
+@dataclass(frozen=True)
+class Films(Declared):
+    """Thin films with no substrate of their own: a model places them on an index it holds.
+
+    ``coating_films=Films(...)`` of :class:`models.SubsurfaceFacetBRDF`,
+    :class:`models.SingleScatterBRDF` and :class:`models.DiffuseSubsurfaceBRDF` puts them on
+    the coating's top surface (ambient | films | coating, :meth:`on` the model's
+    ``coating``), so the coating's index is stated once, by the model.
+
+    Parameters
+    ----------
+    layers : tuple of (index, thickness_nm)
+        Films from the ambient side down, as :class:`FilmStack`'s ``layers``.
+    wavelength_nm : float
+        Vacuum wavelength (nm) at which the indices and phases are evaluated.
+    """
+
+    layers: tuple = param((), "films ((index, thickness_nm), ...) from the ambient side down", kind="object")
+    wavelength_nm: float = param(550.0, "vacuum wavelength (nm)", low=0.0, low_open=True)
+
+    def _validate(self):
+        object.__setattr__(self, "layers", _checked_layers(self.layers))
+        _ = self.indices
+
+    @cached_property
+    def indices(self):
+        """The films' indices at :attr:`wavelength_nm`."""
+        return _film_indices(self.layers, self.wavelength_nm)
+
+    def on(self, substrate):
+        """The :class:`FilmStack` of these films on ``substrate``."""
+        return FilmStack(layers=self.layers, substrate=substrate, wavelength_nm=self.wavelength_nm)
+
+    def at(self, wavelength_nm):
+        """The same films at another vacuum wavelength (nm)."""
+        return self.replace(wavelength_nm=wavelength_nm)
+
+
+def check_films(name, value):
+    """The ``check`` of a ``coating_films`` parameter (:func:`models.params.param`): ``None``
+    (no films: the bare interface) or a :class:`Films`, which validated itself when built."""
+    if value is None or isinstance(value, Films):
+        return value
+    hint = (
+        "; a FilmStack states its own substrate, and the films sit on the model's coating: pass "
+        "Films(layers=..., wavelength_nm=...)"
+        if isinstance(value, FilmStack)
+        else ""
+    )
+    raise ValueError(f"{name} must be None or a models.Films (layers, wavelength_nm); got {value!r}{hint}")
+
+
+def _rouard(kz, ns, thickness, wavelength_nm, r, t):
+    """``(r_s, r_p, t_s, t_p)`` seen from the incident medium: the films summed from the bottom
+    up (module docstring).  ``kz`` and ``ns`` list the incident medium then the films in order
+    (film ``j`` has ``thickness[j - 1]`` nm); ``r``, ``t`` are the ``[s, p]`` coefficients of
+    the last film's interface with the medium below it."""
+    for j in range(len(thickness), 0, -1):
+        e_half = np.exp(2j * math.pi * thickness[j - 1] / wavelength_nm * kz[j])
+        e = e_half * e_half
+        rj, tj = _interface(kz[j - 1], kz[j], ns[j - 1], ns[j])
+        den = [1.0 + rj[q] * r[q] * e for q in (0, 1)]
+        r = [(rj[q] + r[q] * e) / den[q] for q in (0, 1)]
+        t = [tj[q] * t[q] * e_half / den[q] for q in (0, 1)]
+    return r[0], r[1], t[0], t[1]
 
 
 def _interface(kz1, kz2, n1, n2):

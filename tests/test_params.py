@@ -59,7 +59,7 @@ def test_range_in_message():
 
 def test_parameters_are_declared_and_listed():
     names = [p.name for p in models.SubsurfaceFacetBRDF.parameters()]
-    assert names == ["slopes", "coating", "substrate", "shadowing"]
+    assert names == ["slopes", "coating", "substrate", "shadowing", "coating_films"]
     text = models.list_models()
     assert "SubsurfaceFacetBRDF" in text and "coating" in text and "perfect conductor" in text
 

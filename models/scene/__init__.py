@@ -33,6 +33,13 @@ Schema (angles in degrees in files, as everywhere outside the Python API)::
     sigma = 0.02
     shadowing = "smith"            # none (default) | smith | smith-correlated (not with a
                                    # Monte Carlo [volume] under it: interface = "rough")
+    [coating.film]                 # optional: thin films on the coating's top surface
+                                   # (models.Films, coating_films of the models), from the
+                                   # ambient down, at [illumination] wavelength_nm (then
+                                   # required); with facets (model = "facet") or a [volume]
+                                   # under a smooth interface, not with cook-torrance or the
+                                   # Monte Carlo volume
+    layers = [{index = 1.2247, thickness_nm = 129.2}]
 
     [substrate]                    # the flakes or the substrate under the coating
     index = [1.37, 7.62]           # [n, k], a number, or "inf" (perfect conductor)

@@ -45,22 +45,26 @@ def mechanisms(substrate: dict | None, coating: dict | None, volume: dict | None
     """The mechanisms of a scene's validated ``[substrate]``, ``[coating]`` and ``[volume]``."""
     coat_n = coating["index"] if coating else None
     rough_top = coating.get("roughness") if coating else None
-    out = [] if substrate is None else substrate["entry"].mechanisms(substrate, coat_n)
+    # films on the coating's top ([coating.film]): the schema allows them only where a model takes them
+    top = {"coating_films": coating["films"]} if coating and coating.get("films") is not None else {}
+    out = [] if substrate is None else substrate["entry"].mechanisms(substrate, coat_n, **top)
     if rough_top is not None:
+        surface = top["coating_films"].on(coat_n) if top else coat_n
         out.append(
             Mechanism(
                 "rough coating surface",
-                FacetBRDF(slopes=rough_top, substrate=coat_n, shadowing=coating.get("shadowing", "none")),
-                "the coating's top surface is rough: facet reflection by the exposed interface",
+                FacetBRDF(slopes=rough_top, substrate=surface, shadowing=coating.get("shadowing", "none")),
+                "the coating's top surface is rough: facet reflection by the exposed interface"
+                + (" (its films on the coating)" if top else ""),
             )
         )
     if volume is not None:
-        out = _volume_mechanisms(out, volume, coat_n, rough_top)
+        out = _volume_mechanisms(out, volume, coat_n, rough_top, top)
     return out
 
 
-def facet_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
-    """Facets (flakes or a rough substrate), under the coating when there is one."""
+def facet_mechanisms(sub: dict, coat_n, coating_films=None) -> list[Mechanism]:
+    """Facets (flakes or a rough substrate), under the coating (and its films) when there is one."""
     if sub["slopes"] is None:
         return []  # a flat substrate only reflects specularly
     kw = {
@@ -70,8 +74,10 @@ def facet_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
     }
     films = " with thin films on them" if isinstance(sub["index"], FilmStack) else ""
     if coat_n is not None:
-        model = SubsurfaceFacetBRDF(coating=coat_n, **kw)
+        model = SubsurfaceFacetBRDF(coating=coat_n, coating_films=coating_films, **kw)
         why = f"facets (flakes or a rough substrate){films} under the coating: seed 000's subsurface facet model"
+        if coating_films is not None:
+            why += ", through the films on the coating (their complex transmission amplitudes)"
         return [Mechanism("subsurface facets", model, why)]
     model = FacetBRDF(**kw)
     why = f"a rough substrate{films} with no coating: the exposed facet model"
@@ -114,7 +120,7 @@ def maxwell_beard_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
     return [Mechanism("Maxwell-Beard", model, why)]
 
 
-def _volume_mechanisms(out, v, n, rough_top):
+def _volume_mechanisms(out, v, n, rough_top, top):
     """Seed 003: volume scattering in the binder (index = the coating's)."""
     phase = HenyeyGreenstein(g=v["g"], polarized=v["polarized"])
     if rough_top is not None and v["interface"] == "rough":
@@ -137,18 +143,18 @@ def _volume_mechanisms(out, v, n, rough_top):
         )
         return out + [Mechanism("volume under a rough interface (Monte Carlo)", model, why)]
     under = (
-        "under a smooth interface"
+        "under a smooth interface" + (" with films" if top else "")
         if rough_top is None
         else "treated as under a smooth interface, as seed 003 does for the red paint (interface = 'smooth')"
     )
     if v["single"]:
-        single = SingleScatterBRDF(coating=n, phase=phase)
+        single = SingleScatterBRDF(coating=n, phase=phase, **top)
         if v["single_weight"] != 1.0:
             single = v["single_weight"] * single
         why = f"single scattering by the pigment {under} (seed 003 Eq. 8-20); no Monte Carlo needed"
         out.append(Mechanism("single volume scattering", single, why))
     if v["rho"] > 0:
-        model = DiffuseSubsurfaceBRDF(coating=n, rho=v["rho"])
+        model = DiffuseSubsurfaceBRDF(coating=n, rho=v["rho"], **top)
         out.append(
             Mechanism(
                 "totally diffuse volume", model, f"multiply scattered light {under} (seed 003 Eq. 21-28)"

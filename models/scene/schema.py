@@ -18,7 +18,7 @@ from ..facet import FacetBRDF
 from ..point_source import PointSourceBRDF
 from ..polarization import stokes
 from ..subsurface_facet import SubsurfaceFacetBRDF
-from ..thin_film import FilmStack
+from ..thin_film import Films, FilmStack
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
 __all__ = [
@@ -141,11 +141,12 @@ def parse(data: dict, path: str) -> dict:
     if "fit" in data and not isinstance(data["fit"], dict):
         raise _err(path, "[fit]", f"must be a table (free, noise, mask); got {shown(data['fit'])}")
     out = {"name": name, **_illumination(path, data.get("illumination"))}
-    out["coating"] = _coating(path, data["coating"]) if "coating" in data else None
+    out["coating"] = _coating(path, data["coating"], out["wavelength_nm"]) if "coating" in data else None
     out["substrate"] = (
         _substrate(path, data["substrate"], data, out["wavelength_nm"]) if "substrate" in data else None
     )
     out["volume"] = _volume(path, data["volume"], out["coating"]) if "volume" in data else None
+    _coating_films_apply(path, out)
     out["detector"] = _detector(path, data["detector"]) if "detector" in data else None
     out["fit"] = data.get("fit")
     return out
@@ -233,11 +234,15 @@ def _illumination(path, ill):
     return out
 
 
-def _coating(path, c):
-    _unknown(path, "[coating] ", c, {"index", "roughness"})
+def _coating(path, c, wavelength_nm):
+    _unknown(path, "[coating] ", c, {"index", "roughness", "film"})
     if "index" not in c:
         raise _err(path, "[coating] index", "required: a real index >= 1")
     out = {"index": _declared(path, "[coating] index", SubsurfaceFacetBRDF, "coating", c["index"])}
+    out["films"] = None
+    if "film" in c:
+        layers = _film_layers(path, "[coating.film]", c["film"], wavelength_nm)
+        out["films"] = _film_built(path, "[coating.film]", Films, layers=layers, wavelength_nm=wavelength_nm)
     if "roughness" in c:
         rough = c["roughness"]
         if not isinstance(rough, dict):
@@ -340,26 +345,34 @@ def _substrate(path, s, data, wavelength_nm):
 
 
 def _film(path, film, substrate, wavelength_nm):
-    """``[substrate.film]``: thin films on the substrate/flakes (:class:`models.FilmStack`),
-    ``layers = [{index = [n, k], thickness_nm = d}, ...]`` from the incident side down, at
-    ``[illumination] wavelength_nm``."""
-    _unknown(path, "[substrate.film] ", film, {"layers"})
+    """``[substrate.film]``: thin films on the substrate/flakes (:class:`models.FilmStack`)."""
+    layers = _film_layers(path, "[substrate.film]", film, wavelength_nm)
+    return _film_built(
+        path, "[substrate.film]", FilmStack, layers=layers, substrate=substrate, wavelength_nm=wavelength_nm
+    )
+
+
+def _film_layers(path, section, film, wavelength_nm):
+    """The layers of a film table (``[substrate.film]``, ``[coating.film]``): ``layers =
+    [{index = [n, k], thickness_nm = d}, ...]`` from the incident side down, at
+    ``[illumination] wavelength_nm``, as ``((index, thickness_nm), ...)`` (values unchecked)."""
+    _unknown(path, f"{section} ", film, {"layers"})
     if wavelength_nm is None:
         raise _err(
             path,
             "[illumination] wavelength_nm",
-            "required with [substrate.film]: the films' phase thicknesses depend on the wavelength",
+            f"required with {section}: the films' phase thicknesses depend on the wavelength",
         )
     layers = film.get("layers")
     if not isinstance(layers, list) or not layers:
         raise _err(
             path,
-            "[substrate.film] layers",
+            f"{section} layers",
             f"required: a non-empty array of tables {{index = [n, k], thickness_nm = d}}; got {shown(layers)}",
         )
     out = []
     for j, layer in enumerate(layers):
-        key = f"[substrate.film] layers[{j}]"
+        key = f"{section} layers[{j}]"
         if not isinstance(layer, dict):
             raise _err(path, key, f"must be a table {{index = [n, k], thickness_nm = d}}; got {shown(layer)}")
         _unknown(path, f"{key}.", layer, {"index", "thickness_nm"})
@@ -367,12 +380,43 @@ def _film(path, film, substrate, wavelength_nm):
             if k not in layer:
                 raise _err(path, f"{key}.{k}", f"required: {what}")
         out.append((_index(path, f"{key}.index", layer["index"]), layer["thickness_nm"]))
-    try:  # the stack validates the values; its message names layers[j] index / thickness_nm
-        return FilmStack(layers=tuple(out), substrate=substrate, wavelength_nm=wavelength_nm)
+    return tuple(out)
+
+
+def _film_built(path, section, cls, **kw):
+    """``cls(**kw)`` (:class:`models.FilmStack` or :class:`models.Films`), which validates the
+    values; its message names ``layers[j] index / thickness_nm``, the error the file's key."""
+    try:
+        return cls(**kw)
     except ValueError as exc:
         m = re.match(r"layers\[(\d+)\] (index|thickness_nm)", str(exc))
-        key = f"[substrate.film] layers[{m[1]}].{m[2]}" if m else "[substrate.film]"
+        key = f"{section} layers[{m[1]}].{m[2]}" if m else section
         raise _err(path, key, str(exc)) from exc
+
+
+def _coating_films_apply(path, out):
+    """``[coating.film]`` only where a model takes films on the coating's top surface: facets
+    under it (:class:`models.SubsurfaceFacetBRDF`), a volume under a smooth interface
+    (:class:`models.SingleScatterBRDF`, :class:`models.DiffuseSubsurfaceBRDF`) and the rough
+    top surface's own facet reflection; not seed 001's varnish model, nor the Monte Carlo
+    model under a rough interface."""
+    coating, sub, vol = out["coating"], out["substrate"], out["volume"]
+    if coating is None or coating["films"] is None:
+        return
+    if sub is not None and sub["model"] != "facet":
+        raise _err(
+            path,
+            "[coating.film]",
+            f"not with [substrate] model = {sub['model']!r}: its varnish model takes no films "
+            "(films on the coating go with model = 'facet' or a [volume])",
+        )
+    if vol is not None and vol["interface"] == "rough" and coating.get("roughness") is not None:
+        raise _err(
+            path,
+            "[coating.film]",
+            "not with a [volume] under the rough coating (interface = 'rough'): its Monte Carlo model "
+            "has no films; use interface = 'smooth' or omit [coating.film]",
+        )
 
 
 def _slope_keys_apply(path, s, kind, entry):

@@ -137,6 +137,24 @@ def _issue15_bases(name):
     return out + [(cls(substrate=f, shadowing=sh), ()) for f in films for sh in ("none", "smith")]
 
 
+def _coating_film_bases(name):
+    """Films on the coating's top surface (``coating_films``) of the models that take them, as
+    ``(instance, swept parameters)``: a zero-thickness film, a quarter-wave anti-reflection
+    film, a thick one and an absorbing pair as they are, and the absorbing pair with the
+    coating swept to its edges (1, 1 + 1e-9, 3)."""
+    if name not in ("SubsurfaceFacetBRDF", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF"):
+        return []
+    cls = getattr(models, name)
+    ar = math.sqrt(1.5)
+    absorbing = models.Films(layers=((1.8 + 0.3j, 120.0), (2.4, 60.0)), wavelength_nm=550.0)
+    films = (
+        models.Films(layers=((2.0, 0.0),), wavelength_nm=550.0),
+        models.Films(layers=((ar, 550.0 / (4 * ar)),), wavelength_nm=550.0),
+        models.Films(layers=((2.6, 1e5),), wavelength_nm=550.0),
+    )
+    return [(cls(coating_films=f), ()) for f in films] + [(cls(coating_films=absorbing), ("coating",))]
+
+
 _INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
 
 
@@ -224,7 +242,7 @@ def edge_instances(cls):
         if inst not in out:
             out.append(inst)
     if not isinstance(cls, models.Model):
-        for extra, names in _issue15_bases(cls.__name__):
+        for extra, names in _issue15_bases(cls.__name__) + _coating_film_bases(cls.__name__):
             out += [inst for inst in _one_at_a_time(extra, names) if inst not in out]
     return out
 
@@ -237,6 +255,8 @@ def _real_indices(obj, out=None):
             if isinstance(v, models.FilmStack):  # its films' and substrate's indices
                 films, sub = v.indices
                 out += [float(n.real) for n in (*films, sub) if n != math.inf and n.imag == 0]
+            elif isinstance(v, models.Films):  # films on the coating: their indices
+                out += [float(n.real) for n in v.indices if n.imag == 0]
             elif info.kind in ("index", "real_index") and v != math.inf and complex(v).imag == 0:
                 out.append(float(complex(v).real))
             elif isinstance(v, Declared):
