@@ -24,6 +24,7 @@ import argparse
 import math
 import subprocess
 import tempfile
+import time
 
 import numba
 import numpy as np
@@ -73,20 +74,34 @@ def per_geometry(n, repeat):
 
 
 def small_calls(repeat):
-    """``{case: (numpy us, kernel us)}`` per call of SubsurfaceFacetBRDF."""
-    m = models.SubsurfaceFacetBRDF()
+    """``{"model, case": (numpy us, kernel us)}`` per call of every closed-form model: one
+    geometry as three floats (``m.mueller(0.5, 0.6, 0.1)``) and 100 geometries (two float64
+    arrays and a float).  Each figure is the best over ``10 * repeat`` batches of about 2 ms
+    (on a shared machine short batches miss the other processes' time slices)."""
     x = np.linspace(0.1, 1.4, 100)
     y = x[::-1].copy()
-    cases = {"one geometry": lambda: m.mueller(0.5, 0.6, 0.1), "100 geometries": lambda: m.mueller(x, y, 0.3)}
     out = {}
-    k = 2000
-    for name, fn in cases.items():
-        fn()
-        with models.backend("numpy"):
-            t_np = best_of(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat)[0] / k
-        t_k = best_of(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat)[0] / k
-        out[name] = (1e6 * t_np, 1e6 * t_k)
+    for name, make in MODELS.items():
+        m = make()
+        cases = {
+            "one geometry": lambda m=m: m.mueller(0.5, 0.6, 0.1),
+            "100 geometries": lambda m=m: m.mueller(x, y, 0.3),
+        }
+        for case, fn in cases.items():
+            fn()
+            with models.backend("numpy"):
+                fn()
+                t_np = _per_call(fn, repeat)
+            t_k = _per_call(fn, repeat)
+            out[f"{name}, {case}"] = (1e6 * t_np, 1e6 * t_k)
     return out
+
+
+def _per_call(fn, repeat):
+    t = time.perf_counter()
+    fn()
+    k = max(1, int(2e-3 / max(time.perf_counter() - t, 1e-7)))
+    return best_of(lambda: [fn() for _ in range(k)], 10 * repeat)[0] / k
 
 
 def float32(n, repeat):
@@ -124,7 +139,7 @@ def main():
     for name, (t_np, t_1, t_all) in per_geometry(args.n, args.repeat).items():
         print(f"{name:<26} {t_np:9.4f} {t_1:9.4f} {t_all:9.4f} {t_np / t_1:7.1f}x {t_1 / t_all:8.2f}x")
     for name, (t_np, t_k) in small_calls(args.repeat).items():
-        print(f"small call, {name:<15} numpy {t_np:8.1f} us, kernel {t_k:6.1f} us ({t_np / t_k:.1f}x)")
+        print(f"small call, {name:<42} numpy {t_np:8.1f} us, kernel {t_k:6.1f} us ({t_np / t_k:.1f}x)")
     t64, t32, err = float32(args.n, args.repeat)
     print(
         f"float32: {t32:.4f} us vs float64 {t64:.4f} us per geometry; error {err:.1e} (max |M32 - M64| / max M00)"
