@@ -74,14 +74,15 @@ sensitivity to it; ``u = EPS / 2`` is the unit roundoff, ``Delta`` the sine erro
 
 * every kernel parameter rounds to a finite float32 (a perfect conductor's ``inf`` is exact),
   zero or normal (``>= TINY``: a subnormal has lost digits), and ``<= sqrt(HUGE)`` (the kernels
-  square them);
+  square them); rotations (:data:`ANGLE_ROWS`) are reduced to (-pi, pi] in float64 first;
 * the model's scale, ``M00`` at normal incidence and exit in float64, is zero or within
   ``[TINY / EPS, sqrt(HUGE)]``: values down to ``EPS`` of it stay normal, and the peak and the
   Jones products have a factor 1.8e19 of room above it (e.g. a coating of index 1e16 makes the
   facet reflection ``~ (2 / n)^4 ~ 1e-64``, zero in float32).
 
-The sine term is the kernels' own: with sines from ``sin(theta)`` (relative error ``~ EPS``)
-:data:`SINE` would be ``~ EPS`` and the domain would reach lobes a hundred times narrower.
+The sine terms are the kernels' own: with sines from ``sin(theta)`` (relative error ``~ EPS``)
+:data:`SINE` would be a few EPS instead of 2048 and the domain would reach lobes hundreds of
+times narrower (``tests/test_float32_domain.py`` checks the 2048 against float32 itself).
 """
 
 from __future__ import annotations
