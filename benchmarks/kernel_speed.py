@@ -76,25 +76,38 @@ def per_geometry(n, repeat):
 def small_calls(repeat):
     """``{"model, case": (numpy us, kernel us)}`` per call of every closed-form model: one
     geometry as three floats (``m.mueller(0.5, 0.6, 0.1)``) and 100 geometries (two float64
-    arrays and a float).  Each figure is the best over ``10 * repeat`` batches of about 2 ms
-    (on a shared machine short batches miss the other processes' time slices)."""
+    arrays and a float); then, for SubsurfaceFacetBRDF, the other forms users pass (ints,
+    numpy scalars, lists, a broadcast grid, ``out=``, float32).  Each figure is the best over
+    ``10 * repeat`` batches of about 2 ms (on a shared machine short batches miss the other
+    processes' time slices)."""
     x = np.linspace(0.1, 1.4, 100)
     y = x[::-1].copy()
-    out = {}
+    cases = {}
     for name, make in MODELS.items():
         m = make()
-        cases = {
-            "one geometry": lambda m=m: m.mueller(0.5, 0.6, 0.1),
-            "100 geometries": lambda m=m: m.mueller(x, y, 0.3),
-        }
-        for case, fn in cases.items():
+        cases[f"{name}, one geometry"] = lambda m=m: m.mueller(0.5, 0.6, 0.1)
+        cases[f"{name}, 100 geometries"] = lambda m=m: m.mueller(x, y, 0.3)
+    m = MODELS["SubsurfaceFacetBRDF"]()
+    f, out = np.float64, np.empty((16, 100))
+    forms = {
+        "ints (0, 1, 0)": lambda: m.mueller(0, 1, 0),
+        "numpy scalars": lambda: m.mueller(f(0.5), f(0.6), f(0.1)),
+        "lists of 3": lambda: m.mueller([0.5, 0.6, 0.7], [0.6, 0.5, 0.4], [0.1, 0.2, 0.3]),
+        "10 x 10 grid": lambda: m.mueller(x[:10, None], y[None, :10], 0.3),
+        "100 into out=": lambda: m.mueller(x, y, 0.3, out=out),
+        "brdf, 100": lambda: m.brdf(x, y, 0.3),
+        "float32, one geometry": lambda: m.mueller(0.5, 0.6, 0.1, precision="float32"),
+        "float32, 100": lambda: m.mueller(x, y, 0.3, precision="float32"),
+    }
+    cases.update({f"SubsurfaceFacetBRDF, {k}": fn for k, fn in forms.items()})
+    result = {}
+    for case, fn in cases.items():
+        fn()
+        with models.backend("numpy"):
             fn()
-            with models.backend("numpy"):
-                fn()
-                t_np = _per_call(fn, repeat)
-            t_k = _per_call(fn, repeat)
-            out[f"{name}, {case}"] = (1e6 * t_np, 1e6 * t_k)
-    return out
+            t_np = _per_call(fn, repeat)
+        result[case] = (1e6 * t_np, 1e6 * _per_call(fn, repeat))
+    return result
 
 
 def _per_call(fn, repeat):

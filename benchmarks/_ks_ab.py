@@ -1,0 +1,153 @@
+"""The compiled kernels against the numpy reference path, measured in one run.
+
+    python benchmarks/kernel_speed.py [--n 1000000] [--repeat 5]
+
+Prints, for every closed-form model: the per-geometry cost of the full float64 Mueller
+matrix from angles at ``--n`` geometries with the numpy path and with the kernels on one
+thread and on every core (best of ``--repeat``), and the ratios; the small calls (one
+geometry, 100 geometries); float32 against float64 (cost, and the error as the trade-off
+study's precision knob defines it: max |M32 - M64| over every element / max M64_00); and
+the import + first-call time of a fresh process with an empty kernel cache (cold: the
+kernels compile) and again with that cache filled (warm).  The machine's load is printed
+before and after: figures from a shared machine are noisy, the ratios within one run less so.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+# the checkout's packages, not an installed copy, when run as ``python benchmarks/...``
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+import argparse
+import math
+import subprocess
+import tempfile
+import time
+
+import numba
+import numpy as np
+
+import models
+from benchmarks.speed import best_of
+from validation.checks.common import random_geometries
+from validation.studies.tradeoff import precision_error
+
+AL = 1.37 + 7.62j
+MODELS = {
+    "FacetBRDF": lambda: models.FacetBRDF(slopes=models.ExponentialSlopes(0.1), substrate=AL),
+    "SubsurfaceFacetBRDF": lambda: models.SubsurfaceFacetBRDF(),
+    "FacetBTDF": lambda: models.FacetBTDF(slopes=models.GaussianSlopes(0.2), substrate=1.5),
+    "SingleScatterBRDF": lambda: models.SingleScatterBRDF(phase=models.HenyeyGreenstein(0.3, True)),
+    "DiffuseSubsurfaceBRDF": lambda: models.DiffuseSubsurfaceBRDF(),
+    "CookTorranceBRDF": lambda: models.CookTorranceBRDF(),
+    "VarnishedCookTorranceBRDF": lambda: models.VarnishedCookTorranceBRDF(),
+    "MaxwellBeardBRDF": lambda: models.MaxwellBeardBRDF(polarized=True),
+}
+FIRST_CALL = (
+    "import time; t = time.perf_counter(); import models; "
+    "models.SubsurfaceFacetBRDF().mueller(0.5, 0.6, 0.1); print(time.perf_counter() - t)"
+)
+
+
+def geometries(n):
+    """``(ti, tr, pr)``: polar angles uniform in [0, 1.5] rad, azimuth in [-pi, pi) (seed 0)."""
+    return random_geometries(n, 0, max_deg=math.degrees(1.5))
+
+
+def per_geometry(n, repeat):
+    """``{model: (numpy us, one thread us, all threads us)}`` per geometry at ``n``."""
+    ti, tr, pr = geometries(n)
+    out = {}
+    for name, make in MODELS.items():
+        m = make()
+        m.mueller(ti[:10], tr[:10], pr[:10])  # compiled (or loaded) before timing
+        with models.backend("numpy"):
+            t_np = best_of(lambda m=m: m.mueller(ti, tr, pr), max(1, repeat // 2))[0]
+        numba.set_num_threads(1)
+        t_1 = best_of(lambda m=m: m.mueller(ti, tr, pr), repeat)[0]
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        t_all = best_of(lambda m=m: m.mueller(ti, tr, pr), repeat)[0]
+        out[name] = tuple(1e6 * t / n for t in (t_np, t_1, t_all))
+    return out
+
+
+def small_calls(repeat):
+    """``{"model, case": (numpy us, kernel us)}`` per call of every closed-form model: one
+    geometry as three floats (``m.mueller(0.5, 0.6, 0.1)``) and 100 geometries (two float64
+    arrays and a float).  Each figure is the best over ``10 * repeat`` batches of about 2 ms
+    (on a shared machine short batches miss the other processes' time slices)."""
+    x = np.linspace(0.1, 1.4, 100)
+    y = x[::-1].copy()
+    out = {}
+    for name, make in MODELS.items():
+        m = make()
+        cases = {
+            "one geometry": lambda m=m: m.mueller(0.5, 0.6, 0.1),
+            "100 geometries": lambda m=m: m.mueller(x, y, 0.3),
+        }
+        for case, fn in cases.items():
+            fn()
+            with models.backend("numpy"):
+                fn()
+                t_np = _per_call(fn, repeat)
+            t_k = _per_call(fn, repeat)
+            out[f"{name}, {case}"] = (1e6 * t_np, 1e6 * t_k)
+    return out
+
+
+def _per_call(fn, repeat):
+    t = time.perf_counter()
+    fn()
+    k = max(1, int(2e-3 / max(time.perf_counter() - t, 1e-7)))
+    return best_of(lambda: [fn() for _ in range(k)], 10 * repeat)[0] / k
+
+
+def float32(n, repeat):
+    """``(float64 us, float32 us, error)`` per geometry, SubsurfaceFacetBRDF; the error is
+    the precision knob's (:func:`validation.studies.tradeoff.precision_error`)."""
+    m = models.SubsurfaceFacetBRDF()
+    ti, tr, pr = geometries(n)
+    m.mueller(ti[:10], tr[:10], pr[:10], precision="float32")
+    t64 = best_of(lambda: m.mueller(ti, tr, pr), repeat)[0]
+    t32 = best_of(lambda: m.mueller(ti, tr, pr, precision="float32"), repeat)[0]
+    err = precision_error(m.mueller(ti, tr, pr, precision="float32"), m.mueller(ti, tr, pr))
+    return 1e6 * t64 / n, 1e6 * t32 / n, err
+
+
+def first_call():
+    """``(cold s, warm s)``: a fresh interpreter's import + first call, cache empty then filled."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=os.path.dirname(os.path.dirname(__file__)))
+        runs = [
+            subprocess.run([sys.executable, "-c", FIRST_CALL], env=env, capture_output=True, text=True)
+            for _ in "cw"
+        ]
+    return tuple(float(r.stdout.strip()) for r in runs)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=1_000_000)
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args()
+    print(
+        f"load {os.getloadavg()}; {numba.config.NUMBA_NUM_THREADS} threads; {args.n} geometries, full Mueller"
+    )
+    print(f"{'model':<26} {'numpy us':>9} {'1 thread':>9} {'all':>9} {'np/1thr':>8} {'1thr/all':>9}")
+    for name, (t_np, t_1, t_all) in per_geometry(args.n, args.repeat).items():
+        print(f"{name:<26} {t_np:9.4f} {t_1:9.4f} {t_all:9.4f} {t_np / t_1:7.1f}x {t_1 / t_all:8.2f}x")
+    for name, (t_np, t_k) in small_calls(args.repeat).items():
+        print(f"small call, {name:<42} numpy {t_np:8.1f} us, kernel {t_k:6.1f} us ({t_np / t_k:.1f}x)")
+    t64, t32, err = float32(args.n, args.repeat)
+    print(
+        f"float32: {t32:.4f} us vs float64 {t64:.4f} us per geometry; error {err:.1e} (max |M32 - M64| / max M00)"
+    )
+    cold, warm = first_call()
+    print(f"import + first call, fresh process: cold cache {cold:.1f} s, warm cache {warm:.2f} s")
+    print(f"load after: {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()
