@@ -112,7 +112,7 @@ def checked_angles(model, theta_i, theta_r, phi_r):
 
 #: one angle value a small call takes without numpy's conversion (a ``bool`` is not one:
 #: the general path refuses it, naming the angle)
-SCALARS = (float, int, np.float64)
+SCALARS = (float, int, np.float64, np.int64, np.int32)
 
 
 def scalar(x):
