@@ -24,6 +24,7 @@ import argparse
 import math
 import subprocess
 import tempfile
+import time
 
 import numba
 import numpy as np
@@ -73,20 +74,47 @@ def per_geometry(n, repeat):
 
 
 def small_calls(repeat):
-    """``{case: (numpy us, kernel us)}`` per call of SubsurfaceFacetBRDF."""
-    m = models.SubsurfaceFacetBRDF()
+    """``{"model, case": (numpy us, kernel us)}`` per call of every closed-form model: one
+    geometry as three floats (``m.mueller(0.5, 0.6, 0.1)``) and 100 geometries (two float64
+    arrays and a float); then, for SubsurfaceFacetBRDF, the other forms users pass (ints,
+    numpy scalars, lists, a broadcast grid, ``out=``, float32).  Each figure is the best over
+    ``10 * repeat`` batches of about 2 ms (on a shared machine short batches miss the other
+    processes' time slices)."""
     x = np.linspace(0.1, 1.4, 100)
     y = x[::-1].copy()
-    cases = {"one geometry": lambda: m.mueller(0.5, 0.6, 0.1), "100 geometries": lambda: m.mueller(x, y, 0.3)}
-    out = {}
-    k = 2000
-    for name, fn in cases.items():
+    cases = {}
+    for name, make in MODELS.items():
+        m = make()
+        cases[f"{name}, one geometry"] = lambda m=m: m.mueller(0.5, 0.6, 0.1)
+        cases[f"{name}, 100 geometries"] = lambda m=m: m.mueller(x, y, 0.3)
+    m = MODELS["SubsurfaceFacetBRDF"]()
+    f, out = np.float64, np.empty((16, 100))
+    forms = {
+        "ints (0, 1, 0)": lambda: m.mueller(0, 1, 0),
+        "numpy scalars": lambda: m.mueller(f(0.5), f(0.6), f(0.1)),
+        "lists of 3": lambda: m.mueller([0.5, 0.6, 0.7], [0.6, 0.5, 0.4], [0.1, 0.2, 0.3]),
+        "10 x 10 grid": lambda: m.mueller(x[:10, None], y[None, :10], 0.3),
+        "100 into out=": lambda: m.mueller(x, y, 0.3, out=out),
+        "brdf, 100": lambda: m.brdf(x, y, 0.3),
+        "float32, one geometry": lambda: m.mueller(0.5, 0.6, 0.1, precision="float32"),
+        "float32, 100": lambda: m.mueller(x, y, 0.3, precision="float32"),
+    }
+    cases.update({f"SubsurfaceFacetBRDF, {k}": fn for k, fn in forms.items()})
+    result = {}
+    for case, fn in cases.items():
         fn()
         with models.backend("numpy"):
-            t_np = best_of(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat)[0] / k
-        t_k = best_of(lambda fn=fn, k=k: [fn() for _ in range(k)], repeat)[0] / k
-        out[name] = (1e6 * t_np, 1e6 * t_k)
-    return out
+            fn()
+            t_np = _per_call(fn, repeat)
+        result[case] = (1e6 * t_np, 1e6 * _per_call(fn, repeat))
+    return result
+
+
+def _per_call(fn, repeat):
+    t = time.perf_counter()
+    fn()
+    k = max(1, int(2e-3 / max(time.perf_counter() - t, 1e-7)))
+    return best_of(lambda: [fn() for _ in range(k)], 10 * repeat)[0] / k
 
 
 def float32(n, repeat):
@@ -124,7 +152,7 @@ def main():
     for name, (t_np, t_1, t_all) in per_geometry(args.n, args.repeat).items():
         print(f"{name:<26} {t_np:9.4f} {t_1:9.4f} {t_all:9.4f} {t_np / t_1:7.1f}x {t_1 / t_all:8.2f}x")
     for name, (t_np, t_k) in small_calls(args.repeat).items():
-        print(f"small call, {name:<15} numpy {t_np:8.1f} us, kernel {t_k:6.1f} us ({t_np / t_k:.1f}x)")
+        print(f"small call, {name:<42} numpy {t_np:8.1f} us, kernel {t_k:6.1f} us ({t_np / t_k:.1f}x)")
     t64, t32, err = float32(args.n, args.repeat)
     print(
         f"float32: {t32:.4f} us vs float64 {t64:.4f} us per geometry; error {err:.1e} (max |M32 - M64| / max M00)"

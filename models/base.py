@@ -21,7 +21,7 @@ from functools import cached_property
 
 import numpy as np
 
-from . import evaluation, modelset
+from . import evaluation, float32_domain, modelset
 from .evaluation import CHUNK
 from .geometry import broadcast_angles
 from .modelset import array_leaves
@@ -165,16 +165,16 @@ class Model(Declared):
         The angles broadcast against each other and against the parameter shape of a model
         set (:attr:`param_shape`).  ``out``, optional: a ``(16, N)`` array of the
         precision's dtype (e.g. a ``numpy.memmap``) to write into, element-major, for very
-        large evaluations.  ``precision``: ``"float64"`` or ``"float32"`` (the float32
-        kernels, :mod:`models.kernels`; a model without one is evaluated in float64 and
-        rounded).
+        large evaluations.  ``precision``: ``"float64"`` or ``"float32"``: the float32
+        kernels (:mod:`models.kernels`) where the parameters lie in their float32-safe domain
+        (:mod:`models.float32_domain`); otherwise, as for a model without a kernel, the
+        float64 evaluation rounded to float32 (:attr:`float32_fallback` says why).
         """
-        if out is None and precision == "float64":
-            fast = self._fast(theta_i, theta_r, phi_r, 16)
-            if fast is not None:
-                return fast
+        fast = self._fast(theta_i, theta_r, phi_r, 16, precision, out)
+        if fast is not None:
+            return fast
         shape, out = self.mueller16(theta_i, theta_r, phi_r, out, precision)
-        return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
+        return evaluation.as_matrices(out, shape)
 
     def mueller16(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
         """``(shape, M)``: the Mueller BRDF as its element-major storage ``M`` ``(16, N)``
@@ -194,31 +194,61 @@ class Model(Declared):
 
     def brdf(self, theta_i, theta_r, phi_r=0.0, precision="float64"):
         """Unpolarized-in, total-out BRDF ``M00`` (1/sr); ``precision`` as for :meth:`mueller`."""
-        if precision == "float64":
-            fast = self._fast(theta_i, theta_r, phi_r, 1)
-            if fast is not None:
-                return fast
+        fast = self._fast(theta_i, theta_r, phi_r, 1, precision)
+        if fast is not None:
+            return fast
         plan = self._plan(theta_i, theta_r, phi_r)
         out = np.empty((1, plan.n), dtype=np.dtype(evaluation.check_precision(precision)))
         self._fill(plan, out, 1, precision)
         return out.reshape(plan.shape)
 
+    @property
+    def float32_fallback(self) -> str | None:
+        """Why ``precision="float32"`` evaluates this model in float64 and rounds the result
+        (a sentence), or ``None`` when the float32 kernel evaluates it: no kernel covers the
+        model or its options, the numpy backend is selected, or the parameters lie outside
+        the float32-safe domain (:mod:`models.float32_domain`; decided once per model)."""
+        if not self._has_kernel:
+            return f"no compiled kernel covers {type(self).__name__} with these options"
+        if evaluation.current_backend() != "numba":
+            return "the numpy backend is selected (models.backend)"
+        return self._float32_unsafe if evaluation.float32_guarded() else None
+
+    @cached_property
+    def _float32_unsafe(self):
+        return float32_domain.model_unsafe(self)
+
+    def _falls_back(self) -> bool:
+        """True when a float32 request runs the kernel in float64 here (outside the
+        float32-safe domain, unless :func:`models.evaluation.raw_float32` is in effect)."""
+        return self._float32_unsafe is not None and evaluation.float32_guarded()
+
     def _fill(self, plan, out, rows, precision):
         """Evaluate ``plan`` into ``out`` chunk by chunk: the kernel where one covers the model
-        (a model set's chunk is a model with flat parameters, with its own kernel rows),
-        otherwise the numpy implementation (rounded to ``out``'s dtype)."""
+        (a model set's chunk is a model with flat parameters, with its own kernel rows; float32
+        outside the float32-safe domain computed in float64), otherwise the numpy
+        implementation (rounded to ``out``'s dtype)."""
         kernel = self._kernel_path()
+        if kernel and precision == "float32" and self._falls_back():
+            precision = "float64"
         for sl, ti, tr, pr, m in plan.blocks(fill=not kernel):
             if kernel:
                 m._kernel.write(out, sl, ti, tr, pr, precision)
             else:
                 out[:, sl] = m._m16(ti, tr, pr) if rows == 16 else m._m00(ti, tr, pr)
 
-    def _fast(self, theta_i, theta_r, phi_r, rows):
-        """A small call (floats, or float64 arrays of one shape) straight into the kernel,
-        or ``None`` for the general path (which also raises the errors)."""
+    def _fast(self, theta_i, theta_r, phi_r, rows, precision, out=None):
+        """A small call (:meth:`models.kernels.Compiled.fast`) straight into the kernel, or
+        ``None`` for the general path (which also raises the errors)."""
         kernel = None if self._sets else self._compiled()
-        return None if kernel is None else kernel.fast(theta_i, theta_r, phi_r, rows)
+        if kernel is None:
+            return None
+        if precision == "float64" or (precision == "float32" and not self._falls_back()):
+            return kernel.fast(theta_i, theta_r, phi_r, rows, precision, out)
+        if precision != "float32" or out is not None:
+            return None
+        fast = kernel.fast(theta_i, theta_r, phi_r, rows, "float64")  # the float32 fallback
+        return None if fast is None else fast.astype(np.float32)
 
     def _brdf_flat(self, ti, tr, pr):
         return self._mueller16(ti, tr, pr)[0]

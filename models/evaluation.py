@@ -27,7 +27,19 @@ import numpy as np
 from .modelset import with_leaves
 from .params import check_finite_array, check_polar_angle
 
-__all__ = ["backend", "current_backend", "BACKENDS", "PRECISIONS", "CHUNK", "KERNEL_CHUNK", "Plan"]
+__all__ = [
+    "backend",
+    "current_backend",
+    "BACKENDS",
+    "PRECISIONS",
+    "CHUNK",
+    "KERNEL_CHUNK",
+    "Plan",
+    "small_angles",
+    "as_matrices",
+    "float32_guarded",
+    "raw_float32",
+]
 
 #: Geometries per chunk on the numpy path, chosen so a model's float64 temporaries stay in
 #: L2 cache: the smallest size of the flat optimum (``python benchmarks/chunk_size.py``:
@@ -64,6 +76,27 @@ def backend(name: str):
         _BACKEND.reset(token)
 
 
+_FLOAT32_GUARD = contextvars.ContextVar("scatterbench_float32_guard", default=True)
+
+
+def float32_guarded() -> bool:
+    """True (the default) when float32 requests outside a model's float32-safe domain are
+    evaluated in float64 (:mod:`models.float32_domain`)."""
+    return _FLOAT32_GUARD.get()
+
+
+@contextlib.contextmanager
+def raw_float32():
+    """Run the float32 kernels inside the ``with`` block even outside their float32-safe
+    domain (:mod:`models.float32_domain`): for tests of the kernels themselves (finite at
+    the ends of the declared ranges), never for results."""
+    token = _FLOAT32_GUARD.set(False)
+    try:
+        yield
+    finally:
+        _FLOAT32_GUARD.reset(token)
+
+
 def check_precision(precision):
     if precision not in PRECISIONS:
         raise ValueError(f"precision must be one of {', '.join(map(repr, PRECISIONS))}; got {precision!r}")
@@ -75,6 +108,107 @@ def checked_angles(model, theta_i, theta_r, phi_r):
     them (two polar angles in [0, pi/2], a finite azimuth)."""
     n1, n2, n3 = model._angle_names
     return [check_polar_angle(n1, theta_i), check_polar_angle(n2, theta_r), check_finite_array(n3, phi_r)]
+
+
+#: one angle value a small call takes without numpy's conversion (a ``bool`` is not one:
+#: the general path refuses it, naming the angle)
+SCALARS = (float, int, np.float64, np.int64, np.int32)
+
+
+def scalar(x):
+    """``x`` (one of :data:`SCALARS`) as a float, or ``None`` (an integer no float holds: the
+    general path refuses it, naming the angle)."""
+    try:
+        return float(x)
+    except OverflowError:
+        return None
+
+
+def small_angles(theta_i, theta_r, phi_r, limit):
+    """``(shape, n, [ti, tr, pr])`` for a small call: the broadcast ``shape`` of the three
+    angle inputs (numbers, lists, float64 or integer arrays), its size ``n``, and each input
+    as a flat float64 array of length 1 (a single value) or ``n``; ``None`` for what the
+    general path (:class:`Plan`) takes instead: other types (float32, whose polar angles are
+    judged in float32; bools and objects, which it refuses), more than ``limit`` geometries
+    (the general path's chunks bound the memory), none at all, or shapes that do not
+    broadcast (it raises the error).  The values are not validated here.
+    """
+    arrays, shapes = [], []
+    for x in (theta_i, theta_r, phi_r):
+        if type(x) is float:
+            x = np.array((x,))
+            shapes.append(())
+        else:
+            if not (type(x) is np.ndarray and x.dtype is _FLOAT64):
+                x = _converted(x)
+                if x is None:
+                    return None
+            shapes.append(x.shape)
+        arrays.append(x)
+    shape = _broadcast(*shapes)
+    if shape is None:
+        return None
+    n = math.prod(shape)
+    if n == 0 or n > limit:
+        return None
+    for k, x in enumerate(arrays):
+        if x.size == 1:
+            arrays[k] = x.reshape(1)
+        elif x.shape != shape or not x.flags.c_contiguous:
+            full = np.empty(shape)
+            full[...] = x  # numpy.broadcast_to costs more than this copy at a small call's sizes
+            arrays[k] = full.reshape(-1)
+        elif x.ndim != 1:
+            arrays[k] = x.reshape(-1)
+    return shape, n, arrays
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _broadcast(s1, s2, s3):
+    """``numpy.broadcast_shapes`` (``None`` where they do not broadcast), without its cost
+    where the shapes other than ``()`` are equal."""
+    full = s1 or s2 or s3
+    if (not s1 or s1 == full) and (not s2 or s2 == full) and (not s3 or s3 == full):
+        return full
+    try:
+        return np.broadcast_shapes(s1, s2, s3)
+    except ValueError:
+        return None
+
+
+def _converted(x):
+    """A small call's angle input other than a float or a float64 array, as a float64 array,
+    or ``None`` (see :func:`small_angles`)."""
+    if type(x) in SCALARS:
+        v = scalar(x)
+        return None if v is None else np.array(v)
+    if type(x) in (list, tuple):
+        try:
+            x = np.asarray(x)
+        except ValueError:  # ragged: the general path names the angle
+            return None
+    if (
+        type(x) is not np.ndarray
+        or x.dtype.kind not in "fiu"
+        or (x.dtype.kind == "f" and x.dtype.itemsize != 8)
+    ):
+        return None
+    return x.astype(np.float64)
+
+
+_AXES = {}
+
+
+def as_matrices(m16, shape):
+    """The ``shape + (4, 4)`` view of element-major Mueller storage ``m16`` ``(16, N)``
+    (``numpy.moveaxis`` without its argument checking, which costs more than a small call)."""
+    nd = len(shape)
+    axes = _AXES.get(nd)
+    if axes is None:
+        axes = _AXES[nd] = tuple(range(2, nd + 2)) + (0, 1)
+    return m16.reshape((4, 4) + shape).transpose(axes)
 
 
 class Plan:

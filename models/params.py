@@ -270,30 +270,49 @@ def check_polar_angle(name, value) -> np.ndarray:
     slightly above the float64 pi/2 and means grazing, so it is accepted and
     clipped to pi/2.
     """
-    raw = np.asarray(value)
-    a = check_finite_array(name, value)
-    if raw.dtype.kind == "f" and raw.dtype.itemsize < 8 and a.size:
-        top = float(np.asarray(math.pi / 2, dtype=raw.dtype))
-        if top > math.pi / 2:
-            a = np.where((a > math.pi / 2) & (a <= top), math.pi / 2, a)
-    if a.size and (np.min(a) < 0.0 or np.max(a) > math.pi / 2):
+    raw = _real_array(name, value)
+    a = raw.astype(np.float64, copy=False)
+    # one pass for the common case: NaN fails both comparisons, +-inf one of them
+    if a.size and not (0.0 <= a.min() and a.max() <= _HALF_PI):
+        a = _checked_polar(name, raw, a)
+    return a
+
+
+_HALF_PI = 0.5 * math.pi
+
+
+def _checked_polar(name, raw, a):
+    """:func:`check_polar_angle` of values that are not all in [0, pi/2] in float64: the
+    error naming ``name``, or float32 grazing angles clipped to pi/2."""
+    if not np.isfinite(a).all():
+        raise ValueError(f"{name} must be finite (no NaN or inf)")
+    if raw.dtype.kind == "f" and raw.dtype.itemsize < 8:
+        top = float(np.asarray(_HALF_PI, dtype=raw.dtype))
+        if top > _HALF_PI:
+            a = np.where((a > _HALF_PI) & (a <= top), _HALF_PI, a)
+    if a.min() < 0.0 or a.max() > _HALF_PI:
         raise ValueError(
             f"{name} must lie in [0, pi/2] radians (a polar angle above the surface); "
-            f"got values in [{np.min(a):.6g}, {np.max(a):.6g}]"
+            f"got values in [{a.min():.6g}, {a.max():.6g}]"
         )
     return a
 
 
-def check_finite_array(name, value) -> np.ndarray:
-    """A real array with only finite values (float32 is promoted to float64)."""
+def _real_array(name, value) -> np.ndarray:
+    """``value`` as a numpy array of integers or reals, or the ``ValueError`` naming ``name``."""
     try:
         a = np.asarray(value)
     except Exception as exc:  # pragma: no cover - numpy raises many types
         raise ValueError(f"{name} must be a real number or array of real numbers") from exc
     if a.dtype.kind not in "iuf":
         raise ValueError(f"{name} must be a real number or array of real numbers; got {a.dtype}")
-    a = a.astype(np.float64, copy=False)
-    if not np.all(np.isfinite(a)):
+    return a
+
+
+def check_finite_array(name, value) -> np.ndarray:
+    """A real array with only finite values (float32 is promoted to float64)."""
+    a = _real_array(name, value).astype(np.float64, copy=False)
+    if not np.isfinite(a).all():
         raise ValueError(f"{name} must be finite (no NaN or inf)")
     return a
 

@@ -30,12 +30,17 @@ import tempfile
 
 import numpy as np
 
+from .. import evaluation
+from ..float32_domain import ANGLE_ROWS
+
 __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 
 #: geometries from which the kernels run on every core (below: the serial loop, which has
 #: no thread start-up cost)
 PARALLEL_MIN = 8192
 _HALF_PI = 0.5 * math.pi
+_FLOAT64 = np.dtype(np.float64)
+_DTYPES = {"float64": _FLOAT64, "float32": np.dtype(np.float32)}
 _HERE = os.path.dirname(os.path.abspath(__file__))
 
 
@@ -106,6 +111,7 @@ class Compiled:
 
     def __init__(self, model, code, rows, options):
         assert len(rows) == len(drive.ROWS[code]), f"{code} kernel rows: {drive.ROWS[code]}"
+        self.name = code
         self.code = drive.CODES[code]
         length = max((np.size(r) for r in rows), default=1)
         prm = np.empty((len(rows), length))
@@ -115,9 +121,15 @@ class Compiled:
         self.iopt = np.asarray(options, dtype=np.int64)
 
     def params(self, precision):
+        """The parameter rows in ``precision``; float32 rows take the angle rows (rotations)
+        reduced to (-pi, pi] in float64 first, so that rounding keeps their cosines and sines."""
         p = self.prm.get(precision)
         if p is None:
-            p = self.prm[precision] = self.prm["float64"].astype(precision)
+            p = self.prm["float64"].copy()
+            for k, name in enumerate(drive.ROWS[self.name]):
+                if name in ANGLE_ROWS:
+                    p[k] = np.arctan2(np.sin(p[k]), np.cos(p[k]))
+            p = self.prm[precision] = p.astype(precision)
         return p
 
     def call(self, ti, tr, pr, out, start, precision="float64"):
@@ -136,45 +148,64 @@ class Compiled:
         return out
 
     def write(self, out, sl, ti, tr, pr, precision):
-        """One chunk of flat float64 angles (length 1 or the chunk's) into ``out[:, sl]``, in
-        ``precision`` (the float32 kernels for ``"float32"``): in place in a C-contiguous
-        ndarray, otherwise (e.g. a memmap) through a chunk-sized buffer."""
+        """One chunk of flat float64 angles (length 1 or the chunk's) into ``out[:, sl]``,
+        computed in ``precision`` (the float32 kernels for ``"float32"``): in place in a
+        C-contiguous ndarray of that dtype, otherwise (a memmap; a float32 ``out`` filled by
+        the float64 fallback) through a chunk-sized buffer."""
         dtype = np.dtype(precision)
         a, b, c = (x.astype(dtype, copy=False) for x in (ti, tr, pr))
-        if type(out) is np.ndarray and out.flags.c_contiguous:
+        if type(out) is np.ndarray and out.flags.c_contiguous and out.dtype == dtype:
             self.call(a, b, c, out, sl.start, precision)
         else:
             buf = np.empty((out.shape[0], sl.stop - sl.start), dtype=dtype)
             self.call(a, b, c, buf, 0, precision)
             out[:, sl] = buf
 
-    def fast(self, theta_i, theta_r, phi_r, rows):
-        """The small-call path: floats, or C-contiguous float64 arrays of one shape (or
-        floats among them); ``None`` for anything else or a bad angle (the general path
-        then raises the error naming it)."""
-        if type(theta_i) is float and type(theta_r) is float and type(phi_r) in (float, int):
-            if not (0.0 <= theta_i <= _HALF_PI and 0.0 <= theta_r <= _HALF_PI and math.isfinite(phi_r)):
-                return None
-            out = np.empty((rows, 1))
-            drive.run_one(self.code, theta_i, theta_r, float(phi_r), self.prm["float64"], self.iopt, out)
-            return out.reshape(4, 4) if rows == 16 else out.reshape(())
-        shape = None
-        flat = []
-        for x in (theta_i, theta_r, phi_r):
-            if type(x) is float:
-                flat.append(np.full(1, x))
-            elif type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous and x.ndim:
-                if shape is not None and x.shape != shape:
-                    return None
-                shape = x.shape
-                flat.append(x.reshape(-1))
-            else:
-                return None
-        if shape is None or not drive.angles_ok(*flat):
+    def fast(self, theta_i, theta_r, phi_r, rows, precision="float64", out=None):
+        """The small-call path: up to :data:`models.evaluation.KERNEL_CHUNK` geometries given
+        as floats, ints, lists or float64/integer arrays that broadcast
+        (:func:`models.evaluation.small_angles`), evaluated in ``precision`` (``"float64"`` or
+        ``"float32"``), into ``out`` when given (a C-contiguous ``(rows, N)`` ndarray of that
+        dtype); ``None`` for anything else or a bad angle (the general path then raises the
+        error naming it)."""
+        if precision == "float64" and out is None:
+            one = self._one(theta_i, theta_r, phi_r, rows)
+            if one is not None:
+                return one
+        small = evaluation.small_angles(theta_i, theta_r, phi_r, evaluation.KERNEL_CHUNK)
+        if small is None:
             return None
-        n = flat[0].size if flat[0].size > 1 else max(f.size for f in flat)
-        out = np.empty((rows, n))
-        self.call(flat[0], flat[1], flat[2], out, 0)
-        if rows == 1:
-            return out.reshape(shape)
-        return np.moveaxis(out.reshape((4, 4) + shape), (0, 1), (-2, -1))
+        shape, n, (ti, tr, pr) = small
+        dtype = _DTYPES[precision]
+        if out is None:
+            out = np.empty((rows, n), dtype=dtype)
+        elif not (type(out) is np.ndarray and out.shape == (rows, n) and out.dtype == dtype):
+            return None
+        elif not out.flags.c_contiguous:
+            return None
+        if dtype is _FLOAT64 and n < PARALLEL_MIN:
+            if not drive.run_checked(self.code, ti, tr, pr, self.prm["float64"], self.iopt, out):
+                return None
+        else:
+            if not drive.angles_ok(ti, tr, pr):
+                return None
+            self.call(ti.astype(dtype), tr.astype(dtype), pr.astype(dtype), out, 0, precision)
+        return out.reshape(shape) if rows == 1 else evaluation.as_matrices(out, shape)
+
+    def _one(self, theta_i, theta_r, phi_r, rows):
+        """One geometry given as three numbers, straight into the scalar loop; ``None`` for
+        anything else (arrays, a bad angle)."""
+        if type(theta_i) is float and type(theta_r) is float and type(phi_r) is float:
+            a, b, c = theta_i, theta_r, phi_r
+        else:
+            scalars = evaluation.SCALARS
+            if not (type(theta_i) in scalars and type(theta_r) in scalars and type(phi_r) in scalars):
+                return None
+            a, b, c = (evaluation.scalar(x) for x in (theta_i, theta_r, phi_r))
+            if a is None or b is None or c is None:
+                return None
+        if not (0.0 <= a <= _HALF_PI and 0.0 <= b <= _HALF_PI and math.isfinite(c)):
+            return None
+        out = np.empty((rows, 1))
+        drive.run_one(self.code, a, b, c, self.prm["float64"], self.iopt, out)
+        return out.reshape(4, 4) if rows == 16 else out.reshape(())

@@ -69,6 +69,16 @@ def run_parallel(code, ti, tr, pr, prm, iopt, out, start):
 
 
 @njit(cache=True)
+def run_checked(code, ti, tr, pr, prm, iopt, out):
+    """:func:`run` from column 0 when every angle is valid (:func:`angles_ok`), returning True;
+    False, writing nothing, otherwise (one call into numba for a small call)."""
+    if not angles_ok(ti, tr, pr):
+        return False
+    run(code, ti, tr, pr, prm, iopt, out, 0)
+    return True
+
+
+@njit(cache=True)
 def run_one(code, ti, tr, pr, prm, iopt, out):
     """One geometry given as scalars (the small-call path)."""
     element(code, ti, tr, pr, prm, 0, iopt, out, 0)

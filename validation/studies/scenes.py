@@ -74,10 +74,11 @@ def _pick(knob, tol, notes, **kw):
 def _choose_precision(model, tol, notes):
     """``"float32"`` when a float32 kernel evaluates ``model`` and its float32 error,
     measured on ``model`` itself, meets ``tol`` at a lower cost, else ``"float64"``."""
-    from .tradeoff import precision_option
+    from .tradeoff import float32_unavailable
 
-    if precision_option(model) is None:
-        notes.append(f"precision: float64 ({type(model).__name__} has no float32 kernel)")
+    reason = float32_unavailable(model)
+    if reason is not None:
+        notes.append(f"precision: float64 ({reason})")
         return "float64"
     bits = _pick("precision", tol, notes, model=model)
     return "float32" if bits == 32 else "float64"

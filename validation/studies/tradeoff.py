@@ -13,7 +13,7 @@ an independent higher-accuracy reference (never an extrapolation):
   error over the curve);
 * ``precision``: the Mueller matrix evaluated in float32 against float64, where a
   float32 kernel evaluates the model (:func:`precision_option`); skipped, saying why,
-  where none does;
+  where none does or where the model's parameters send float32 to the float64 fallback;
 * knobs that other modules register with :func:`register_knob` (Monte Carlo
   pairs, point-source resolution, ...).
 
@@ -59,6 +59,7 @@ __all__ = [
     "Timing",
     "time_call",
     "precision_option",
+    "float32_unavailable",
     "at_precision",
     "study",
     "pareto",
@@ -281,22 +282,32 @@ def knob_point_source(quick=False):
     )
 
 
-def precision_option(model):
-    """``"keyword"`` when ``model`` really evaluates in float32 through its ``mueller``'s
-    ``precision="float32"`` keyword, else ``None``.
+def float32_unavailable(model):
+    """Why ``model`` has no float32 evaluation to measure (a sentence naming it), or ``None``.
 
-    Every :class:`models.Model`'s ``mueller`` takes the keyword, but only a model a
-    compiled kernel evaluates (``_kernel_spec()`` not ``None``, numba backend) computes in
-    float32: the others (Monte Carlo, wrappers such as the point source) evaluate in
-    float64 and round, at the same cost.  An object that is not a :class:`models.Model`
-    is taken at its word when its ``mueller`` takes the keyword.
+    Every :class:`models.Model`'s ``mueller`` takes ``precision="float32"``, but only a
+    model a compiled kernel evaluates (``_kernel_spec()`` not ``None``, numba backend)
+    computes in float32, and only inside the kernels' float32-safe domain
+    (:mod:`models.float32_domain`): elsewhere (Monte Carlo, wrappers such as the point
+    source; parameters outside the domain) it evaluates in float64 and rounds, at float64's
+    cost.  An object that is not a :class:`models.Model` is taken at its word when its
+    ``mueller`` takes the keyword.
     """
+    name = type(model).__name__
     if "precision" not in inspect.signature(model.mueller).parameters:
-        return None
+        return f"{name} has no float32 kernel"
     if isinstance(model, models.Model):
         if not model._kernel_path():
-            return None
-    return "keyword"
+            return f"{name} has no float32 kernel"
+        if model.float32_fallback is not None:
+            return f"{name} falls back to float64 for float32 requests ({model.float32_fallback})"
+    return None
+
+
+def precision_option(model):
+    """``"keyword"`` when ``model`` really evaluates in float32 through its ``mueller``'s
+    ``precision="float32"`` keyword, else ``None`` (:func:`float32_unavailable` says why)."""
+    return None if float32_unavailable(model) else "keyword"
 
 
 def at_precision(model, precision):
@@ -304,8 +315,9 @@ def at_precision(model, precision):
     through the model's own option; ``ValueError`` if it has none."""
     if precision not in ("float64", "float32"):
         raise ValueError(f"precision must be 'float64' or 'float32'; got {precision!r}")
-    if precision_option(model) is None:
-        raise ValueError(f"precision: {type(model).__name__} has no float32 kernel")
+    reason = float32_unavailable(model)
+    if reason is not None:
+        raise ValueError(f"precision: {reason}")
     return functools.partial(model.mueller, precision=precision)
 
 
@@ -320,15 +332,17 @@ def knob_precision(quick=False, model=None):
     """The Mueller matrix in float32 and float64 on 4096 random geometries, against the
     float64 evaluation (so the float64 point has error 0 by construction); ``model``
     defaults to seed 000's coated flake model.  :class:`KnobUnavailable` when no float32
-    kernel evaluates the model (:func:`precision_option`)."""
+    kernel evaluates the model, or its parameters send float32 requests to float64
+    (:func:`float32_unavailable`): a fallback is reported, never timed as float32."""
     if model is None:
         model = models.SubsurfaceFacetBRDF(
             slopes=models.ExponentialSlopes(0.1), coating=1.5, substrate=1.37 + 7.62j
         )
-    if precision_option(model) is None:
+    reason = float32_unavailable(model)
+    if reason is not None:
         raise KnobUnavailable(
-            f"{type(model).__name__} has no float32 kernel: it evaluates in float64 (and rounds a "
-            "float32 request), so there is no float32 cost to measure"
+            f"{reason}: it evaluates in float64 (and rounds a float32 request), so there is no "
+            "float32 cost to measure"
         )
     from validation.checks.common import random_geometries  # not at import: it loads every check
 
