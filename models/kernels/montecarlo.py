@@ -27,6 +27,8 @@ __all__ = ["estimate", "exit_transmittance"]
 
 #: Mueller elements a real Jones matrix can reach (the others couple V and vanish here)
 _REACHED = np.array([0, 1, 2, 4, 5, 6, 8, 9, 10, 15])
+#: the basis returned for a ray that does not exist (never read)
+_NO_BASIS = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
 @njit(cache=True, inline="always")
@@ -43,8 +45,9 @@ def _ray_basis(k):
 
 @njit(cache=True, inline="always")
 def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
-    """The incident ray through facet ``m`` (slope x ``zx``): ``(weight, k1, Jones, flux
-    factor)``; weight 0 where the facet is not struck or the ray does not go down."""
+    """The incident ray through facet ``m`` (slope x ``zx``): ``(weight, k1, basis of k1,
+    Jones, flux factor)``; weight 0 where the facet is not struck or the ray does not go
+    down."""
     w = max(ci - si * zx, 0.0) / n_i
     eta = 1.0 / n
     c = -dot3(k_i, m)
@@ -52,15 +55,16 @@ def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     f = eta * c - ct
     k1 = (eta * k_i[0] + f * m[0], eta * k_i[1] + f * m[1], eta * k_i[2] + f * m[2])
     if not (w > 0.0 and c > 0.0 and -k1[2] > 0.0):
-        return 0.0, k1, (0.0, 0.0, 0.0, 0.0), 0.0
-    ss, ps, sp, pp, c_in, c_out = btdf_jones(k_i, k1, m, n, e_i, _ray_basis(k1))
-    return w, k1, (ss, ps, sp, pp), n * c_out / (c_in if c_in > 0.0 else 1.0)
+        return 0.0, k1, _NO_BASIS, (0.0, 0.0, 0.0, 0.0), 0.0
+    e1 = _ray_basis(k1)
+    ss, ps, sp, pp, c_in, c_out = btdf_jones(k_i, k1, m, n, e_i, e1)
+    return w, k1, e1, (ss, ps, sp, pp), n * c_out / (c_in if c_in > 0.0 else 1.0)
 
 
 @njit(cache=True, inline="always")
 def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
     """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
-    ``(weight, k2, Jones, flux factor)``, weight 0 where no such ray exists."""
+    ``(weight, k2, basis of k2, Jones, flux factor)``, weight 0 where no such ray exists."""
     w = max(cr + srcp * zx + srsp * zy, 0.0) / n_r
     eta = 1.0 / n
     c = dot3(k_r, m)
@@ -68,10 +72,10 @@ def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
     f = eta * c - ct
     k2 = (eta * k_r[0] - f * m[0], eta * k_r[1] - f * m[1], eta * k_r[2] - f * m[2])
     if not (w > 0.0 and c > 0.0 and k2[2] > 0.0):
-        return 0.0, k2, (0.0, 0.0, 0.0, 0.0), 0.0
-    neg = (-m[0], -m[1], -m[2])
-    ss, ps, sp, pp, c_in, c_out = btdf_jones(k2, k_r, neg, eta, _ray_basis(k2), e_r)
-    return w, k2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
+        return 0.0, k2, _NO_BASIS, (0.0, 0.0, 0.0, 0.0), 0.0
+    e2 = _ray_basis(k2)
+    ss, ps, sp, pp, c_in, c_out = btdf_jones(k2, k_r, (-m[0], -m[1], -m[2]), eta, e2, e_r)
+    return w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
 
 
 @njit(cache=True, inline="always")
@@ -95,7 +99,7 @@ def _real_mueller(x, a, b, c, d):
 
 
 @njit(cache=True, inline="always")
-def _volume(x, k1, ji, k2, jo, base, depth, prm):
+def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
     """One live pair's Mueller estimate into ``x``: the totally diffuse term and the single
     scattering (depolarizing: a scalar; polarized: the Jones chain of Eq. 4-5)."""
     diffuse, single, g, polarized = prm[1], prm[2], prm[3], prm[4] != 0.0
@@ -121,8 +125,7 @@ def _volume(x, k1, ji, k2, jo, base, depth, prm):
         for q in range(3):
             x[4 * a + q] = ca * rows[q]
     if polarized and single > 0.0:
-        s1, p1 = _ray_basis(k1)
-        s2, p2 = _ray_basis(k2)
+        (s1, p1), (s2, p2) = e1, e2
         ph = ((dot3(s2, s1), dot3(s2, p1)), (dot3(p2, s1), dot3(p2, p1)))
         t = (
             (ph[0][0] * ji[0] + ph[0][1] * ji[2], ph[0][0] * ji[1] + ph[0][1] * ji[3]),
@@ -139,9 +142,9 @@ def _volume(x, k1, ji, k2, jo, base, depth, prm):
 
 
 @njit(cache=True)
-def _walk(geo, z, m, prm, scale, x, mean, m2, peak):
+def _walk(geo, z, m, prm, inv_scale, x, mean, m2, peak):
     """Welford's running mean and sum of squared deviations (``mean``, ``m2``) of the live
-    pairs' estimates divided by ``scale``, and their largest magnitudes (``peak``); returns
+    pairs' estimates times ``inv_scale``, and their largest magnitudes (``peak``); returns
     the number of live pairs."""
     k_i, e_i, ci, si, n_i, k_r, e_r, cr, srcp, srsp, n_r = geo
     n = prm[0]
@@ -150,19 +153,19 @@ def _walk(geo, z, m, prm, scale, x, mean, m2, peak):
     m2[:] = 0.0
     peak[:] = 0.0
     for j in range(z.shape[1]):
-        w1, k1, ji, f_in = _entry(k_i, e_i, ci, si, n_i, z[0, j], (m[0, j], m[1, j], m[2, j]), n)
+        w1, k1, e1, ji, f_in = _entry(k_i, e_i, ci, si, n_i, z[0, j], (m[0, j], m[1, j], m[2, j]), n)
         if w1 == 0.0:
             continue
         mj = (m[3, j], m[4, j], m[5, j])
-        w2, k2, jo, f_out = _exit(k_r, e_r, cr, srcp, srsp, n_r, z[2, j], z[3, j], mj, n)
+        w2, k2, e2, jo, f_out = _exit(k_r, e_r, cr, srcp, srsp, n_r, z[2, j], z[3, j], mj, n)
         if w2 == 0.0:
             continue
         base = w1 * w2 * f_in * f_out / (n * n)
-        _volume(x, k1, ji, k2, jo, base, 1.0 / (-k1[2] + k2[2]), prm)
+        _volume(x, k1, e1, ji, k2, e2, jo, base, 1.0 / (-k1[2] + k2[2]), prm)
         live += 1
         inv = 1.0 / live
         for e in _REACHED:
-            v = x[e] / scale[e]
+            v = x[e] * inv_scale[e]
             d = v - mean[e]
             mean[e] += d * inv
             m2[e] += d * (v - mean[e])
@@ -195,7 +198,7 @@ def _geometry(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, col):
         # squares of such values overflow: walk again with each element over its largest
         for e in range(16):
             scale[e] = peak[e] if peak[e] > 0.0 else 1.0
-        live = _walk(geo, z, m, prm, scale, x, mu, m2, peak)
+        live = _walk(geo, z, m, prm, 1.0 / scale, x, mu, m2, peak)
     pairs = z.shape[1]
     dead = pairs - live
     for e in _REACHED:
@@ -258,7 +261,7 @@ def exit_transmittance(tr, pr, n_r, z, m, n):
         total = 0.0
         for j in range(z.shape[1]):
             mj = (m[3, j], m[4, j], m[5, j])
-            w, _, jo, f = _exit(k_r, e_r, cr, sr * cp, sr * sp, n_r[i], z[2, j], z[3, j], mj, n)
+            w, _, _, jo, f = _exit(k_r, e_r, cr, sr * cp, sr * sp, n_r[i], z[2, j], z[3, j], mj, n)
             if w > 0.0:
                 total += 0.5 * (jo[0] * jo[0] + jo[1] * jo[1] + jo[2] * jo[2] + jo[3] * jo[3]) * f * w
         out[i] = total / z.shape[1]
