@@ -44,7 +44,11 @@ at grazing incidence.  ``N_k`` is computed deterministically from the radial
 inverse CDF (2048 midpoint quantiles; relative error < 1e-6).
 
 The mean over pairs is the estimate and ``std / sqrt(pairs)`` its standard
-error (:meth:`RoughDiffuseBRDF.mueller_with_error`).  With ``surface=True`` the
+error (:meth:`RoughDiffuseBRDF.mueller_with_error`).  It is computed by the compiled
+loop :mod:`models.kernels.montecarlo` (the default backend: one pass per geometry over
+the same facet pairs, no temporaries) or, ``with models.backend("numpy")``, by the numpy
+implementation here, the reference the tests hold the kernel to (1e-12 relative to
+``M00``).  With ``surface=True`` the
 direct reflection by the exposed rough surface (:class:`models.FacetBRDF`
 with substrate ``n``, the coating's index) is added (deterministic, zero error).  No shadowing, as
 in the paper.
@@ -58,7 +62,7 @@ from functools import cached_property
 
 import numpy as np
 
-from . import modelset
+from . import evaluation, modelset
 from .base import Model
 from .facet import FacetBRDF
 from .facet_btdf import _dot, angle_basis, facet_transmission_jones, projected_area, ray_basis
@@ -271,12 +275,23 @@ class RoughDiffuseBRDF(Model):
         phi = (np.arange(n_phi) + 0.5) * (2.0 * math.pi / n_phi)
         U, P = np.meshgrid(u, phi, indexing="ij")
         tr, pr = np.arccos(U).ravel(), P.ravel()
-        per = max(1, BLOCK // self.pairs)
-        t = np.concatenate(
-            [self._exit_transmittance(tr[k : k + per], pr[k : k + per]) for k in range(0, tr.size, per)]
-        )
+        mc = self._montecarlo()
+        if mc is not None:
+            t = mc.exit_transmittance(
+                tr, pr, self._norm(np.cos(tr)[:, None])[:, 0], *self._facets, self.coating
+            )
+        else:
+            per = max(1, BLOCK // self.pairs)
+            t = np.concatenate(
+                [self._exit_transmittance(tr[k : k + per], pr[k : k + per]) for k in range(0, tr.size, per)]
+            )
         total = np.sum(t.reshape(U.shape) * (wu * u)[:, None]) * (2.0 * math.pi / n_phi)
         return 1.0 - total / (math.pi * self.coating * self.coating)
+
+    @property
+    def _diffuse(self):
+        """The totally diffuse factor ``(rho / pi) / (1 - rho R-bar)`` (Eq. 21, 23)."""
+        return (self.rho / math.pi) / (1.0 - self.rho * self._rbar)
 
     @cached_property
     def _surface_model(self):
@@ -322,7 +337,7 @@ class RoughDiffuseBRDF(Model):
         depth = 1.0 / np.where(live, c1z + c2z, 1.0)
         cos_scat = _dot(k1, k2)
         dens = self.phase.density(cos_scat)
-        diffuse = (self.rho / math.pi) / (1.0 - self.rho * self._rbar)
+        diffuse = self._diffuse
         out = np.zeros((16, g, p))
         # column 0 of M(J_out) and row 0 of M(J_in) (real Jones: no V components)
         ss, ps, sp_, pp = jin
@@ -366,8 +381,38 @@ class RoughDiffuseBRDF(Model):
         return np.where(nk > 0, nk, 1.0)
 
     # ------------------------------------------------------------------ estimates
+    @cached_property
+    def _facets(self):
+        """The facet pairs as the kernel reads them: slopes ``(4, pairs)`` (entry x, y, exit
+        x, y) and unit normals ``(6, pairs)`` (entry, exit), contiguous."""
+        z = np.ascontiguousarray(np.concatenate([self._z1, self._z2]))
+        m = np.ascontiguousarray(np.concatenate([_normals(self._z1)[:, 0], _normals(self._z2)[:, 0]]))
+        return z, m
+
+    @staticmethod
+    def _montecarlo():
+        """The compiled Monte Carlo (:mod:`models.kernels.montecarlo`), or ``None`` on the
+        numpy backend (the reference it is tested against)."""
+        if evaluation.current_backend() != "numba":
+            return None
+        from .kernels import montecarlo
+
+        return montecarlo
+
     def _estimate(self, ti, tr, pr):
         """Mean and standard error ``(16, n)`` of the volume terms."""
+        mc = self._montecarlo()
+        if mc is not None:
+            prm = np.array(
+                [self.coating, self._diffuse, self.single, self.phase.g, float(self.phase.polarized)]
+            )
+            norms = (self._norm(np.cos(t)[:, None])[:, 0] for t in (ti, tr))
+            parallel = ti.size > 1 and ti.size * self.pairs >= BLOCK
+            return mc.estimate(ti, tr, pr, *norms, *self._facets, prm, _SUM_SAFE, parallel)
+        return self._estimate_numpy(ti, tr, pr)
+
+    def _estimate_numpy(self, ti, tr, pr):
+        """:meth:`_estimate` on the numpy path, block by block of :data:`BLOCK` entries."""
         n = ti.size
         mean = np.empty((16, n))
         err = np.empty((16, n))

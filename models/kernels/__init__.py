@@ -90,7 +90,8 @@ def _caching_in(path):
 
 
 with _caching_in(cache_dir()):
-    from . import drive  # noqa: E402  (decorated here, cached there)
+    # montecarlo: RoughDiffuseBRDF's Monte Carlo, which the model imports itself
+    from . import drive, montecarlo  # noqa: E402, F401  (decorated here, cached there)
 
 
 class Compiled:

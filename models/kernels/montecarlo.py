@@ -1,0 +1,268 @@
+"""The Monte Carlo of :class:`models.RoughDiffuseBRDF` (seed 003 Sec. 2.5), compiled.
+
+The numpy implementation (:meth:`models.RoughDiffuseBRDF._block`) evaluates every
+(geometry, facet pair) entry of a block as arrays and reduces them with ``mean`` and
+``std``; here one loop per geometry walks the same facet pairs (the model's, drawn once
+from its seed: the random numbers are identical) and accumulates the mean and the spread
+as it goes (Welford's update), with no temporaries.  Pairs that cannot connect the two
+directions contribute exact zeros in both implementations, so they are counted, not
+evaluated.  Where a geometry's estimates are so large that squares would overflow
+(``|x| >= safe``), the geometry is walked again with each element scaled by its largest
+magnitude, as the numpy path rescales its block.
+
+The facet refraction is :func:`models.kernels.facet.btdf_jones` (the FacetBTDF kernel's);
+the tests hold this module to the numpy path within 1e-12 relative to ``M00``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .facet import btdf_jones, cross3, dot3
+
+__all__ = ["estimate", "exit_transmittance"]
+
+#: Mueller elements a real Jones matrix can reach (the others couple V and vanish here)
+_REACHED = np.array([0, 1, 2, 4, 5, 6, 8, 9, 10, 15])
+#: the basis returned for a ray that does not exist (never read)
+_NO_BASIS = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+
+@njit(cache=True, inline="always")
+def _ray_basis(k):
+    """``(s, p)`` of ray ``k``: ``s = unit(z x k)``, ``+y`` along the z axis
+    (:func:`models.facet_btdf.ray_basis`)."""
+    norm = math.sqrt(k[1] * k[1] + k[0] * k[0])
+    if norm <= 1e-15:
+        s = (0.0, 1.0, 0.0)
+    else:
+        s = (-k[1] / norm, k[0] / norm, 0.0)
+    return s, cross3(k, s)
+
+
+@njit(cache=True, inline="always")
+def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
+    """The incident ray through facet ``m`` (slope x ``zx``): ``(weight, k1, basis of k1,
+    Jones, flux factor)``; weight 0 where the facet is not struck or the ray does not go
+    down."""
+    w = max(ci - si * zx, 0.0) / n_i
+    eta = 1.0 / n
+    c = -dot3(k_i, m)
+    ct = math.sqrt(max(1.0 - eta * eta * (1.0 - c * c), 0.0))
+    f = eta * c - ct
+    k1 = (eta * k_i[0] + f * m[0], eta * k_i[1] + f * m[1], eta * k_i[2] + f * m[2])
+    if not (w > 0.0 and c > 0.0 and -k1[2] > 0.0):
+        return 0.0, k1, _NO_BASIS, (0.0, 0.0, 0.0, 0.0), 0.0
+    e1 = _ray_basis(k1)
+    ss, ps, sp, pp, c_in, c_out = btdf_jones(k_i, k1, m, n, e_i, e1)
+    return w, k1, e1, (ss, ps, sp, pp), n * c_out / (c_in if c_in > 0.0 else 1.0)
+
+
+@njit(cache=True, inline="always")
+def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
+    """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
+    ``(weight, k2, basis of k2, Jones, flux factor)``, weight 0 where no such ray exists."""
+    w = max(cr + srcp * zx + srsp * zy, 0.0) / n_r
+    eta = 1.0 / n
+    c = dot3(k_r, m)
+    ct = math.sqrt(max(1.0 - eta * eta * (1.0 - c * c), 0.0))
+    f = eta * c - ct
+    k2 = (eta * k_r[0] - f * m[0], eta * k_r[1] - f * m[1], eta * k_r[2] - f * m[2])
+    if not (w > 0.0 and c > 0.0 and k2[2] > 0.0):
+        return 0.0, k2, _NO_BASIS, (0.0, 0.0, 0.0, 0.0), 0.0
+    e2 = _ray_basis(k2)
+    ss, ps, sp, pp, c_in, c_out = btdf_jones(k2, k_r, (-m[0], -m[1], -m[2]), eta, e2, e_r)
+    return w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
+
+
+@njit(cache=True, inline="always")
+def _real_mueller(x, a, b, c, d):
+    """Add the Mueller elements of the real Jones matrix ``ss, ps, sp, pp = a, b, c, d`` to
+    ``x`` (:func:`models.polarization.mueller16_from_jones` with zero imaginary parts)."""
+    s_ = a * a + d * d
+    dd = a * a - d * d
+    o_ = b * b + c * c
+    od = c * c - b * b
+    x[0] += 0.5 * (s_ + o_)
+    x[1] += 0.5 * (dd + od)
+    x[4] += 0.5 * (dd - od)
+    x[5] += 0.5 * (s_ - o_)
+    x[2] += a * b + d * c
+    x[6] += a * b - d * c
+    x[8] += a * c + d * b
+    x[9] += a * c - d * b
+    x[10] += d * a + b * c
+    x[15] += d * a - b * c
+
+
+@njit(cache=True, inline="always")
+def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
+    """One live pair's Mueller estimate into ``x``: the totally diffuse term and the single
+    scattering (depolarizing: a scalar; polarized: the Jones chain of Eq. 4-5)."""
+    diffuse, single, g, polarized = prm[1], prm[2], prm[3], prm[4] != 0.0
+    cos_scat = dot3(k1, k2)
+    b = 1.0 + g * g - 2.0 * g * cos_scat
+    dens = (1.0 - g * g) / (4.0 * math.pi * b * math.sqrt(b))
+    rows = (
+        0.5 * (ji[0] * ji[0] + ji[1] * ji[1] + ji[2] * ji[2] + ji[3] * ji[3]),
+        0.5 * (ji[0] * ji[0] - ji[1] * ji[1] + ji[2] * ji[2] - ji[3] * ji[3]),
+        ji[0] * ji[1] + ji[2] * ji[3],
+    )
+    cols = (
+        0.5 * (jo[0] * jo[0] + jo[1] * jo[1] + jo[2] * jo[2] + jo[3] * jo[3]),
+        0.5 * (jo[0] * jo[0] + jo[1] * jo[1] - jo[2] * jo[2] - jo[3] * jo[3]),
+        jo[0] * jo[2] + jo[3] * jo[1],
+    )
+    scal = diffuse * base
+    if not polarized:
+        scal = scal + single * base * dens * depth
+    x[:] = 0.0
+    for a in range(3):
+        ca = cols[a] * scal
+        for q in range(3):
+            x[4 * a + q] = ca * rows[q]
+    if polarized and single > 0.0:
+        (s1, p1), (s2, p2) = e1, e2
+        ph = ((dot3(s2, s1), dot3(s2, p1)), (dot3(p2, s1), dot3(p2, p1)))
+        t = (
+            (ph[0][0] * ji[0] + ph[0][1] * ji[2], ph[0][0] * ji[1] + ph[0][1] * ji[3]),
+            (ph[1][0] * ji[0] + ph[1][1] * ji[2], ph[1][0] * ji[1] + ph[1][1] * ji[3]),
+        )
+        root = math.sqrt(single * base * dens * depth * 2.0 / (1.0 + cos_scat * cos_scat))
+        _real_mueller(
+            x,
+            (jo[0] * t[0][0] + jo[1] * t[1][0]) * root,
+            (jo[0] * t[0][1] + jo[1] * t[1][1]) * root,
+            (jo[2] * t[0][0] + jo[3] * t[1][0]) * root,
+            (jo[2] * t[0][1] + jo[3] * t[1][1]) * root,
+        )
+
+
+@njit(cache=True)
+def _walk(geo, z, m, prm, inv_scale, x, mean, m2, peak):
+    """Welford's running mean and sum of squared deviations (``mean``, ``m2``) of the live
+    pairs' estimates times ``inv_scale``, and their largest magnitudes (``peak``); returns
+    the number of live pairs."""
+    k_i, e_i, ci, si, n_i, k_r, e_r, cr, srcp, srsp, n_r = geo
+    n = prm[0]
+    live = 0
+    mean[:] = 0.0
+    m2[:] = 0.0
+    peak[:] = 0.0
+    for j in range(z.shape[1]):
+        w1, k1, e1, ji, f_in = _entry(k_i, e_i, ci, si, n_i, z[0, j], (m[0, j], m[1, j], m[2, j]), n)
+        if w1 == 0.0:
+            continue
+        mj = (m[3, j], m[4, j], m[5, j])
+        w2, k2, e2, jo, f_out = _exit(k_r, e_r, cr, srcp, srsp, n_r, z[2, j], z[3, j], mj, n)
+        if w2 == 0.0:
+            continue
+        base = w1 * w2 * f_in * f_out / (n * n)
+        _volume(x, k1, e1, ji, k2, e2, jo, base, 1.0 / (-k1[2] + k2[2]), prm)
+        live += 1
+        inv = 1.0 / live
+        for e in _REACHED:
+            v = x[e] * inv_scale[e]
+            d = v - mean[e]
+            mean[e] += d * inv
+            m2[e] += d * (v - mean[e])
+            peak[e] = max(peak[e], abs(v))
+    return live
+
+
+@njit(cache=True)
+def _geometry(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, col):
+    """Mean and standard error of one geometry into ``mean[:, col]``, ``err[:, col]``."""
+    mean[:, col] = 0.0
+    err[:, col] = 0.0
+    if not (ti < 0.5 * math.pi and tr < 0.5 * math.pi):
+        return
+    ci, si, cr, sr, cp, sp = (
+        math.cos(ti),
+        math.sin(ti),
+        math.cos(tr),
+        math.sin(tr),
+        math.cos(pr),
+        math.sin(pr),
+    )
+    k_i = (si, 0.0, -ci)
+    k_r = (sr * cp, sr * sp, cr)
+    s_i, s_r = (0.0, 1.0, 0.0), (-sp, cp, 0.0)
+    geo = (k_i, (s_i, cross3(k_i, s_i)), ci, si, n_i, k_r, (s_r, cross3(k_r, s_r)), cr, sr * cp, sr * sp, n_r)
+    x, mu, m2, peak, scale = np.empty(16), np.empty(16), np.empty(16), np.empty(16), np.ones(16)
+    live = _walk(geo, z, m, prm, scale, x, mu, m2, peak)
+    if peak.max() >= safe:
+        # squares of such values overflow: walk again with each element over its largest
+        for e in range(16):
+            scale[e] = peak[e] if peak[e] > 0.0 else 1.0
+        live = _walk(geo, z, m, prm, 1.0 / scale, x, mu, m2, peak)
+    pairs = z.shape[1]
+    dead = pairs - live
+    for e in _REACHED:
+        # the dead pairs' exact zeros joined to the live ones (Chan et al.'s pairwise update)
+        total = mu[e] * live / pairs
+        ss = m2[e] + mu[e] * mu[e] * live * dead / pairs
+        mean[e, col] = total * scale[e]
+        err[e, col] = math.sqrt(ss / (pairs - 1)) / math.sqrt(pairs) * scale[e]
+
+
+@njit(cache=True)
+def _serial(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err):
+    for i in range(mean.shape[1]):
+        _geometry(ti[i], tr[i], pr[i], n_i[i], n_r[i], z, m, prm, safe, mean, err, i)
+
+
+@njit(cache=True, parallel=True)
+def _parallel(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err):
+    for i in prange(mean.shape[1]):
+        _geometry(ti[i], tr[i], pr[i], n_i[i], n_r[i], z, m, prm, safe, mean, err, i)
+
+
+def estimate(ti, tr, pr, n_i, n_r, z, m, prm, safe, parallel):
+    """Mean and standard error ``(16, n)`` of the volume terms at flat angles ``(n,)``.
+
+    Parameters
+    ----------
+    ti, tr, pr : ndarray
+        Flat float64 angles, one per geometry.
+    n_i, n_r : ndarray
+        The exact normalizations ``N_k`` of the incident and scattered directions (1 where
+        ``N_k`` vanishes), one per geometry.
+    z : ndarray
+        ``(4, pairs)``: slopes x, y of the entry facets, then of the exit facets.
+    m : ndarray
+        ``(6, pairs)``: the unit normals of the entry facets, then of the exit facets.
+    prm : ndarray
+        ``(n, diffuse factor rho / pi / (1 - rho R-bar), single weight, g, polarized)``.
+    safe : float
+        The magnitude from which a geometry's estimates are rescaled before squaring.
+    parallel : bool
+        Spread the geometries over the cores.
+    """
+    mean = np.empty((16, ti.size))
+    err = np.empty((16, ti.size))
+    run = _parallel if parallel else _serial
+    run(ti, tr, pr, n_i, n_r, z, m, prm, float(safe), mean, err)
+    return mean, err
+
+
+@njit(cache=True, parallel=True)
+def exit_transmittance(tr, pr, n_r, z, m, n):
+    """``<w_r M_out[0, 0]>`` over the exit facets for flat directions ``(tr, pr)``
+    (:meth:`models.RoughDiffuseBRDF._exit_transmittance`; bases from :func:`_ray_basis`)."""
+    out = np.empty(tr.size)
+    for i in prange(tr.size):
+        cr, sr, cp, sp = math.cos(tr[i]), math.sin(tr[i]), math.cos(pr[i]), math.sin(pr[i])
+        k_r = (sr * cp, sr * sp, cr)
+        e_r = _ray_basis(k_r)
+        total = 0.0
+        for j in range(z.shape[1]):
+            mj = (m[3, j], m[4, j], m[5, j])
+            w, _, _, jo, f = _exit(k_r, e_r, cr, sr * cp, sr * sp, n_r[i], z[2, j], z[3, j], mj, n)
+            if w > 0.0:
+                total += 0.5 * (jo[0] * jo[0] + jo[1] * jo[1] + jo[2] * jo[2] + jo[3] * jo[3]) * f * w
+        out[i] = total / z.shape[1]
+    return out
