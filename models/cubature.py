@@ -41,6 +41,8 @@ def _genz_malik():
 
 
 GM_U, GM_V, _W7, _W5 = _genz_malik()
+#: a region is split when its error exceeds this fraction of its row's worst region's
+WORST = 0.25
 #: points per region
 GM_POINTS = GM_U.size
 
@@ -184,8 +186,11 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
         todo = row_err > allowed
         capped |= todo & (count >= max_regions)
         todo &= ~capped
-        # every region above its fair share of the row's budget is split
-        split = todo[row] & (err > allowed[row] / count[row])
+        # the worst regions are split: those above both their fair share of the row's budget
+        # and a fraction of the row's worst (the share alone would soon split nearly all)
+        worst = np.zeros(n_rows)
+        np.maximum.at(worst, row, err)
+        split = todo[row] & (err > np.maximum(allowed[row] / count[row], WORST * worst[row]))
         if not split.any():
             return Cubature(total, row_err, count, capped)
         regions = _refine(regions, split, integrand, block)
