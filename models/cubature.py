@@ -49,7 +49,7 @@ GM_POINTS = GM_U.size
 
 @dataclass
 class Cubature:
-    """The result of :func:`adaptive`: ``value`` ``(k, n_rows)`` the integrals, ``error``
+    """The result of :func:`adaptive`: ``value`` ``(k + 1, n_rows)`` the integrals, ``error``
     ``(n_rows,)`` the summed regional error estimates (the units of ``norm``), ``regions``
     ``(n_rows,)`` how many regions each row ended with, ``capped`` ``(n_rows,)`` True where a
     row stopped at ``max_regions`` before meeting its budget."""
@@ -61,20 +61,22 @@ class Cubature:
 
 
 def _rule(integrand, r):
-    """Degree-7 values ``(k, m)``, the magnitudes of their embedded differences ``(k, m)`` and
-    the split axis ``(m,)`` (True: across v) of the regions ``r``."""
+    """Degree-7 values ``(k + 1, m)``, the magnitudes of their embedded differences and the
+    split axis ``(m,)`` (True: across v) of the regions ``r``."""
     u = r.u0[:, None] + r.du[:, None] * GM_U[None, :]
     v = r.v0[:, None] + r.dv[:, None] * GM_V[None, :]
-    f = integrand(r.cell, u, v)  # (k, m, 17)
-    area = r.du * r.dv
+    f, w = integrand(r.cell, u, v)  # (k, m, 17), (m, 17)
+    area = (r.du * r.dv)[:, None]
+    w7, w5 = w * (_W7 * area), w * (_W5 * area)
     # einsum sums each region's points in one fixed order: a row's value does not depend on
     # how many other regions share the call (a BLAS product may block differently)
-    i7 = np.einsum("kmp,p->km", f, _W7) * area
-    diff = np.abs(i7 - np.einsum("kmp,p->km", f, _W5) * area)
+    i7 = np.concatenate([np.einsum("kmp,mp->km", f, w7), w7.sum(axis=1)[None]])
+    diff = np.abs(i7 - np.concatenate([np.einsum("kmp,mp->km", f, w5), w5.sum(axis=1)[None]]))
     # fourth differences along u and v of the component whose error estimate is largest: the
     # axis to split across is where that component varies most
     k = np.argmax(diff, axis=0)
-    g = np.take_along_axis(f, k[None, :, None], axis=0)[0]  # (m, 17)
+    g = f[np.minimum(k, f.shape[0] - 1), np.arange(k.size)]
+    g = np.where((k == f.shape[0])[:, None], 1.0, g) * w  # (m, 17); the last component is w itself
     d = [np.abs(g[:, a] + g[:, a + 1] - 2 * g[:, 0] - (g[:, a + 2] + g[:, a + 3] - 2 * g[:, 0]) / 7.0)
          for a in (1, 5)]  # fmt: skip
     return i7, diff, d[1] > d[0]
@@ -83,7 +85,7 @@ def _rule(integrand, r):
 @dataclass
 class _Regions:
     """Rectangles ``[u0, u0 + du] x [v0, v0 + dv]`` of the cells ``cell``, with their degree-7
-    values ``val`` ``(k, m)``, error bounds ``diff`` ``(k, m)`` and split axes."""
+    values ``val`` ``(k + 1, m)``, error bounds ``diff`` ``(k + 1, m)`` and split axes."""
 
     cell: np.ndarray
     u0: np.ndarray
@@ -150,17 +152,19 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
     ----------
     integrand : callable
         ``integrand(cell, u, v)``: ``cell`` ``(m,)`` cell indices, ``u``, ``v`` ``(m, P)``
-        points of the unit square; returns ``(k, m, P)`` values (``k`` integrands at once,
-        Jacobians included).
+        points of the unit square; returns ``(f, w)``: ``k`` functions ``f`` ``(k, m, P)``
+        and a weight ``w`` ``(m, P)`` (Jacobians included).  The ``k + 1`` integrals are
+        those of ``f w`` and of ``w`` itself (the last).
     cell_row : ndarray of int, shape (n_cells,)
         The row each cell belongs to.
     n_rows : int
         Number of rows.
     norm : callable
         ``norm(diff, value)``: the scalar error ``(m,)`` of regions from the bounds ``diff``
-        ``(k, m)`` on their components and their rows' current totals ``value`` ``(k, m)``.
+        ``(k + 1, m)`` on their integrals and their rows' current totals ``value`` ``(k + 1, m)``.
     budget : callable
-        ``budget(value)``: the error ``(n_rows,)`` allowed for the totals ``value`` ``(k, n_rows)``.
+        ``budget(value)``: the error ``(n_rows,)`` allowed for the totals ``value``
+        ``(k + 1, n_rows)``.
     max_regions : int
         Regions per row beyond which it is not refined (reported in ``capped``).
     start : int

@@ -403,10 +403,8 @@ class PointSourceBRDF(_Wrapper):
         for n_r in _FIRST:
             t, chi, w = _product_nodes(n_r)
             step = max(1, _BLOCK // t.size)
-            vals.append(np.concatenate([
-                (lambda f: f[:16] / f[16])(disc.values(rows[a:a + step], t, chi, w).sum(axis=-1))
-                for a in range(0, rows.size, step)
-            ], axis=1))  # fmt: skip
+            vals.append(np.concatenate([_weighted_mean(*disc.values(rows[a:a + step], t, chi, w))
+                                        for a in range(0, rows.size, step)], axis=1))  # fmt: skip
         coarse, fine = vals
         err = np.max(np.abs(fine - coarse), axis=0)
         sc = np.maximum(np.abs(fine[0]), scale)
@@ -576,6 +574,11 @@ def _ratio(a, b):
     return np.divide(a, b, out=np.where(a > 0, np.inf, 0.0), where=b > 0)
 
 
+def _weighted_mean(M, J):
+    """``sum_p M J / sum_p J`` per row: ``(16, m)``."""
+    return np.einsum("kmp,mp->km", M, J) / J.sum(axis=1)
+
+
 def _product_nodes(n_r):
     """``(t, chi, w)`` ``(1, K)``: Gauss-Legendre in ``t`` (``n_r`` nodes) times the periodic
     trapezoid rule in ``chi`` (``2 n_r`` nodes); the area element is the integrand's."""
@@ -626,8 +629,8 @@ class _Disc:
         return np.sqrt(np.maximum(1.0 - (ox * s) ** 2, 0.0)) - ox * c
 
     def values(self, rows, t, chi, w):
-        """The integrands ``(17, m, P)`` at ``(t, chi)`` with weights ``w``: the 16 Mueller
-        elements times the irradiance weight, and the weight (``rho^2 t cos^3 psi w``)."""
+        """``(M, J)`` at ``(t, chi)`` with quadrature weights ``w``: the 16 Mueller elements
+        ``(16, m, P)`` and the irradiance weight ``J = rho^2 t cos^3 psi w`` ``(m, P)``."""
         ox = self.ox[rows][:, None]
         c, s = np.cos(chi), np.sin(chi)
         rho = self.rho(ox, c, s)
@@ -636,9 +639,9 @@ class _Disc:
         y = self.k * r * s
         q = x * x + y * y  # tan^2 psi
         cos_psi = 1.0 / np.sqrt(1.0 + q)
-        J = w * rho * rho * t * cos_psi**3
+        J = w * rho * rho * t * (cos_psi * cos_psi * cos_psi)
         M = self.ps._local(np.arctan(np.sqrt(q)), np.arctan2(y, x), self.tr[rows], self.pr[rows])
-        return np.concatenate([M * J[None], J[None]], axis=0)
+        return M, J
 
     def cells(self, rows):
         """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into
