@@ -103,18 +103,35 @@ class DetectorAperture(_Wrapper):
         if self.aperture == 0.0:
             return self.model._m16(ti, tr, pr)
         n = ti.size
+        out = np.empty((16, n))
+        K = self._nodes[0].size
+        step = max(1, _BLOCK // K)  # geometries per block, with all their nodes
+        for g0 in range(0, n, step):
+            g = slice(g0, min(n, g0 + step))
+            th, ph, wt, c2, s2 = _Frame(tr[g], pr[g]).nodes(*self._nodes)
+            M = self.model._m16(np.repeat(ti[g], K), th.ravel(), ph.ravel()).reshape(16, -1, K)
+            out[:, g] = _rotate_rows_and_sum(M, wt, c2, s2) / wt.sum(axis=1)
+        return out
+
+    def _mueller16_reference(self, ti, tr, pr):
+        """:meth:`_mueller16` the direct way, kept as the reference the tests hold it to
+        (1e-12 of ``M00``): the node directions as vectors, their angles by ``arccos`` and
+        ``arctan2``, both bases built and the analyzer basis carried over by projection, and
+        each node's full ``4 x 4`` rotation applied by a matrix product."""
+        if self.aperture == 0.0:
+            return self.model._m16(ti, tr, pr)
+        n = ti.size
         out = np.zeros((16, n))
         wsum = np.zeros(n)
         s_r, _ = sp_basis_angles(tr, pr)
         K = self._nodes[0].size
-        step = max(1, _BLOCK // n)  # nodes per block: every temporary is O(_BLOCK)
+        step = max(1, _BLOCK // n)
         for k0 in range(0, K, step):
             sl = slice(k0, min(K, k0 + step))
             k, wt = self.directions(tr, pr, sl)
             kb = wt.shape[1]
             th = np.where(wt > 0, np.arccos(np.clip(k[..., 2], -1.0, 1.0)), 0.0)  # dead node: weight 0
             ph = np.arctan2(k[..., 1], k[..., 0])
-            # the nominal analyzer basis carried to each node, and its angle from the node's own basis
             s_k, p_k = sp_basis_angles(th, ph)  # the basis the model's matrix at (th, ph) is in
             sa = s_r[:, None, :] - np.sum(s_r[:, None, :] * k, axis=-1, keepdims=True) * k
             sa /= np.linalg.norm(sa, axis=-1, keepdims=True)
@@ -126,3 +143,69 @@ class DetectorAperture(_Wrapper):
             out += np.einsum("ijnk,jlnk,nk->iln", R, M, wt).reshape(16, n)
             wsum += wt.sum(axis=1)
         return out / wsum
+
+
+class _Frame:
+    """The nominal directions' frames ``(k_r, p_r, s_r)``, for the node algebra of
+    :meth:`DetectorAperture._mueller16`.
+
+    A node ``k = cos_u k_r + a p_r + b s_r`` has the height ``k_z = cos_u cos tr + a p_rz``,
+    horizontal components ``(h, b)`` along ``(cos pr, sin pr)`` and ``s_r`` with
+    ``h = cos_u sin tr - a cos tr``, so its azimuth is ``pr + arctan2(b, h)``.  The
+    analyzer basis carried to ``k`` (``s_r`` less its ``k`` part) makes with the node's own
+    ``(s_k, p_k)`` the Jones rotation ``(c, s)``, proportional to ``(s_r . (z x k),
+    s_r . (k x (z x k))) = (h, -k_z b)``; only the double angle enters the Mueller
+    rotation, ``cos 2x = (c^2 - s^2) / (c^2 + s^2)``, ``sin 2x = 2 c s / (c^2 + s^2)``, so
+    nothing is normalized and no basis vector is built.
+    """
+
+    def __init__(self, tr, pr):
+        _, p_r = sp_basis_angles(tr, pr)
+        self.ct, self.st = np.cos(tr)[:, None], np.sin(tr)[:, None]
+        self.prz = p_r[:, 2][:, None]  # = sin tr, rounded as the vector form rounds it
+        self.pr = pr[:, None]
+
+    def nodes(self, a, b, cos_u, w):
+        """``(theta, phi, weight, cos 2x, sin 2x)``, each ``(n, K)``, of the nodes given by the
+        offsets ``a``, ``b`` along ``p_r``, ``s_r``, ``cos u`` and area weights ``w`` (``(K,)``)."""
+        kz = cos_u * self.ct + a * self.prz
+        wt = w * np.maximum(kz, 0.0)
+        th = np.where(wt > 0, np.arccos(np.minimum(kz, 1.0)), 0.0)  # dead node: weight 0
+        h = cos_u * self.st - a * self.ct
+        b = np.broadcast_to(b, h.shape)
+        ph = self.pr + np.arctan2(b, h)
+        c, s = h, -kz * b
+        cc, ss = c * c, s * s
+        q = cc + ss
+        if not q.min() > 1e-280:  # squares near underflow (a node near the normal): scale them first
+            return th, ph, wt, *_double_angle_scaled(c, s)
+        iq = 1.0 / q
+        return th, ph, wt, (cc - ss) * iq, 2.0 * c * s * iq
+
+
+def _double_angle_scaled(c, s):
+    """``(cos 2x, sin 2x)`` of the angle of ``(c, s)``, scaled so that the squares cannot
+    underflow; a node exactly on the normal (``c = s = 0``) is in the nominal basis turned by
+    its azimuth offset, 0 or pi: ``(1, 0)``."""
+    big = np.maximum(np.abs(c), np.abs(s))
+    on_axis = big == 0
+    c = np.where(on_axis, 1.0, c) / np.where(on_axis, 1.0, big)
+    s = np.where(on_axis, 0.0, s) / np.where(on_axis, 1.0, big)
+    q = c * c + s * s
+    return (c * c - s * s) / q, 2.0 * c * s / q
+
+
+def _rotate_rows_and_sum(M, wt, c2, s2):
+    """``sum_k wt R_k M_k`` ``(16, n)`` for the Mueller rotations ``R_k`` of double angles
+    ``(c2, s2)``: ``R`` keeps rows 0 and 3 and turns rows 1-2 by ``[[c2, s2], [-s2, c2]]``,
+    so it is applied as weighted sums of the rows (``M``: ``(16, n, K)``)."""
+    wc, ws = wt * c2, wt * s2
+    m1, m2 = M[4:8], M[8:12]
+    return np.concatenate(
+        [
+            np.einsum("enk,nk->en", M[0:4], wt),
+            np.einsum("enk,nk->en", m1, wc) + np.einsum("enk,nk->en", m2, ws),
+            np.einsum("enk,nk->en", m2, wc) - np.einsum("enk,nk->en", m1, ws),
+            np.einsum("enk,nk->en", M[12:16], wt),
+        ]
+    )

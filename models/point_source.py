@@ -24,21 +24,44 @@ paper's weights are not used: Eq. 25 is the *one-dimensional* Cauchy density
 over a disc of radius ``X`` grows like ``ln X``); the irradiance of a point
 source on a plane is the bivariate Cauchy density ``d / (2 pi (d^2 + x^2)^{3/2})``,
 and Eq. 28's measure ``d psi d Phi`` is not the area element
-(``dA = d^2 tan psi sec^2 psi d psi d Phi``).  The quadrature is Gauss-Legendre
-in the radius (``resolution`` nodes, weight ``rho d rho``) times the periodic
-trapezoid rule in the azimuth (``2 resolution`` nodes) over the disc.
+(``dA = d^2 tan psi sec^2 psi d psi d Phi``).
 
-Resolution.  The nodes must resolve the collimated lobe as the incidence sweeps over the
-disc: a fixed 16 leaves Cook-Torrance m = 0.01 at d/R = 3 off by more than half the peak
-(``tests/test_point_source_resolution.py`` shows it).  The default ``resolution="auto"``
-takes ``N = max(16, ceil(10 s / w))`` per incidence, with ``s`` the incidence spread over
-the sample (:meth:`incidence_range`) and ``w`` the inner model's lobe width
-(:meth:`Model.lobe`; 16 for a model without a narrow lobe).  For smooth lobes (Gaussian
-and Cook-Torrance slopes, GGX) of width 0.02 to 0.2 rad at d/R 1 and 3 the change on
-doubling ``N`` is at most 1e-6 of the peak (the same test holds it there).  A cusped lobe
-(exponential slopes) converges only algebraically and is not held to that bound: give a
-larger ``resolution`` and measure it (``scatterbench tradeoff``'s point-source resolution
-knob).  The cost grows as ``N^2`` inner evaluations per geometry.
+Accuracy (``resolution="auto"``, the default, exact method).  The user states the accuracy,
+``tol``, and every geometry is refined until its estimated error meets it: each Mueller element
+is then within ``tol * max(M00, M00_c)`` of the exact superposition, ``M00`` the geometry's own
+value and ``M00_c`` the value at the inner model's lobe centre at the same incidence
+(:meth:`Model.lobe`; 0 without a lobe, so that the bound is relative to ``M00`` alone).
+``M00_c`` is at most the peak, so every value is within ``tol`` of the peak, and within ``tol``
+relative where it exceeds ``M00_c``.  A geometry's value does not depend on the others in the
+call.  A fixed 16 nodes left Cook-Torrance m = 0.01 at d/R = 3 off by more than half the peak,
+and the cusp of exponential slopes ~1e-2 at any practical count: the quadrature must follow the
+integrand's features, which are known:
+
+* the lobe, and for exponential slopes its cusp, sits where the local specular direction of the
+  incidence meets the observer, the point ``P*`` at ``psi = theta_r``, ``Phi = phi_r`` (or the
+  point of the disc nearest to it);
+* the incident ``(s, p)`` basis turns with ``Phi`` around the foot ``H`` of the source, so the
+  polarization elements have a direction-dependent limit there when ``H`` lies on the disc.
+
+The disc is written in polar coordinates ``(t, chi)`` about ``H`` (when on the disc) or its
+centre, ``rho = t rho_max(chi)``, which makes the basis smooth; it is cut at ``P*`` into at most
+four cells (``t`` below and above ``t*``, ``chi`` on either side of ``chi*``), each graded
+exponentially towards ``P*`` over the lobe's width on the disc (``width * d``), and integrated
+by adaptive cubature (:mod:`models.cubature`: Genz-Malik rules whose embedded difference, and
+the change a split makes, bound each region's error; regions above their share are halved until
+the geometry meets ``tol``).  A lobe broad compared with the incidence spread (``spread <=
+2 width``) or no lobe at all is tried first with the product rule in ``(t, chi)`` at 4 and 8
+radial nodes (160 evaluations; the difference of the two is the estimate): geometries it
+settles skip the cubature.  A geometry that reaches :data:`MAX_REGIONS` regions stops there with
+an :class:`AccuracyWarning` naming how many did and their estimated error;
+:meth:`PointSourceBRDF.accuracy` returns the estimates themselves.  An anisotropic inner model
+is rotated per node as a model set (``model.rotated(array)``); one that cannot be falls back to
+the product rule about the disc centre, doubled from 4 radial nodes up to 4096.
+
+A fixed ``resolution`` (an int) is the product rule of earlier versions, unrefined and
+unestimated: Gauss-Legendre in the radius about the disc centre (``resolution`` nodes, weight
+``rho d rho``) times the periodic trapezoid rule in the azimuth (``2 resolution`` nodes), whose
+cost grows as ``resolution^2`` (``scatterbench tradeoff``'s point-source resolution knob).
 
 Shift approximation (Eq. 29-30).  Every local BRDF is taken to be the central
 one ``f_c = f(psi_c, ., .)`` shifted so that its specular direction follows the
@@ -57,16 +80,19 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy import signal
 
+from . import cubature
 from .base import Model, _Wrapper
 from .geometry import disc_quadrature
 from .params import param
 
-__all__ = ["PointSourceBRDF", "point_source_geometry"]
+__all__ = ["PointSourceBRDF", "point_source_geometry", "Accuracy", "AccuracyWarning", "MAX_REGIONS"]
 
 #: Inner-model geometries per block (bounds the temporaries of one block).
 _BLOCK = 1 << 16
@@ -84,9 +110,41 @@ def point_source_geometry(lo_deg, hi_deg):
     return math.atan(0.5 * (tl + th)), 2.0 / (th - tl)
 
 
-#: ``resolution="auto"``: nodes per (incidence spread / lobe width), and the bounds
+#: :meth:`PointSourceBRDF.resolution_at` (the shift method's node count) for ``"auto"``: nodes
+#: per (incidence spread / lobe width), and the bounds
 AUTO_FACTOR = 10.0
 _AUTO_MIN, _AUTO_MAX = 16, 4096
+
+#: ``resolution="auto"``: the regions per geometry at which refinement stops (each region a
+#: 17-point rule: at most ~70,000 inner-model evaluations per geometry)
+MAX_REGIONS = 4096
+#: the product rule's node counts of the first try, and the largest doubling of the fallback
+_FIRST, _PRODUCT_MAX = (4, 8), 4096
+#: the first try is made when the incidence spread is at most this many lobe widths
+_BROAD = 2.0
+#: ``tol``: below ~1e-13 the rounding of the sums dominates; above 0.1 it is no statement
+_TOL_MIN, _TOL_MAX = 1e-13, 0.1
+
+
+class AccuracyWarning(RuntimeWarning):
+    """Some geometries reached the refinement cap before their estimated error met ``tol``."""
+
+
+@dataclass(frozen=True)
+class Accuracy:
+    """What :meth:`PointSourceBRDF.accuracy` measured, per geometry (the broadcast shape).
+
+    ``mueller`` ``(..., 4, 4)`` the result; ``error`` the estimated error of its worst element
+    over ``scale``, comparable with ``tol``; ``scale`` ``max(M00, M00_c)`` (module docstring,
+    Accuracy); ``evaluations`` the inner-model evaluations spent; ``capped`` True where the
+    refinement stopped at :data:`MAX_REGIONS` (or the fallback's 4096 radial nodes) before
+    ``error`` met ``tol``."""
+
+    mueller: np.ndarray
+    error: np.ndarray
+    scale: np.ndarray
+    evaluations: np.ndarray
+    capped: np.ndarray
 
 
 def _check_resolution(name, r):
@@ -95,6 +153,13 @@ def _check_resolution(name, r):
     if isinstance(r, (int, np.integer)) and not isinstance(r, bool) and 1 <= r <= 4096:
         return int(r)
     raise ValueError(f"{name} must be 'auto' or an integer in [1, 4096]; got {r!r}")
+
+
+def _check_tol(name, v):
+    ok = isinstance(v, (int, float, np.floating)) and not isinstance(v, bool) and _TOL_MIN <= v <= _TOL_MAX
+    if not ok:
+        raise ValueError(f"{name} must be a real number in [{_TOL_MIN:g}, {_TOL_MAX:g}]; got {v!r}")
+    return float(v)
 
 
 def _check_distance(name, d):
@@ -128,9 +193,14 @@ class PointSourceBRDF(_Wrapper):
     method : "exact" | "shift"
         Eq. 28 superposition, or the shift approximation Eq. 29-30.
     resolution : int or "auto"
-        Radial quadrature nodes over the disc (azimuthal nodes: twice as many), or
-        ``"auto"``: chosen per incidence from the lobe width and the incidence spread
-        (module docstring, "Resolution").
+        ``"auto"``: refined per geometry until the estimated error meets ``tol`` (module
+        docstring, "Accuracy"); an int: the fixed product rule with that many radial nodes
+        (azimuthal nodes: twice as many), no estimate.  The shift method takes
+        :meth:`resolution_at` nodes.
+    tol : float
+        The accuracy ``"auto"`` refines to, in [1e-13, 0.1]: every Mueller element within
+        ``tol * max(M00, M00_c)`` of the exact superposition, ``M00_c`` the value at the inner
+        model's lobe centre at the same incidence (at most the peak).
     """
 
     model: Model = param(dataclasses.MISSING, "the collimated model", kind="object")
@@ -143,10 +213,14 @@ class PointSourceBRDF(_Wrapper):
     )
     resolution: int | str = param(
         "auto",
-        "radial quadrature nodes over the disc (1-4096), or 'auto' from the lobe width",
+        "'auto': refined to tol; or a fixed count of radial quadrature nodes over the disc (1-4096)",
         kind="object",
         check=_check_resolution,
     )
+    tol: float = param(
+        1e-4, "accuracy of resolution='auto', relative to max(M00, M00 at the lobe centre)",
+        kind="object", check=_check_tol,
+    )  # fmt: skip
 
     def lobe(self, theta_i):
         lb = self.model.lobe(theta_i)
@@ -157,7 +231,9 @@ class PointSourceBRDF(_Wrapper):
 
     # -- source geometry ------------------------------------------------------------
     def resolution_at(self, theta_i):
-        """The radial node count used at central incidence ``theta_i`` (a float)."""
+        """The product rule's radial node count at central incidence ``theta_i`` (a float): a
+        fixed ``resolution``, or for ``"auto"`` (used by the shift method, whose error is its
+        approximation's) ``max(16, ceil(10 spread / lobe width))``."""
         if self.resolution != "auto":
             return self.resolution
         lb = self.model.lobe(theta_i)
@@ -201,22 +277,187 @@ class PointSourceBRDF(_Wrapper):
 
     # -- evaluation -----------------------------------------------------------------------
     def _mueller16(self, ti, tr, pr):
-        if self.distance == math.inf:
+        if self.distance == math.inf or self.sample_radius / self.distance == 0.0:
             return self.model._m16(ti, tr, pr)
+        if self.resolution == "auto" and self.method == "exact":
+            res = self._auto(ti, tr, pr)
+            if res.capped.any():
+                k = int(res.capped.sum())
+                warnings.warn(
+                    f"PointSourceBRDF: {k} of {ti.size} geometries stopped at the refinement cap "
+                    f"with an estimated error up to {np.max(res.error[res.capped]):.2g} of their scale, "
+                    f"above tol = {self.tol:g} (PointSourceBRDF.accuracy reports each)",
+                    AccuracyWarning,
+                    stacklevel=4,
+                )
+            return res.mueller
         out = np.zeros((16, ti.size))
-        live = ti < 0.5 * math.pi
-        if not live.all():
-            idx = np.flatnonzero(live)
-            if idx.size:
-                out[:, idx] = self._mueller16(ti[idx], tr[idx], pr[idx])
-            return out
+        live = np.flatnonzero(ti < 0.5 * math.pi)
+        ti, tr, pr = ti[live], tr[live], pr[live]
         # one node set per resolution: a geometry's value does not depend on the others in the call
         uniq, inv = np.unique(ti, return_inverse=True)
-        res = np.array([self.resolution_at(float(t)) for t in uniq])[inv]
+        res = np.array([self.resolution_at(float(t)) for t in uniq], dtype=int)[inv]
         for r in np.unique(res):
             idx = np.flatnonzero(res == r)
-            out[:, idx] = self._superpose(ti[idx], tr[idx], pr[idx], int(r))
+            out[:, live[idx]] = self._superpose(ti[idx], tr[idx], pr[idx], int(r))
         return out
+
+    # -- resolution="auto": refined to tol (module docstring, Accuracy) ---------------------------
+    def accuracy(self, theta_i, theta_r, phi_r=0.0):
+        """The ``"auto"`` evaluation of the exact superposition with its error estimates
+        (:class:`Accuracy`), whatever ``resolution`` and ``method`` this instance has."""
+        auto = (
+            self
+            if (self.resolution, self.method) == ("auto", "exact")
+            else self.replace(resolution="auto", method="exact")
+        )
+        shape, (ti, tr, pr) = auto._angles(theta_i, theta_r, phi_r)
+        if auto.distance == math.inf or auto.sample_radius / auto.distance == 0.0:
+            M = auto.model._m16(ti, tr, pr)
+            res = _Result(M, np.zeros(ti.size), np.abs(M[0]), np.ones(ti.size, int), np.zeros(ti.size, bool))
+        else:
+            res = auto._auto(ti, tr, pr)
+        return Accuracy(
+            np.moveaxis(res.mueller.reshape((4, 4) + shape), (0, 1), (-2, -1)),
+            *(a.reshape(shape) for a in (res.error, res.scale, res.evaluations, res.capped)),
+        )
+
+    @cached_property
+    def _scale_cache(self):
+        """``{theta_i: M00_c}``, filled as incidences are met (dropped with the parameters)."""
+        return {}
+
+    def _scales(self, ti):
+        """``M00_c`` per geometry: the value at the inner lobe's centre at its incidence, itself
+        refined to ``tol`` relative to itself (0 without a lobe)."""
+        cache = self._scale_cache
+        uniq, inv = np.unique(ti, return_inverse=True)
+        todo = [float(t) for t in uniq if float(t) not in cache]
+        lobes = [self.model.lobe(t) for t in todo]
+        at = [(t, lb) for t, lb in zip(todo, lobes, strict=True) if lb is not None and t < 0.5 * math.pi]
+        cache.update((t, 0.0) for t in todo)
+        if at:
+            c = np.array([[t, lb[0], lb[1]] for t, lb in at]).T
+            ok = c[1] <= 0.5 * math.pi  # a lobe centre below the horizon: no scale there
+            if ok.any():
+                m = self._refined(c[0][ok], c[1][ok], c[2][ok], np.zeros(int(ok.sum())))
+                cache.update(zip(c[0][ok].tolist(), np.abs(m.mueller[0]).tolist(), strict=True))
+        if len(cache) > 4096:  # a bound on what a long run of distinct incidences keeps
+            cache.clear()
+        return np.array([cache.get(float(t), 0.0) for t in uniq])[inv]
+
+    def _auto(self, ti, tr, pr):
+        """``resolution="auto"`` on flat angles: :class:`_Result`, zeros at grazing incidence."""
+        n = ti.size
+        res = _Result(np.zeros((16, n)), np.zeros(n), np.zeros(n), np.zeros(n, int), np.zeros(n, bool))
+        live = np.flatnonzero(ti < 0.5 * math.pi)
+        if live.size:
+            got = self._refined(ti[live], tr[live], pr[live], self._scales(ti[live]))
+            for f in dataclasses.fields(res):
+                getattr(res, f.name)[..., live] = getattr(got, f.name)
+        return res
+
+    def _refined(self, ti, tr, pr, scale):
+        """Every geometry refined until its estimated error is within ``tol * max(M00, scale)``."""
+        if not self._rotates:
+            return self._doubled(ti, tr, pr, scale)
+        disc = _Disc(self, ti, tr, pr)
+        n = ti.size
+        res = _Result(np.zeros((16, n)), np.zeros(n), np.zeros(n), np.zeros(n, int), np.zeros(n, bool))
+        todo = np.arange(n)
+        broad = np.flatnonzero(~(disc.spread > _BROAD * disc.width))  # also: no specular lobe (nan)
+        if broad.size:
+            done = self._first_try(disc, broad, scale[broad], res)
+            todo = np.setdiff1d(todo, broad[done])
+        if todo.size:
+            self._cubature(disc, todo, scale[todo], res)
+        return res
+
+    @cached_property
+    def _isotropic(self):
+        return self.model.rotated(1.0) is self.model
+
+    @cached_property
+    def _rotates(self):
+        """True when the local models can be evaluated in one call: an isotropic inner model, or
+        one whose ``rotated`` takes an array of angles (a model set)."""
+        if self._isotropic:
+            return True
+        try:
+            return self.model.rotated(np.array([0.0, 1.0])).param_shape == (2,)
+        except (TypeError, ValueError, AttributeError):
+            return False
+
+    def _local(self, psi, Phi, tr, pr):
+        """The inner model's Mueller elements ``(16, m, P)`` at local incidences ``(psi, Phi)``
+        ``(m, P)`` for the observations ``(tr, pr)`` ``(m,)``: the sample rotated by ``-Phi``."""
+        m, P = psi.shape
+        model = self.model if self._isotropic else self.model.rotated(-Phi.ravel())
+        M = model._m16(psi.ravel(), np.repeat(tr, P), (pr[:, None] - Phi).ravel())
+        return M.reshape(16, m, P)
+
+    def _first_try(self, disc, rows, scale, res):
+        """The product rule in ``(t, chi)`` at 4 and 8 radial nodes on ``rows``; where the two agree
+        within the budget the 8-node value is kept (in ``res``).  Returns the settled mask."""
+        vals = []
+        for n_r in _FIRST:
+            t, chi, w = _product_nodes(n_r)
+            step = max(1, _BLOCK // t.size)
+            vals.append(np.concatenate([_weighted_mean(*disc.values(rows[a:a + step], t, chi, w))
+                                        for a in range(0, rows.size, step)], axis=1))  # fmt: skip
+        coarse, fine = vals
+        err = np.max(np.abs(fine - coarse), axis=0)
+        sc = np.maximum(np.abs(fine[0]), scale)
+        done = err <= self.tol * sc
+        res.evaluations[rows] = sum(2 * n * n for n in _FIRST)
+        take = rows[done]
+        res.mueller[:, take], res.scale[take] = fine[:, done], sc[done]
+        res.error[take] = _ratio(err[done], sc[done])
+        return done
+
+    def _cubature(self, disc, rows, scale, res):
+        """Adaptive cubature over the cells of ``rows`` (module docstring, Accuracy), into ``res``."""
+        cells = disc.cells(rows)
+        tol = self.tol
+
+        def integrand(cell, u, v):
+            t, chi, w = cells.point(cell, u, v)
+            return disc.values(rows[cells.row[cell]], t, chi, w)
+
+        def norm(diff, total):
+            return np.max(diff[:16] + np.abs(total[:16] / total[16]) * diff[16], axis=0)
+
+        def budget(total):
+            return tol * np.maximum(np.abs(total[0] / total[16]), scale) * total[16]
+
+        got = cubature.adaptive(integrand, cells.row, rows.size, norm, budget, MAX_REGIONS)
+        W = got.value[16]
+        M = got.value[:16] / W
+        sc = np.maximum(np.abs(M[0]), scale)
+        res.mueller[:, rows], res.scale[rows], res.capped[rows] = M, sc, got.capped
+        res.error[rows] = _ratio(got.error / W, sc)
+        res.evaluations[rows] += cubature.GM_POINTS * got.regions
+
+    def _doubled(self, ti, tr, pr, scale):
+        """The fallback for an anisotropic model that cannot be rotated per node in one call: the
+        product rule about the disc centre, doubled from 4 radial nodes until two successive
+        counts agree within the budget (or 4096 nodes are reached)."""
+        n = ti.size
+        res = _Result(np.zeros((16, n)), np.full(n, np.inf), np.zeros(n), np.zeros(n, int), np.zeros(n, bool))
+        todo, prev, N = np.arange(n), self._superpose(ti, tr, pr, 2), 4
+        res.evaluations[:] = 8
+        while todo.size:
+            cur = self._superpose(ti[todo], tr[todo], pr[todo], N)
+            res.evaluations[todo] += 2 * N * N
+            sc = np.maximum(np.abs(cur[0]), scale[todo])
+            err = _ratio(np.max(np.abs(cur - prev), axis=0), sc)
+            res.mueller[:, todo], res.scale[todo], res.error[todo] = cur, sc, err
+            more = err > self.tol
+            if N >= _PRODUCT_MAX:
+                res.capped[todo[more]] = True
+                break
+            todo, prev, N = todo[more], cur[:, more], 2 * N
+        return res
 
     def _superpose(self, ti, tr, pr, resolution):
         """Eq. 28 (or the shift approximation) at ``resolution`` radial nodes: ``(16, n)``."""
@@ -315,3 +556,149 @@ class PointSourceBRDF(_Wrapper):
         F = np.zeros(T.shape)
         F[ok] = self.model.brdf(ti, T[ok], P[ok])
         return signal.correlate(F, K, mode="valid", method="fft")
+
+
+@dataclass
+class _Result:
+    """Flat ``"auto"`` results: Mueller elements ``(16, n)`` and per-geometry estimates."""
+
+    mueller: np.ndarray
+    error: np.ndarray
+    scale: np.ndarray
+    evaluations: np.ndarray
+    capped: np.ndarray
+
+
+def _ratio(a, b):
+    """``a / b`` with ``0 / 0 = 0`` (an exact zero known exactly)."""
+    return np.divide(a, b, out=np.where(a > 0, np.inf, 0.0), where=b > 0)
+
+
+def _weighted_mean(M, J):
+    """``sum_p M J / sum_p J`` per row: ``(16, m)``."""
+    return np.einsum("kmp,mp->km", M, J) / J.sum(axis=1)
+
+
+def _product_nodes(n_r):
+    """``(t, chi, w)`` ``(1, K)``: Gauss-Legendre in ``t`` (``n_r`` nodes) times the periodic
+    trapezoid rule in ``chi`` (``2 n_r`` nodes); the area element is the integrand's."""
+    x, wx = np.polynomial.legendre.leggauss(n_r)
+    chi = (np.arange(2 * n_r) + 0.5) * (math.pi / n_r)
+    t = np.repeat(0.5 * (x + 1.0), 2 * n_r)[None, :]
+    w = np.repeat(0.5 * wx, 2 * n_r)[None, :] * (math.pi / n_r)
+    return t, np.tile(chi, n_r)[None, :], w
+
+
+def _graded(beta, x):
+    """``g(x) = expm1(beta x) / expm1(beta)`` on [0, 1] and ``g'(x)``: points clustered towards 0
+    over a fraction ~1 / beta (``beta`` >= 1e-3, a smooth change of variables for any)."""
+    e = np.expm1(beta)
+    ex = np.exp(beta * x)
+    return (ex - 1.0) / e, beta * ex / e
+
+
+class _Disc:
+    """The disc as the ``"auto"`` quadrature sees it, per geometry (module docstring, Accuracy).
+
+    Lengths on the disc are in units of its radius ``R``; the source's height ``d`` enters
+    through ``k = R / d``.  Polar coordinates ``(t, chi)`` about ``O``, the foot ``H`` of the
+    source when it lies on the disc, else the centre: a point is ``O + t rho(chi) (cos chi,
+    sin chi)``, ``rho`` the distance from ``O`` to the rim.  ``width``: the inner model's lobe
+    width at the central incidence where its lobe is specular (centred at ``(theta_i, 0)``,
+    so that its peak or cusp sits at ``P*``), nan otherwise; ``spread``: the incidence spread.
+    """
+
+    def __init__(self, ps, ti, tr, pr):
+        self.ps, self.tr, self.pr = ps, tr, pr
+        self.k = ps.sample_radius / ps.distance
+        self.tan_c = np.tan(ti)  # H to C, in units of d
+        xc = self.tan_c / self.k  # H to C, in units of R
+        self.ox = np.where(xc < 1.0, -xc, 0.0)  # O from C
+        self.width = np.full(ti.size, np.nan)
+        self.spread = np.zeros(ti.size)
+        uniq, inv = np.unique(ti, return_inverse=True)
+        for j, t in enumerate(uniq.tolist()):
+            lb = ps.model.lobe(t)
+            lo, hi = ps.incidence_range(t)
+            self.spread[inv == j] = hi - lo
+            if lb is not None and lb[0] == t and lb[1] == 0.0:
+                self.width[inv == j] = lb[2]
+
+    def rho(self, ox, c, s):
+        """Distance from ``O`` (at ``ox``) to the rim along ``(c, s)``."""
+        return np.sqrt(np.maximum(1.0 - (ox * s) ** 2, 0.0)) - ox * c
+
+    def values(self, rows, t, chi, w):
+        """``(M, J)`` at ``(t, chi)`` with quadrature weights ``w``: the 16 Mueller elements
+        ``(16, m, P)`` and the irradiance weight ``J = rho^2 t cos^3 psi w`` ``(m, P)``."""
+        ox = self.ox[rows][:, None]
+        c, s = np.cos(chi), np.sin(chi)
+        rho = self.rho(ox, c, s)
+        r = rho * t
+        x = self.tan_c[rows][:, None] + self.k * (ox + r * c)  # from H, units of d
+        y = self.k * r * s
+        q = x * x + y * y  # tan^2 psi
+        cos_psi = 1.0 / np.sqrt(1.0 + q)
+        J = w * rho * rho * t * (cos_psi * cos_psi * cos_psi)
+        M = self.ps._local(np.arctan(np.sqrt(q)), np.arctan2(y, x), self.tr[rows], self.pr[rows])
+        return M, J
+
+    def cells(self, rows):
+        """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into
+        ``t`` below and above ``t*`` and ``chi`` on either side of ``chi*``, graded towards it."""
+        tq, cq, lt, lc = self._cusp(rows)
+        out = []
+        for span in (1.0 - tq, -tq):
+            for sign in (1.0, -1.0):
+                ok = np.flatnonzero(span != 0.0)
+                L = np.where(span > 0, lt[1], lt[0])[ok]  # the cell's extent on the disc along t
+                out.append((ok, tq[ok], span[ok], L, cq[ok], np.full(ok.size, sign * math.pi), lc[ok]))
+        return _Cells(*(np.concatenate(a) for a in zip(*out, strict=True)), self.width[rows] / self.k)
+
+    def _cusp(self, rows):
+        """``(t*, chi*)`` of ``P*`` clamped to the disc, and the disc lengths ``(inner, outer)``
+        along ``t`` and along ``chi`` (half turn at ``t*``) from it.  Without a specular lobe:
+        ``t* = 1, chi* = 0`` (no cut; no grading follows from a nan width)."""
+        tr, pr, k = self.tr[rows], self.pr[rows], self.k
+        tt = np.tan(np.minimum(tr, 0.5 * math.pi - 1e-12))
+        px = (tt * np.cos(pr) - self.tan_c[rows]) / k  # P* from C, units of R
+        py = tt * np.sin(pr) / k
+        big = np.hypot(px, py)
+        f = np.where(big > 1.0, 1.0 / np.where(big > 1.0, big, 1.0), 1.0)
+        qx, qy = px * f - self.ox[rows], py * f
+        cq = np.arctan2(qy, qx)
+        rq = self.rho(self.ox[rows], np.cos(cq), np.sin(cq))
+        tq = np.clip(np.hypot(qx, qy) / np.where(rq > 0, rq, 1.0), 0.0, 1.0)
+        none = np.isnan(self.width[rows])
+        tq, cq = np.where(none, 1.0, tq), np.where(none, 0.0, cq)
+        return tq, cq, (tq * rq, (1.0 - tq) * rq), tq * rq * math.pi
+
+
+@dataclass
+class _Cells:
+    """Cells of the ``(t, chi)`` plane per geometry: ``t = t0 + dt g_t(u)``, ``chi = c0 + dc
+    g_c(v)`` on the unit square, graded from the corner ``(t0, c0)`` at ``P*`` over the lobe's
+    width on the disc ``lobe`` (per geometry: lengths ``lt``, ``lc`` of the cell along t, chi)."""
+
+    row: np.ndarray
+    t0: np.ndarray
+    dt: np.ndarray
+    lt: np.ndarray
+    c0: np.ndarray
+    dc: np.ndarray
+    lc: np.ndarray
+    lobe: np.ndarray
+
+    def __post_init__(self):
+        # cluster over the lobe's width; without a specular lobe (nan) barely at all
+        lobe = self.lobe[self.row]
+        self.bt, self.bc = (
+            np.maximum(np.nan_to_num(np.log1p(length / lobe), nan=0.0), 1e-3) for length in (self.lt, self.lc)
+        )
+
+    def point(self, cell, u, v):
+        """``(t, chi, w)`` ``(m, P)`` of unit-square points of ``cell``, ``w`` the map's Jacobian."""
+        gt, dgt = _graded(self.bt[cell][:, None], u)
+        gc, dgc = _graded(self.bc[cell][:, None], v)
+        dt, dc = self.dt[cell][:, None], self.dc[cell][:, None]
+        return self.t0[cell][:, None] + dt * gt, self.c0[cell][:, None] + dc * gc, np.abs(dt * dc) * dgt * dgc

@@ -326,9 +326,9 @@ def shipped_models() -> list[tuple[str, object]]:
 
     * ``RoughDiffuseBRDF`` with 20 facet pairs per geometry (Monte Carlo; the kit checks
       shapes, finiteness, realizability and the seed, not its precision);
-    * ``PointSourceBRDF`` with 4 radial nodes over the disc (the default, ``"auto"``, takes
-      at least 16 per incidence, and the cost grows with their square; the quadrature is
-      the same code).
+    * ``PointSourceBRDF`` with 4 radial nodes over the disc (the default, ``"auto"``, refines
+      each geometry to ``tol``, hundreds to thousands of evaluations; the kit checks the
+      wrapper's shapes and physics, not its quadrature).
 
     Where a default is a paper's known slip (``CookTorranceBRDF``'s published
     normalization, ``FacetBTDF``'s Eq. 37), the kit reports a finding with the reason
