@@ -318,10 +318,11 @@ class Model(Declared):
         """Docstring summary and declared parameters, for listing models."""
         head = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else cls.__name__
         lines = [f"{cls.__name__}: {head}"]
+        width = max([12] + [len(p.name) for p in cls.parameters()])  # the names' column, aligned
         for p in cls.parameters():
             old = f"; old name{'s' if len(p.aliases) > 1 else ''} {', '.join(p.aliases)}" if p.aliases else ""
             default = f"{'(required)':<22}" if p.required else f"default={p.default!r:<14}"
-            lines.append(f"    {p.name:<12} {default} {p.doc} ({p.range_text()}{old})")
+            lines.append(f"    {p.name:<{width}} {default} {p.doc} ({p.range_text()}{old})")
         return "\n".join(lines)
 
 
