@@ -3,14 +3,15 @@
 Each integral (a *row*) is the sum of integrals over *cells*, each cell parametrized by
 the unit square ``(u, v) in [0, 1]^2`` (the caller maps it to its domain and includes the
 Jacobian in the integrand).  Every region, a rectangle of a cell, is integrated with the
-Genz-Malik rule of degree 7 (17 points in two dimensions) and its embedded rule of degree 5;
-their difference estimates the region's error (the error of the degree-5 rule: the
-degree-7 value returned is usually far more accurate).  Rows whose summed error exceeds
-their budget split every region above its fair share (budget / regions of the row) in two,
-across the axis with the larger fourth difference (Genz & Malik, J. Comput. Appl. Math. 6,
-295 (1980); Berntsen, Espelid & Genz, ACM TOMS 17, 437 (1991)), until each row meets its
-budget or reaches ``max_regions``.  Only the new regions are evaluated; rows that are done
-cost nothing more.
+Genz-Malik rule of degree 7 (17 points in two dimensions) and its embedded rule of degree 5
+(Genz & Malik, J. Comput. Appl. Math. 6, 295 (1980)).  A region's error bound is their
+difference (the error of the degree-5 rule: the degree-7 value returned is usually far more
+accurate) or, once it comes from a split, half the change the split made to its parent's
+value if that is larger: two rules can straddle a kink alike and agree by accident, a split
+cannot hide it.  Rows whose summed bound exceeds their budget split their worst regions (above
+their fair share of the budget and above :data:`WORST` of the row's worst) in two, across the
+axis along which the fourth difference is larger, until each row meets its budget or reaches
+``max_regions``.  Only the new regions are evaluated; rows that are done cost nothing more.
 """
 
 from __future__ import annotations

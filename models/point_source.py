@@ -34,8 +34,10 @@ value and ``M00_c`` the value at the inner model's lobe centre at the same incid
 ``M00_c`` is at most the peak, so every value is within ``tol`` of the peak, and within ``tol``
 relative where it exceeds ``M00_c``.  A geometry's value does not depend on the others in the
 call.  A fixed 16 nodes left Cook-Torrance m = 0.01 at d/R = 3 off by more than half the peak,
-and the cusp of exponential slopes ~1e-2 at any practical count: the quadrature must follow the
-integrand's features, which are known:
+and the product rule about the sample's centre converges only algebraically on the cusp of
+exponential slopes (3e-3 of the peak for sigma = 0.05 at d/R = 3 with the earlier lobe-based
+node count, 1.6e-4 with 256 radial nodes: ``benchmarks/wrappers.py``): the quadrature must
+follow the integrand's features, which are known:
 
 * the lobe, and for exponential slopes its cusp, sits where the local specular direction of the
   incidence meets the observer, the point ``P*`` at ``psi = theta_r``, ``Phi = phi_r`` (or the
@@ -288,7 +290,7 @@ class PointSourceBRDF(_Wrapper):
                     f"with an estimated error up to {np.max(res.error[res.capped]):.2g} of their scale, "
                     f"above tol = {self.tol:g} (PointSourceBRDF.accuracy reports each)",
                     AccuracyWarning,
-                    stacklevel=4,
+                    stacklevel=2,
                 )
             return res.mueller
         out = np.zeros((16, ti.size))
@@ -305,7 +307,10 @@ class PointSourceBRDF(_Wrapper):
     # -- resolution="auto": refined to tol (module docstring, Accuracy) ---------------------------
     def accuracy(self, theta_i, theta_r, phi_r=0.0):
         """The ``"auto"`` evaluation of the exact superposition with its error estimates
-        (:class:`Accuracy`), whatever ``resolution`` and ``method`` this instance has."""
+        (:class:`Accuracy`), whatever ``resolution`` and ``method`` this instance has (a single
+        model: not a model set, whose elements :meth:`mueller` evaluates one by one)."""
+        if self._sets:
+            raise ValueError("accuracy() takes a single model, not a model set (array parameters)")
         auto = (
             self
             if (self.resolution, self.method) == ("auto", "exact")
@@ -342,9 +347,10 @@ class PointSourceBRDF(_Wrapper):
             if ok.any():
                 m = self._refined(c[0][ok], c[1][ok], c[2][ok], np.zeros(int(ok.sum())))
                 cache.update(zip(c[0][ok].tolist(), np.abs(m.mueller[0]).tolist(), strict=True))
+        out = np.array([cache[float(t)] for t in uniq])[inv]
         if len(cache) > 4096:  # a bound on what a long run of distinct incidences keeps
             cache.clear()
-        return np.array([cache.get(float(t), 0.0) for t in uniq])[inv]
+        return out
 
     def _auto(self, ti, tr, pr):
         """``resolution="auto"`` on flat angles: :class:`_Result`, zeros at grazing incidence."""

@@ -176,3 +176,26 @@ def test_resolution_refusals(bad):
 def test_tol_refusals(bad):
     with pytest.raises(ValueError, match=r"^tol must be a real number in \[1e-13, 0\.1\]"):
         S.PointSourceBRDF(model=S.CookTorranceBRDF(), tol=bad)
+
+
+def test_the_scale_is_the_value_at_the_lobe_centre_or_the_geometry_s_own():
+    ps = S.PointSourceBRDF(model=INNERS[3], distance=3.0)
+    tr, pr = _scan()
+    acc = ps.accuracy(0.4, tr, pr)
+    centre = ps.accuracy(0.4, 0.4, 0.0)  # the inner model's lobe centre at theta_i = 0.4
+    m00 = acc.mueller[:, 0, 0]
+    expected = np.maximum(m00, centre.mueller[0, 0])
+    np.testing.assert_allclose(acc.scale, expected, rtol=2 * ps.tol)
+    assert np.any(acc.scale > m00) and np.any(acc.scale == m00)  # both cases occur in the scan
+
+
+def test_a_model_set_is_evaluated_element_by_element():
+    sigmas = np.array([0.05, 0.2])
+    ps = S.PointSourceBRDF(model=S.CookTorranceBRDF(slopes=S.GaussianSlopes(sigmas)), distance=3.0)
+    tr, pr = _scan()
+    got = ps.mueller(0.3, tr[:, None], pr[:, None])
+    for j, s in enumerate(sigmas):
+        one = S.PointSourceBRDF(model=S.CookTorranceBRDF(slopes=S.GaussianSlopes(float(s))), distance=3.0)
+        np.testing.assert_array_equal(got[:, j], one.mueller(0.3, tr, pr))
+    with pytest.raises(ValueError, match="accuracy\\(\\) takes a single model"):
+        ps.accuracy(0.3, tr, pr)
