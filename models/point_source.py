@@ -112,6 +112,13 @@ def point_source_geometry(lo_deg, hi_deg):
     return math.atan(0.5 * (tl + th)), 2.0 / (th - tl)
 
 
+#: ``resolution="auto"`` refines to ``tol`` for discs up to this many source heights in radius;
+#: a wider disc puts nearly all the flux within ``~d`` of the source's foot, a speck the
+#: cubature's cells (in units of ``R``) do not resolve, and gets the product rule of
+#: :meth:`PointSourceBRDF.resolution_at` instead, whose error is not estimated (the cubature's
+#: weights underflowed to 0/0 at R/d = 1e298)
+CUBATURE_SPAN = 1e3
+
 #: :meth:`PointSourceBRDF.resolution_at` (the shift method's node count) for ``"auto"``: nodes
 #: per (incidence spread / lobe width), and the bounds
 AUTO_FACTOR = 10.0
@@ -277,11 +284,16 @@ class PointSourceBRDF(_Wrapper):
         lo = math.atan2(max(xc - R, 0.0), d)
         return lo, math.atan2(xc + R, d)
 
+    @property
+    def _cubature_resolves(self):
+        """Whether ``"auto"`` refines by cubature (:data:`CUBATURE_SPAN`)."""
+        return self.sample_radius <= CUBATURE_SPAN * self.distance
+
     # -- evaluation -----------------------------------------------------------------------
     def _mueller16(self, ti, tr, pr):
         if self.distance == math.inf or self.sample_radius / self.distance == 0.0:
             return self.model._m16(ti, tr, pr)
-        if self.resolution == "auto" and self.method == "exact":
+        if self.resolution == "auto" and self.method == "exact" and self._cubature_resolves:
             res = self._auto(ti, tr, pr)
             if res.capped.any():
                 k = int(res.capped.sum())
@@ -618,7 +630,8 @@ class _Disc:
         self.ps, self.tr, self.pr = ps, tr, pr
         self.k = ps.sample_radius / ps.distance
         self.tan_c = np.tan(ti)  # H to C, in units of d
-        xc = self.tan_c / self.k  # H to C, in units of R
+        with np.errstate(over="ignore"):  # a disc tiny against d: H is off it (xc = inf), O the centre
+            xc = self.tan_c / self.k  # H to C, in units of R
         self.ox = np.where(xc < 1.0, -xc, 0.0)  # O from C
         self.width = np.full(ti.size, np.nan)
         self.spread = np.zeros(ti.size)
@@ -643,10 +656,10 @@ class _Disc:
         r = rho * t
         x = self.tan_c[rows][:, None] + self.k * (ox + r * c)  # from H, units of d
         y = self.k * r * s
-        q = x * x + y * y  # tan^2 psi
-        cos_psi = 1.0 / np.sqrt(1.0 + q)
+        tan_psi = np.hypot(x, y)  # hypot: a disc huge against d does not overflow x^2 (R up to 1e300)
+        cos_psi = 1.0 / np.hypot(1.0, tan_psi)
         J = w * rho * rho * t * (cos_psi * cos_psi * cos_psi)
-        M = self.ps._local(np.arctan(np.sqrt(q)), np.arctan2(y, x), self.tr[rows], self.pr[rows])
+        M = self.ps._local(np.arctan(tan_psi), np.arctan2(y, x), self.tr[rows], self.pr[rows])
         return M, J
 
     def cells(self, rows):
