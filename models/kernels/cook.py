@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import cdiv, coating_cos, refraction_w, stroke_d, write_diag
+from .common import cdiv, coating_cos, diag16, refraction_w, stroke_d
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
@@ -31,7 +31,7 @@ def fresnel_average(c, mr, mi, pec):
 
 
 @njit(cache=True, inline="always")
-def ct_value(ci, cr, cp, sp, prm, j, mr, mi, blinn):
+def ct_value(ci, cr, cp, sp, p, mr, mi, blinn):
     """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``."""
     T = type(ci)
     si = math.sqrt(T(1.0) - ci * ci)
@@ -42,8 +42,8 @@ def ct_value(ci, cr, cp, sp, prm, j, mr, mi, blinn):
     hz2 = hz * hz
     g = hx * hx + hy * hy + hz2
     q = g / hz2
-    a = prm[5, j]
-    val = stroke_d(hx, hy, hz2, prm[3, j], prm[4, j], math.cos(a), math.sin(a)) * (q * q)
+    a = p[5]
+    val = stroke_d(hx, hy, hz2, p[3], p[4], math.cos(a), math.sin(a)) * (q * q)
     val *= fresnel_average(T(0.5) * math.sqrt(g), mr, mi, mr == T(math.inf))
     if blinn:
         t = (T(4.0) / g) * hz
@@ -52,30 +52,28 @@ def ct_value(ci, cr, cp, sp, prm, j, mr, mi, blinn):
 
 
 @njit(cache=True, inline="always")
-def cook(ti, tr, pr, prm, j, iopt, out, i):
-    """Cook-Torrance (``iopt[0] = 0``) or its varnished form (1); ``iopt[1]``: corrected
-    convention, ``iopt[2]``: Blinn's G."""
+def cook(ti, tr, pr, p, o):
+    """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
+    convention, ``o[2]``: Blinn's G."""
     T = type(ti)
     half_pi = T(0.5 * math.pi)
     if ti >= half_pi or tr >= half_pi:
-        write_diag(out, i, T(0.0))
-        return
+        return diag16(T(0.0))
     ci, cr = math.cos(ti), math.cos(tr)
     cp, sp = math.cos(pr), math.sin(pr)
-    nv, sub_r, sub_i = prm[0, j], prm[1, j], prm[2, j]
-    if iopt[0] == 0:
-        val = ct_value(ci, cr, cp, sp, prm, j, sub_r, sub_i, iopt[2] == 1)
-        scale = T(1.0 / (4.0 * math.pi)) if iopt[1] == 1 else T(1.0)
-        write_diag(out, i, val * (scale / (ci * cr)))
-        return
+    nv, sub_r, sub_i = p[0], p[1], p[2]
+    if o[0] == 0:
+        val = ct_value(ci, cr, cp, sp, p, sub_r, sub_i, o[2] == 1)
+        scale = T(1.0 / (4.0 * math.pi)) if o[1] == 1 else T(1.0)
+        return diag16(val * (scale / (ci * cr)))
     cii, cri = coating_cos(ci, nv), coating_cos(cr, nv)
-    val = ct_value(cii, cri, cp, sp, prm, j, sub_r / nv, sub_i / nv, iopt[2] == 1)
+    val = ct_value(cii, cri, cp, sp, p, sub_r / nv, sub_i / nv, o[2] == 1)
     if nv != T(1.0):
         ti_ = T(1.0) - fresnel_average(ci, nv, T(0.0), False)
         tr_ = T(1.0) - fresnel_average(cr, nv, T(0.0), False)
         val *= ti_ * tr_
-    if iopt[1] == 0:
+    if o[1] == 0:
         val *= T(1.0) / (ci * cr)
     else:
         val *= T(1.0 / (4.0 * math.pi)) / (nv * nv * cii * cri)
-    write_diag(out, i, val)
+    return diag16(val)
