@@ -8,7 +8,8 @@ import math
 
 from numba import njit
 
-from .common import cdiv, coating_cos, diag16, refraction_w, stroke_d
+from ..kernel_specs import ANISO_GAUSSIAN, GAUSSIAN
+from .common import SMITH, cdiv, coating_cos, diag16, refraction_w, smith_g, stroke_d
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
@@ -31,8 +32,11 @@ def fresnel_average(c, mr, mi, pec):
 
 
 @njit(cache=True, inline="always")
-def ct_value(ci, cr, cp, sp, p, mr, mi, blinn):
-    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``."""
+def ct_value(ci, cr, cp, sp, p, mr, mi, shadowing):
+    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``;
+    ``shadowing``: a code of :data:`models.kernel_specs.COOK_SHADOWING`.  Smith's ``G`` is that of
+    :func:`models.cook_torrance.smith_slopes`: the Gaussian of width ``m`` (equal ``m``
+    values), else the anisotropic Gaussian ``(m_par, m_perp)`` rotated by the strokes' azimuth."""
     T = type(ci)
     si = math.sqrt(T(1.0) - ci * ci)
     sr = math.sqrt(T(1.0) - cr * cr)
@@ -45,16 +49,19 @@ def ct_value(ci, cr, cp, sp, p, mr, mi, blinn):
     a = p[5]
     val = stroke_d(hx, hy, hz2, p[3], p[4], math.cos(a), math.sin(a)) * (q * q)
     val *= fresnel_average(T(0.5) * math.sqrt(g), mr, mi, mr == T(math.inf))
-    if blinn:
+    if shadowing == 1:
         t = (T(4.0) / g) * hz
         val *= min(T(1.0), t * min(ci, cr))
+    elif shadowing == 2:
+        kind = GAUSSIAN if p[3] == p[4] else ANISO_GAUSSIAN
+        val *= smith_g(SMITH, kind, (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], p[5])
     return val
 
 
 @njit(cache=True, inline="always")
 def cook(ti, tr, pr, p, o):
     """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
-    convention, ``o[2]``: Blinn's G."""
+    convention, ``o[2]``: the shadowing (:data:`models.kernel_specs.COOK_SHADOWING`)."""
     T = type(ti)
     half_pi = T(0.5 * math.pi)
     if ti >= half_pi or tr >= half_pi:
@@ -63,11 +70,11 @@ def cook(ti, tr, pr, p, o):
     cp, sp = math.cos(pr), math.sin(pr)
     nv, sub_r, sub_i = p[0], p[1], p[2]
     if o[0] == 0:
-        val = ct_value(ci, cr, cp, sp, p, sub_r, sub_i, o[2] == 1)
+        val = ct_value(ci, cr, cp, sp, p, sub_r, sub_i, o[2])
         scale = T(1.0 / (4.0 * math.pi)) if o[1] == 1 else T(1.0)
         return diag16(val * (scale / (ci * cr)))
     cii, cri = coating_cos(ci, nv), coating_cos(cr, nv)
-    val = ct_value(cii, cri, cp, sp, p, sub_r / nv, sub_i / nv, o[2] == 1)
+    val = ct_value(cii, cri, cp, sp, p, sub_r / nv, sub_i / nv, o[2])
     if nv != T(1.0):
         ti_ = T(1.0) - fresnel_average(ci, nv, T(0.0), False)
         tr_ = T(1.0) - fresnel_average(cr, nv, T(0.0), False)
