@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from ..kernel_specs import (
@@ -29,6 +30,29 @@ NO_SHADOWING, SMITH = SHADOWING_KINDS["none"], SHADOWING_KINDS["smith"]
 
 _SQRT6 = math.sqrt(6.0)
 _INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
+
+
+@njit(cache=True, inline="always")
+def polar(t):
+    """``(cos t, sin t)`` of a polar angle ``t`` in its precision, the sine as the numpy path
+    takes it, ``sqrt(1 - cos^2)``, both computed in float64: in float32 that formula loses the
+    sine near normal incidence (``cos`` rounds to 1 below 3.5e-4 rad: off by up to 2.4e-4);
+    from float64 the float32 sine is off by less than one float32 epsilon
+    (:data:`models.float32_domain.SINE`)."""
+    T = type(t)
+    c = math.cos(np.float64(t))
+    return T(c), T(math.sqrt(1.0 - c * c))
+
+
+@njit(cache=True, inline="always")
+def internal_sine(c_int, s_ext, n):
+    """Sine of the refracted angle in a coating ``n`` of cosine ``c_int``, external sine
+    ``s_ext``: float64 ``sqrt(1 - c_int^2)`` (the numpy path's); float32 ``s_ext / n`` (Snell;
+    the cosine near 1 has lost the sine, see :func:`polar`)."""
+    T = type(c_int)
+    if T(1e-300) > T(0.0):  # float64 (1e-300 is 0 in float32)
+        return math.sqrt(T(1.0) - c_int * c_int)
+    return s_ext / n
 
 
 @njit(cache=True)

@@ -9,7 +9,7 @@ import math
 from numba import njit
 
 from ..kernel_specs import ANISO_GAUSSIAN, GAUSSIAN
-from .common import SMITH, cdiv, coating_cos, diag16, refraction_w, smith_g, stroke_d
+from .common import SMITH, cdiv, coating_cos, diag16, internal_sine, polar, refraction_w, smith_g, stroke_d
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
@@ -32,14 +32,13 @@ def fresnel_average(c, mr, mi, pec):
 
 
 @njit(cache=True, inline="always")
-def ct_value(ci, cr, cp, sp, p, mr, mi, shadowing):
-    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``;
+def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
+    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
+    and sines ``si``, ``sr``;
     ``shadowing``: a code of :data:`models.kernel_specs.COOK_SHADOWING`.  Smith's ``G`` is that of
     :func:`models.cook_torrance.smith_slopes`: the Gaussian of width ``m`` (equal ``m``
     values), else the anisotropic Gaussian ``(m_par, m_perp)`` rotated by the strokes' azimuth."""
     T = type(ci)
-    si = math.sqrt(T(1.0) - ci * ci)
-    sr = math.sqrt(T(1.0) - cr * cr)
     hx = sr * cp - si
     hy = sr * sp
     hz = ci + cr
@@ -66,15 +65,17 @@ def cook(ti, tr, pr, p, o):
     half_pi = T(0.5 * math.pi)
     if ti >= half_pi or tr >= half_pi:
         return diag16(T(0.0))
-    ci, cr = math.cos(ti), math.cos(tr)
+    ci, si = polar(ti)
+    cr, sr = polar(tr)
     cp, sp = math.cos(pr), math.sin(pr)
     nv, sub_r, sub_i = p[0], p[1], p[2]
     if o[0] == 0:
-        val = ct_value(ci, cr, cp, sp, p, sub_r, sub_i, o[2])
+        val = ct_value(ci, si, cr, sr, cp, sp, p, sub_r, sub_i, o[2])
         scale = T(1.0 / (4.0 * math.pi)) if o[1] == 1 else T(1.0)
         return diag16(val * (scale / (ci * cr)))
     cii, cri = coating_cos(ci, nv), coating_cos(cr, nv)
-    val = ct_value(cii, cri, cp, sp, p, sub_r / nv, sub_i / nv, o[2])
+    sii, sri = internal_sine(cii, si, nv), internal_sine(cri, sr, nv)
+    val = ct_value(cii, sii, cri, sri, cp, sp, p, sub_r / nv, sub_i / nv, o[2])
     if nv != T(1.0):
         ti_ = T(1.0) - fresnel_average(ci, nv, T(0.0), False)
         tr_ = T(1.0) - fresnel_average(cr, nv, T(0.0), False)

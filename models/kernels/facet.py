@@ -9,7 +9,7 @@ import math
 
 from numba import njit
 
-from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, rs_k, smith_g
+from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, rs_k, smith_g
 
 #: parameter rows of the facet reflection kernel
 FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
@@ -21,9 +21,8 @@ def facet_jones(ti, tr, pr, p, o):
     Mueller matrix is the BRDF (:func:`models.facet.facet_jones`)."""
     T = type(ti)
     n, sub_r, sub_i = p[0], p[1], p[2]
-    ci_e, cr_e = math.cos(ti), math.cos(tr)
-    si_e = math.sqrt(T(1.0) - ci_e * ci_e)
-    sr_e = math.sqrt(T(1.0) - cr_e * cr_e)
+    ci_e, si_e = polar(ti)
+    cr_e, sr_e = polar(tr)
     if n == T(1.0):
         si, sr, ci, cr = si_e, sr_e, ci_e, cr_e
     else:

@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import coating_cos, mueller16
+from .common import coating_cos, mueller16, polar
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
 SINGLE_ROWS = ("coating", "g")
@@ -16,14 +16,15 @@ DIFFUSE_ROWS = ("coating", "scale")
 
 
 @njit(cache=True)
-def amplitudes(c, n):
-    """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`."""
+def amplitudes(c, s, n):
+    """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`
+    for the external cosine and sine ``c``, ``s`` (:func:`models.kernels.common.polar`)."""
     T = type(c)
     # a few ulps of pi/2 from grazing is grazing (as the numpy path); float32's pi/2 is 1.2e-7
     # wide and rounds above pi/2 (a negative cosine).  T(1e-300) is 0 in float32.
     if c < (T(1e-15) if T(1e-300) > T(0.0) else T(2.4e-7)):
-        c = T(0.0)
-    s_int = math.sqrt(T(1.0) - c * c) * (T(1.0) / n)
+        c, s = T(0.0), T(1.0)
+    s_int = s * (T(1.0) / n)
     c_int = coating_cos(c, n)
     root = T(2.0) * math.sqrt(c * c_int)
     # n = 1 at grazing: both denominators vanish with the numerator (no projected flux): 0;
@@ -52,8 +53,10 @@ def single(ti, tr, pr, p, o):
     """Single scattering under a smooth interface (seed 003 Eq. 20); ``o[0]``: polarized phase."""
     T = type(ti)
     n, g = p[0], p[1]
-    si, ci, asi, api = amplitudes(math.cos(ti), n)
-    sr, cr, asr, apr = amplitudes(math.cos(tr), n)
+    ci_e, si_e = polar(ti)
+    cr_e, sr_e = polar(tr)
+    si, ci, asi, api = amplitudes(ci_e, si_e, n)
+    sr, cr, asr, apr = amplitudes(cr_e, sr_e, n)
     cp, sp = math.cos(pr), math.sin(pr)
     cos_scat = si * sr * cp - ci * cr
     base = T(1.0) + g * g - T(2.0) * g * cos_scat
@@ -76,6 +79,8 @@ def single(ti, tr, pr, p, o):
 def diffuse(ti, tr, pr, p, o):
     """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``prm[1]``: its scale."""
     n = p[0]
-    _, _, asi, api = amplitudes(math.cos(ti), n)
-    _, _, asr, apr = amplitudes(math.cos(tr), n)
+    ci_e, si_e = polar(ti)
+    cr_e, sr_e = polar(tr)
+    _, _, asi, api = amplitudes(ci_e, si_e, n)
+    _, _, asr, apr = amplitudes(cr_e, sr_e, n)
     return depolarized16(asi, api, asr, apr, p[1])
