@@ -244,11 +244,10 @@ class _CookTorranceBase(Model):
         return stroke_d(*self._m_rows())
 
     def _cook_spec(self, variant, coating):
-        """The Cook-Torrance kernel; numpy for Smith shadowing (the kernel has Blinn's G or none)."""
-        if self.shadowing == "smith":
-            return None
+        """The Cook-Torrance kernel (every shadowing option: :data:`models.kernel_specs.COOK_SHADOWING`)."""
         rows = [coating, *kernel_specs.index_rows(self.substrate), *self._m_rows()]
-        return "cook", rows, (variant, int(self.convention == "corrected"), int(self.shadowing == "blinn"))
+        options = (variant, int(self.convention == "corrected"), kernel_specs.COOK_SHADOWING[self.shadowing])
+        return "cook", rows, options
 
     def _smith(self):
         return smith_slopes(self.slopes) if self.shadowing == "smith" else None

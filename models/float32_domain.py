@@ -30,6 +30,13 @@ sensitivity to it; ``u = EPS / 2`` is the unit roundoff, ``Delta`` the sine erro
   = sqrt(EPS / 2)`` = 2.4e-4 (:data:`SINE`), 2048 EPS, where a directly computed sine has a
   few EPS.  The s/p bases and the Jones elements are sums of terms linear in a sine, with
   coefficients up to the element's scale, and ``|J|^2`` doubles the error: ``4 Delta``.
+  The kernels now evaluate that formula in float64 and round it
+  (:func:`models.kernels.common.polar`), which keeps their sines within 1.125 EPS; the domain
+  still charges ``Delta``, an allowance that also covers what a bound from the accurate sines
+  would have to add and that is not derived here: the polar angles' own rounding (up to
+  ``(pi / 4) EPS`` per sine and cosine) moved into the slopes by ``1 / h_z``, which grows
+  towards grazing.  (Measured, ``tests/test_float32_domain.py``: a Cook-Torrance lobe of
+  ``m = 1e-3`` errs by 5.9e-4 near 79 deg, four times a bound that charged the sines 1.125 EPS.)
 * lobe width ``w`` (the narrowest of ``sigma``, ``alpha``, the stroke ``m``; Cook-Torrance's
   ``m``): ``L Delta / (EPS w)``.  The bisector's slope ``z = h_x / h_z`` has ``h_z >= 1`` near
   normal, so the sines' error moves it by ``<= Delta``; a slope density ``P(z / w)`` then moves
@@ -80,9 +87,8 @@ sensitivity to it; ``u = EPS / 2`` is the unit roundoff, ``Delta`` the sine erro
   Jones products have a factor 1.8e19 of room above it (e.g. a coating of index 1e16 makes the
   facet reflection ``~ (2 / n)^4 ~ 1e-64``, zero in float32).
 
-The sine terms are the kernels' own: with sines from ``sin(theta)`` (relative error ``~ EPS``)
-:data:`SINE` would be a few EPS instead of 2048 and the domain would reach lobes hundreds of
-times narrower (``tests/test_float32_domain.py`` checks the 2048 against float32 itself).
+The sine allowance is float32's own error of ``sqrt(1 - cos^2)`` (``tests/test_float32_domain.py``
+checks the 2048 against float32 itself, and the kernels' sines against 1.125 EPS).
 """
 
 from __future__ import annotations
@@ -114,7 +120,8 @@ HUGE = float(_F32.max)
 TOLERANCE = 1e-2
 #: the kernels' rounding and the polar angles' (in units of EPS)
 ARITHMETIC = 256.0
-#: absolute error of ``sqrt(1 - cos^2)`` near normal incidence in float32
+#: the sine error the domain charges: that of ``sqrt(1 - cos^2)`` near normal incidence in float32
+#: (the kernels' own sines are within 1.125 EPS; see the module docstring)
 SINE = math.sqrt(EPS / 2.0)
 _S = SINE / EPS
 

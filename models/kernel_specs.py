@@ -33,6 +33,8 @@ SLOPE_KINDS = {
 #: slope kinds whose Smith Lambda has a closed form in the kernels
 SMITH_KINDS = (GAUSSIAN, GGX, ANISO_GAUSSIAN, ANISO_GGX)
 SHADOWING_KINDS = {"none": 0, "smith": 1, "smith-correlated": 2}
+#: the Cook-Torrance kernel's shadowing codes (Smith's ``G`` of its Gaussian slopes)
+COOK_SHADOWING = {"none": 0, "blinn": 1, "smith": 2}
 
 
 def slope_rows(slopes):

@@ -65,6 +65,18 @@ def _configs():
                 )
             )
     out.append(S.MaxwellBeardBRDF(polarized=False, rho_d=0.1, rho_v=0.2, tau=0.1, omega=2.0))
+    # Smith's G in the Cook-Torrance kernel: Gaussian (equal m) and anisotropic Gaussian (strokes)
+    for slopes in (S.GaussianSlopes(0.3), S.StrokeSlopes(0.1, 0.4, 0.5), S.StrokeSlopes(1e-3, 1e-3, 0.0)):
+        for sub in (2.29 + 3.37j, math.inf):
+            for conv in ("paper", "corrected"):
+                out.append(
+                    S.CookTorranceBRDF(slopes=slopes, substrate=sub, convention=conv, shadowing="smith")
+                )
+                out.append(
+                    S.VarnishedCookTorranceBRDF(
+                        slopes=slopes, coating=1.5, substrate=sub, convention=conv, shadowing="smith"
+                    )
+                )
     return out
 
 

@@ -115,11 +115,12 @@ class Compiled:
         self.name = code
         self.code = drive.CODES[code]
         length = max((np.size(r) for r in rows), default=1)
-        prm = np.empty((len(rows), length))
+        prm = np.zeros((drive.PARAM_ROWS, length))  # padded: every kernel takes the same tuple
         for k, r in enumerate(rows):
             prm[k] = r
         self.prm = {"float64": prm}
-        self.iopt = np.asarray(options, dtype=np.int64)
+        self.iopt = np.zeros(drive.OPTIONS, dtype=np.int64)
+        self.iopt[: len(options)] = options
 
     def params(self, precision):
         """The parameter rows in ``precision``; float32 rows take the angle rows (rotations)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from ..kernel_specs import (
@@ -29,6 +30,29 @@ NO_SHADOWING, SMITH = SHADOWING_KINDS["none"], SHADOWING_KINDS["smith"]
 
 _SQRT6 = math.sqrt(6.0)
 _INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
+
+
+@njit(cache=True, inline="always")
+def polar(t):
+    """``(cos t, sin t)`` of a polar angle ``t`` in its precision, the sine as the numpy path
+    takes it, ``sqrt(1 - cos^2)``, both computed in float64: in float32 that formula loses the
+    sine near normal incidence (``cos`` rounds to 1 below 3.5e-4 rad: off by up to 2.4e-4);
+    from float64 the float32 sine is off by less than one float32 epsilon
+    (:data:`models.float32_domain.SINE`)."""
+    T = type(t)
+    c = math.cos(np.float64(t))
+    return T(c), T(math.sqrt(1.0 - c * c))
+
+
+@njit(cache=True, inline="always")
+def internal_sine(c_int, s_ext, n):
+    """Sine of the refracted angle in a coating ``n`` of cosine ``c_int``, external sine
+    ``s_ext``: float64 ``sqrt(1 - c_int^2)`` (the numpy path's); float32 ``s_ext / n`` (Snell;
+    the cosine near 1 has lost the sine, see :func:`polar`)."""
+    T = type(c_int)
+    if T(1e-300) > T(0.0):  # float64 (1e-300 is 0 in float32)
+        return math.sqrt(T(1.0) - c_int * c_int)
+    return s_ext / n
 
 
 @njit(cache=True)
@@ -213,9 +237,9 @@ def smith_g(shadowing, kind, di, dio, sx, sy, rot):
 
 
 @njit(cache=True, inline="always")
-def write_mueller(out, i, ssr, ssi, psr, psi, spr, spi, ppr, ppi):
-    """Mueller elements of a Jones matrix into ``out[:, i]`` (Bohren & Huffman, as
-    :func:`models.polarization.mueller16_from_jones`); only ``M00`` when ``out`` has one row."""
+def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
+    """The 16 Mueller elements (row-major) of a Jones matrix (Bohren & Huffman, as
+    :func:`models.polarization.mueller16_from_jones`)."""
     T = type(ssr)
     half = T(0.5)
     nss = ssr * ssr + ssi * ssi
@@ -224,38 +248,33 @@ def write_mueller(out, i, ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     nsp = spr * spr + spi * spi
     a = nss + npp
     c = nps + nsp
-    out[0, i] = (a + c) * half
-    if out.shape[0] == 1:
-        return
     b = nss - npp
     d = nsp - nps
-    out[1, i] = (b + d) * half
-    out[4, i] = (b - d) * half
-    out[5, i] = (a - c) * half
     x1r, x1i = ssr * psr + ssi * psi, ssi * psr - ssr * psi
     x2r, x2i = ppr * spr + ppi * spi, ppi * spr - ppr * spi
     x3r, x3i = ssr * spr + ssi * spi, ssi * spr - ssr * spi
     x4r, x4i = ppr * psr + ppi * psi, ppi * psr - ppr * psi
     x5r, x5i = ppr * ssr + ppi * ssi, ppi * ssr - ppr * ssi
     x6r, x6i = psr * spr + psi * spi, psi * spr - psr * spi
-    out[2, i] = x1r + x2r
-    out[3, i] = x1i - x2i
-    out[6, i] = x1r - x2r
-    out[7, i] = x1i + x2i
-    out[8, i] = x3r + x4r
-    out[9, i] = x3r - x4r
-    out[10, i] = x5r + x6r
-    out[11, i] = -(x5i + x6i)
-    out[12, i] = x4i - x3i
-    out[13, i] = -(x3i + x4i)
-    out[14, i] = x5i - x6i
-    out[15, i] = x5r - x6r
+    return (
+        (a + c) * half, (b + d) * half, x1r + x2r, x1i - x2i,
+        (b - d) * half, (a - c) * half, x1r - x2r, x1i + x2i,
+        x3r + x4r, x3r - x4r, x5r + x6r, -(x5i + x6i),
+        x4i - x3i, -(x3i + x4i), x5i - x6i, x5r - x6r,
+    )  # fmt: skip
 
 
 @njit(cache=True, inline="always")
-def write_diag(out, i, m00):
-    """A depolarizer ``diag(m00, 0, 0, 0)`` into ``out[:, i]`` (the scalar models)."""
-    T = type(m00)
-    out[0, i] = m00
-    for e in range(1, out.shape[0]):
-        out[e, i] = T(0.0)
+def diag16(m00):
+    """A depolarizer ``diag(m00, 0, 0, 0)`` (the scalar models)."""
+    z = type(m00)(0.0)
+    return (m00, z, z, z, z, z, z, z, z, z, z, z, z, z, z, z)
+
+
+@njit(cache=True, inline="always")
+def scaled16(m, f):
+    """The 16 elements ``m`` times ``f``."""
+    return (
+        m[0] * f, m[1] * f, m[2] * f, m[3] * f, m[4] * f, m[5] * f, m[6] * f, m[7] * f,
+        m[8] * f, m[9] * f, m[10] * f, m[11] * f, m[12] * f, m[13] * f, m[14] * f, m[15] * f,
+    )  # fmt: skip

@@ -8,7 +8,8 @@ import math
 
 from numba import njit
 
-from .common import cdiv, coating_cos, refraction_w, stroke_d, write_diag
+from ..kernel_specs import ANISO_GAUSSIAN, GAUSSIAN
+from .common import SMITH, cdiv, coating_cos, diag16, internal_sine, polar, refraction_w, smith_g, stroke_d
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
@@ -31,51 +32,56 @@ def fresnel_average(c, mr, mi, pec):
 
 
 @njit(cache=True, inline="always")
-def ct_value(ci, cr, cp, sp, prm, j, mr, mi, blinn):
-    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``."""
+def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
+    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
+    and sines ``si``, ``sr``;
+    ``shadowing``: a code of :data:`models.kernel_specs.COOK_SHADOWING`.  Smith's ``G`` is that of
+    :func:`models.cook_torrance.smith_slopes`: the Gaussian of width ``m`` (equal ``m``
+    values), else the anisotropic Gaussian ``(m_par, m_perp)`` rotated by the strokes' azimuth."""
     T = type(ci)
-    si = math.sqrt(T(1.0) - ci * ci)
-    sr = math.sqrt(T(1.0) - cr * cr)
     hx = sr * cp - si
     hy = sr * sp
     hz = ci + cr
     hz2 = hz * hz
     g = hx * hx + hy * hy + hz2
     q = g / hz2
-    a = prm[5, j]
-    val = stroke_d(hx, hy, hz2, prm[3, j], prm[4, j], math.cos(a), math.sin(a)) * (q * q)
+    a = p[5]
+    val = stroke_d(hx, hy, hz2, p[3], p[4], math.cos(a), math.sin(a)) * (q * q)
     val *= fresnel_average(T(0.5) * math.sqrt(g), mr, mi, mr == T(math.inf))
-    if blinn:
+    if shadowing == 1:
         t = (T(4.0) / g) * hz
         val *= min(T(1.0), t * min(ci, cr))
+    elif shadowing == 2:
+        kind = GAUSSIAN if p[3] == p[4] else ANISO_GAUSSIAN
+        val *= smith_g(SMITH, kind, (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], p[5])
     return val
 
 
 @njit(cache=True, inline="always")
-def cook(ti, tr, pr, prm, j, iopt, out, i):
-    """Cook-Torrance (``iopt[0] = 0``) or its varnished form (1); ``iopt[1]``: corrected
-    convention, ``iopt[2]``: Blinn's G."""
+def cook(ti, tr, pr, p, o):
+    """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
+    convention, ``o[2]``: the shadowing (:data:`models.kernel_specs.COOK_SHADOWING`)."""
     T = type(ti)
     half_pi = T(0.5 * math.pi)
     if ti >= half_pi or tr >= half_pi:
-        write_diag(out, i, T(0.0))
-        return
-    ci, cr = math.cos(ti), math.cos(tr)
+        return diag16(T(0.0))
+    ci, si = polar(ti)
+    cr, sr = polar(tr)
     cp, sp = math.cos(pr), math.sin(pr)
-    nv, sub_r, sub_i = prm[0, j], prm[1, j], prm[2, j]
-    if iopt[0] == 0:
-        val = ct_value(ci, cr, cp, sp, prm, j, sub_r, sub_i, iopt[2] == 1)
-        scale = T(1.0 / (4.0 * math.pi)) if iopt[1] == 1 else T(1.0)
-        write_diag(out, i, val * (scale / (ci * cr)))
-        return
+    nv, sub_r, sub_i = p[0], p[1], p[2]
+    if o[0] == 0:
+        val = ct_value(ci, si, cr, sr, cp, sp, p, sub_r, sub_i, o[2])
+        scale = T(1.0 / (4.0 * math.pi)) if o[1] == 1 else T(1.0)
+        return diag16(val * (scale / (ci * cr)))
     cii, cri = coating_cos(ci, nv), coating_cos(cr, nv)
-    val = ct_value(cii, cri, cp, sp, prm, j, sub_r / nv, sub_i / nv, iopt[2] == 1)
+    sii, sri = internal_sine(cii, si, nv), internal_sine(cri, sr, nv)
+    val = ct_value(cii, sii, cri, sri, cp, sp, p, sub_r / nv, sub_i / nv, o[2])
     if nv != T(1.0):
         ti_ = T(1.0) - fresnel_average(ci, nv, T(0.0), False)
         tr_ = T(1.0) - fresnel_average(cr, nv, T(0.0), False)
         val *= ti_ * tr_
-    if iopt[1] == 0:
+    if o[1] == 0:
         val *= T(1.0) / (ci * cr)
     else:
         val *= T(1.0 / (4.0 * math.pi)) / (nv * nv * cii * cri)
-    write_diag(out, i, val)
+    return diag16(val)

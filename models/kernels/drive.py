@@ -33,39 +33,76 @@ ROWS = {
 }
 
 
+#: rows of ``prm`` and entries of ``iopt`` every kernel is given (``Compiled`` pads to them)
+PARAM_ROWS = max(len(r) for r in ROWS.values())
+OPTIONS = 3
+
+
 @njit(cache=True, inline="always")
-def element(code, a, b, c, prm, j, iopt, out, i):
-    """One geometry of model ``code`` into ``out[:, i]``."""
+def element(code, a, b, c, p, o):
+    """The 16 Mueller elements of one geometry of model ``code``; ``p``, ``o``: its parameters
+    and options as tuples (no array enters the inlined kernels: numba would count references
+    to it with atomic operations in every geometry)."""
     if code == FACET:
-        facet(a, b, c, prm, j, iopt, out, i)
-    elif code == BTDF:
-        btdf(a, b, c, prm, j, iopt, out, i)
-    elif code == SINGLE:
-        single(a, b, c, prm, j, iopt, out, i)
-    elif code == DIFFUSE:
-        diffuse(a, b, c, prm, j, iopt, out, i)
-    elif code == COOK:
-        cook(a, b, c, prm, j, iopt, out, i)
-    else:
-        maxwell(a, b, c, prm, j, iopt, out, i)
+        return facet(a, b, c, p, o)
+    if code == BTDF:
+        return btdf(a, b, c, p, o)
+    if code == SINGLE:
+        return single(a, b, c, p, o)
+    if code == DIFFUSE:
+        return diffuse(a, b, c, p, o)
+    if code == COOK:
+        return cook(a, b, c, p, o)
+    return maxwell(a, b, c, p, o)
+
+
+@njit(cache=True)
+def params(prm, j):
+    """Column ``j`` of the parameter rows as a tuple."""
+    return (prm[0, j], prm[1, j], prm[2, j], prm[3, j], prm[4, j], prm[5, j],
+            prm[6, j], prm[7, j], prm[8, j], prm[9, j], prm[10, j])  # fmt: skip
+
+
+@njit(cache=True)
+def store(out, i, m):
+    """The elements ``m`` into ``out[:, i]`` (only ``M00`` when ``out`` has one row)."""
+    out[0, i] = m[0]
+    if out.shape[0] == 1:
+        return
+    out[1, i], out[2, i], out[3, i], out[4, i] = m[1], m[2], m[3], m[4]
+    out[5, i], out[6, i], out[7, i], out[8, i] = m[5], m[6], m[7], m[8]
+    out[9, i], out[10, i], out[11, i], out[12, i] = m[9], m[10], m[11], m[12]
+    out[13, i], out[14, i], out[15, i] = m[13], m[14], m[15]
+
+
+#: geometries per task of :func:`run_parallel` (each runs :func:`run_range`'s serial loop)
+BLOCK = 1024
+
+
+@njit(cache=True)
+def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
+    """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``, serially."""
+    a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
+    o = (iopt[0], iopt[1], iopt[2])
+    for i in range(lo, hi):
+        store(out, start + i, element(code, ti[i * a], tr[i * b], pr[i * c], params(prm, i * p), o))
 
 
 @njit(cache=True)
 def run(code, ti, tr, pr, prm, iopt, out, start):
     """Serial loop over the geometries ``0 .. len - 1`` of the inputs, into ``out[:, start + i]``."""
     n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-    a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
-    for i in range(n):
-        element(code, ti[i * a], tr[i * b], pr[i * c], prm, i * p, iopt, out, start + i)
+    run_range(code, ti, tr, pr, prm, iopt, out, start, 0, n)
 
 
 @njit(cache=True, parallel=True)
 def run_parallel(code, ti, tr, pr, prm, iopt, out, start):
-    """:func:`run` with the geometries spread over the cores (``prange``)."""
+    """:func:`run` with blocks of :data:`BLOCK` geometries spread over the cores (``prange``;
+    each block the serial loop, which compiles to tighter code than a ``prange`` body)."""
     n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-    a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
-    for i in prange(n):
-        element(code, ti[i * a], tr[i * b], pr[i * c], prm, i * p, iopt, out, start + i)
+    for blk in prange((n + BLOCK - 1) // BLOCK):
+        lo = blk * BLOCK
+        run_range(code, ti, tr, pr, prm, iopt, out, start, lo, min(lo + BLOCK, n))
 
 
 @njit(cache=True)
@@ -81,7 +118,7 @@ def run_checked(code, ti, tr, pr, prm, iopt, out):
 @njit(cache=True)
 def run_one(code, ti, tr, pr, prm, iopt, out):
     """One geometry given as scalars (the small-call path)."""
-    element(code, ti, tr, pr, prm, 0, iopt, out, 0)
+    store(out, 0, element(code, ti, tr, pr, params(prm, 0), (iopt[0], iopt[1], iopt[2])))
 
 
 @njit(cache=True)

@@ -9,21 +9,20 @@ import math
 
 from numba import njit
 
-from .common import NO_SHADOWING, coating_cos, coating_t, p3, rs_k, smith_g, write_mueller
+from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, rs_k, smith_g
 
 #: parameter rows of the facet reflection kernel
 FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
 
 
 @njit(cache=True, inline="always")
-def facet_jones(ti, tr, pr, prm, j, iopt):
+def facet_jones(ti, tr, pr, p, o):
     """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
     Mueller matrix is the BRDF (:func:`models.facet.facet_jones`)."""
     T = type(ti)
-    n, sub_r, sub_i = prm[0, j], prm[1, j], prm[2, j]
-    ci_e, cr_e = math.cos(ti), math.cos(tr)
-    si_e = math.sqrt(T(1.0) - ci_e * ci_e)
-    sr_e = math.sqrt(T(1.0) - cr_e * cr_e)
+    n, sub_r, sub_i = p[0], p[1], p[2]
+    ci_e, si_e = polar(ti)
+    cr_e, sr_e = polar(tr)
     if n == T(1.0):
         si, sr, ci, cr = si_e, sr_e, ci_e, cr_e
     else:
@@ -36,16 +35,14 @@ def facet_jones(ti, tr, pr, prm, j, iopt):
     hz = cr + ci
     g = hx * hx + hy * hy + hz * hz
     inv_hz = T(1.0) / hz
-    dens = p3(iopt[0], hx * inv_hz, hy * inv_hz, prm[3, j], prm[4, j], prm[5, j], prm[6, j])
+    dens = p3(o[0], hx * inv_hz, hy * inv_hz, p[3], p[4], p[5], p[6])
     q = g * inv_hz * inv_hz
     S = dens * q * q / (T(4.0) * ci_e * cr_e)
     half_pi = T(0.5 * math.pi)
     if ti >= half_pi or tr >= half_pi:
         S = T(0.0)
-    if iopt[1] != NO_SHADOWING:
-        S = S * smith_g(
-            iopt[1], iopt[0], (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), prm[3, j], prm[4, j], prm[5, j]
-        )
+    if o[1] != NO_SHADOWING:
+        S = S * smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], p[5])
     c = T(0.5) * math.sqrt(g)
     rsr, rsi, kr, ki = rs_k(c, sub_r / n, sub_i / n, sub_r == T(math.inf))
     inv_g = T(1.0) / g
@@ -76,10 +73,10 @@ def facet_jones(ti, tr, pr, prm, j, iopt):
 
 
 @njit(cache=True, inline="always")
-def facet(ti, tr, pr, prm, j, iopt, out, i):
+def facet(ti, tr, pr, p, o):
     """:class:`models.FacetBRDF` and :class:`models.SubsurfaceFacetBRDF` at one geometry."""
-    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, prm, j, iopt)
-    write_mueller(out, i, a, b, c, d, e, f, g, h)
+    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, p, o)
+    return mueller16(a, b, c, d, e, f, g, h)
 
 
 #: parameter rows of the facet transmission kernel
@@ -131,24 +128,26 @@ def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     cg = dot3(k_in, k_out)
     one_cg = T(1.0) + cg
     inv1 = T(1.0) / one_cg if one_cg > T(1e-300) else T(0.0)
-    res = [T(0.0)] * 4
-    for a in range(2):
-        ea = e_out[a]
-        eav = dot3(ea, v)
-        eaa = dot3(ea, a_out)
-        for b in range(2):
-            eb = e_in[b]
-            rot = cg * dot3(ea, eb) + dot3(ea, cross3(v, eb)) + eav * dot3(v, eb) * inv1
-            res[2 * a + b] = ts * rot + delta * eaa * dot3(a_in, eb)
+    ss = _btdf_element(e_out[0], e_in[0], v, a_in, a_out, cg, inv1, ts, delta)
+    ps = _btdf_element(e_out[0], e_in[1], v, a_in, a_out, cg, inv1, ts, delta)
+    sp = _btdf_element(e_out[1], e_in[0], v, a_in, a_out, cg, inv1, ts, delta)
+    pp = _btdf_element(e_out[1], e_in[1], v, a_in, a_out, cg, inv1, ts, delta)
     c_out = min(max(-dot3(k_out, m), T(0.0)), T(1.0))
-    return res[0], res[1], res[2], res[3], c, c_out
+    return ss, ps, sp, pp, c, c_out
 
 
 @njit(cache=True, inline="always")
-def btdf(ti, tt, pt, prm, j, iopt, out, i):
+def _btdf_element(ea, eb, v, a_in, a_out, cg, inv1, ts, delta):
+    """One element of :func:`btdf_jones`: out-basis vector ``ea``, in-basis vector ``eb``."""
+    rot = cg * dot3(ea, eb) + dot3(ea, cross3(v, eb)) + dot3(ea, v) * dot3(v, eb) * inv1
+    return ts * rot + delta * dot3(ea, a_out) * dot3(a_in, eb)
+
+
+@njit(cache=True, inline="always")
+def btdf(ti, tt, pt, p, o):
     """:class:`models.FacetBTDF` (``convention="paper"``) at one geometry."""
     T = type(ti)
-    n = prm[0, j]
+    n = p[0]
     si, ci = math.sin(ti), math.cos(ti)
     st, ct = math.sin(tt), math.cos(tt)
     cp, sp = math.cos(pt), math.sin(pt)
@@ -160,8 +159,8 @@ def btdf(ti, tt, pt, prm, j, iopt, out, i):
     mz = h[2] / D
     half_pi = T(0.5 * math.pi)
     if not (mz > T(0.0) and n * dot3(k_in, k_out) - T(1.0) > T(0.0) and ti < half_pi and tt < half_pi):
-        write_mueller(out, i, T(0.0), T(0.0), T(0.0), T(0.0), T(0.0), T(0.0), T(0.0), T(0.0))
-        return
+        z = T(0.0)
+        return mueller16(z, z, z, z, z, z, z, z)
     m = (h[0] / D, h[1] / D, mz)
     z = (T(0.0), T(0.0), T(0.0))
     s_in = (T(0.0), T(1.0), T(0.0))
@@ -169,15 +168,13 @@ def btdf(ti, tt, pt, prm, j, iopt, out, i):
     e_in = (s_in, cross3(k_in, s_in))
     e_out = (s_out, cross3(k_out, s_out))
     ss, ps, sp_, pp, c_in, c_out = btdf_jones(k_in, k_out, m, n, e_in, e_out)
-    dens = p3(iopt[0], h[0] / h[2], h[1] / h[2], prm[1, j], prm[2, j], prm[3, j], prm[4, j])
+    dens = p3(o[0], h[0] / h[2], h[1] / h[2], p[1], p[2], p[3], p[4])
     mz2 = mz * mz
     S = dens * n * c_out * (T(1.0) / (ci * ct)) / (mz2 * mz2) * (n * n * c_out / D2)
-    if iopt[1] != NO_SHADOWING:
-        g = smith_g(
-            iopt[1], iopt[0], (ci, si, -T(1.0), T(0.0)), (-ct, st, cp, sp), prm[1, j], prm[2, j], prm[3, j]
-        )
+    if o[1] != NO_SHADOWING:
+        g = smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (-ct, st, cp, sp), p[1], p[2], p[3])
         # back-facing (chi+) tests of Walter et al. Eq. 21-23: both local cosines positive here
         S = S * (g if (c_in * ci > T(0.0) and c_out * ct > T(0.0)) else T(0.0))
     root = math.sqrt(S)
     zr = z[0]
-    write_mueller(out, i, ss * root, zr, ps * root, zr, sp_ * root, zr, pp * root, zr)
+    return mueller16(ss * root, zr, ps * root, zr, sp_ * root, zr, pp * root, zr)

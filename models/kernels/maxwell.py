@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import write_diag, write_mueller
+from .common import diag16, mueller16, scaled16
 from .facet import FACET_ROWS, facet_jones
 
 #: parameter rows: the facet kernel's, then rho_d, rho_v, tau, omega
@@ -35,22 +35,19 @@ def shadow(ti, tr, pr, tau, omega):
 
 
 @njit(cache=True, inline="always")
-def maxwell(ti, tr, pr, prm, j, iopt, out, i):
-    """Maxwell-Beard at one geometry; ``iopt[2]``: the facet Mueller matrix on the specular term."""
+def maxwell(ti, tr, pr, p, o):
+    """Maxwell-Beard at one geometry; ``o[2]``: the facet Mueller matrix on the specular term."""
     T = type(ti)
-    so = shadow(ti, tr, pr, prm[9, j], prm[10, j])
-    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, prm, j, iopt)
-    if iopt[2] == 1:
-        write_mueller(out, i, a, b, c, d, e, f, g, h)
-        for k in range(out.shape[0]):
-            out[k, i] *= so
+    so = shadow(ti, tr, pr, p[9], p[10])
+    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, p, o)
+    if o[2] == 1:
+        m = scaled16(mueller16(a, b, c, d, e, f, g, h), so)
     else:
-        write_diag(
-            out, i, T(0.5) * ((a * a + b * b) + (c * c + d * d) + (e * e + f * f) + (g * g + h * h)) * so
-        )
+        m = diag16(T(0.5) * ((a * a + b * b) + (c * c + d * d) + (e * e + f * f) + (g * g + h * h)) * so)
     ci, cr = math.cos(ti), math.cos(tr)
     den = ci + cr
-    vol = T(2.0) * prm[8, j] / (den if den > T(0.0) else T(1.0))
+    vol = T(2.0) * p[8] / (den if den > T(0.0) else T(1.0))
     half_pi = T(0.5 * math.pi)
-    if not (ti >= half_pi or tr >= half_pi):
-        out[0, i] += prm[7, j] + vol
+    if ti >= half_pi or tr >= half_pi:
+        return m
+    return (m[0] + (p[7] + vol),) + m[1:]

@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from .common import coating_cos, write_mueller
+from .common import coating_cos, mueller16, polar
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
 SINGLE_ROWS = ("coating", "g")
@@ -16,14 +16,15 @@ DIFFUSE_ROWS = ("coating", "scale")
 
 
 @njit(cache=True)
-def amplitudes(c, n):
-    """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`."""
+def amplitudes(c, s, n):
+    """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`
+    for the external cosine and sine ``c``, ``s`` (:func:`models.kernels.common.polar`)."""
     T = type(c)
     # a few ulps of pi/2 from grazing is grazing (as the numpy path); float32's pi/2 is 1.2e-7
     # wide and rounds above pi/2 (a negative cosine).  T(1e-300) is 0 in float32.
     if c < (T(1e-15) if T(1e-300) > T(0.0) else T(2.4e-7)):
-        c = T(0.0)
-    s_int = math.sqrt(T(1.0) - c * c) * (T(1.0) / n)
+        c, s = T(0.0), T(1.0)
+    s_int = s * (T(1.0) / n)
     c_int = coating_cos(c, n)
     root = T(2.0) * math.sqrt(c * c_int)
     # n = 1 at grazing: both denominators vanish with the numerator (no projected flux): 0;
@@ -35,31 +36,27 @@ def amplitudes(c, n):
 
 
 @njit(cache=True, inline="always")
-def write_depolarized(out, i, asi, api, asr, apr, scale):
-    """:func:`models.smooth_interface.depolarized_between` into ``out[:, i]``."""
+def depolarized16(asi, api, asr, apr, scale):
+    """:func:`models.smooth_interface.depolarized_between`'s 16 elements."""
     T = type(asi)
     half = T(0.5)
     a, b = asr * asr, apr * apr
     c, d = asi * asi, api * api
     s_out, d_out = half * (a + b) * scale, half * (a - b) * scale
     s_in, d_in = half * (c + d), half * (c - d)
-    out[0, i] = s_out * s_in
-    if out.shape[0] == 1:
-        return
-    for e in range(2, 16):
-        out[e, i] = T(0.0)
-    out[1, i] = s_out * d_in
-    out[4, i] = d_out * s_in
-    out[5, i] = d_out * d_in
+    z = T(0.0)
+    return (s_out * s_in, s_out * d_in, z, z, d_out * s_in, d_out * d_in, z, z, z, z, z, z, z, z, z, z)
 
 
 @njit(cache=True, inline="always")
-def single(ti, tr, pr, prm, j, iopt, out, i):
-    """Single scattering under a smooth interface (seed 003 Eq. 20); ``iopt[0]``: polarized phase."""
+def single(ti, tr, pr, p, o):
+    """Single scattering under a smooth interface (seed 003 Eq. 20); ``o[0]``: polarized phase."""
     T = type(ti)
-    n, g = prm[0, j], prm[1, j]
-    si, ci, asi, api = amplitudes(math.cos(ti), n)
-    sr, cr, asr, apr = amplitudes(math.cos(tr), n)
+    n, g = p[0], p[1]
+    ci_e, si_e = polar(ti)
+    cr_e, sr_e = polar(tr)
+    si, ci, asi, api = amplitudes(ci_e, si_e, n)
+    sr, cr, asr, apr = amplitudes(cr_e, sr_e, n)
     cp, sp = math.cos(pr), math.sin(pr)
     cos_scat = si * sr * cp - ci * cr
     base = T(1.0) + g * g - T(2.0) * g * cos_scat
@@ -67,22 +64,23 @@ def single(ti, tr, pr, prm, j, iopt, out, i):
     # both internal cosines zero (grazing under n = 1): no projected flux and zero amplitudes;
     # dens / tiny would overflow float32 and give inf * 0
     K = dens / (ci + cr) if ci + cr > T(0.0) else T(0.0)
-    if iopt[0] == 0:
-        write_depolarized(out, i, asi, api, asr, apr, K)
-        return
+    if o[0] == 0:
+        return depolarized16(asi, api, asr, apr, K)
     root = math.sqrt(T(2.0) * K / (T(1.0) + cos_scat * cos_scat))
     ss = asr * asi * root * cp
     ps = -(asr * api * root) * sp * ci
     sp_ = -(apr * asi * root) * sp * cr
     pp = apr * api * root * (si * sr - ci * cr * cp)
     z = T(0.0)
-    write_mueller(out, i, ss, z, ps, z, sp_, z, pp, z)
+    return mueller16(ss, z, ps, z, sp_, z, pp, z)
 
 
 @njit(cache=True, inline="always")
-def diffuse(ti, tr, pr, prm, j, iopt, out, i):
+def diffuse(ti, tr, pr, p, o):
     """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``prm[1]``: its scale."""
-    n = prm[0, j]
-    _, _, asi, api = amplitudes(math.cos(ti), n)
-    _, _, asr, apr = amplitudes(math.cos(tr), n)
-    write_depolarized(out, i, asi, api, asr, apr, prm[1, j])
+    n = p[0]
+    ci_e, si_e = polar(ti)
+    cr_e, sr_e = polar(tr)
+    _, _, asi, api = amplitudes(ci_e, si_e, n)
+    _, _, asr, apr = amplitudes(cr_e, sr_e, n)
+    return depolarized16(asi, api, asr, apr, p[1])
