@@ -45,8 +45,9 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     hz2 = hz * hz
     g = hx * hx + hy * hy + hz2
     q = g / hz2
-    a = p[5]
-    val = stroke_d(hx, hy, hz2, p[3], p[4], math.cos(a), math.sin(a)) * (q * q)
+    # the strokes' azimuth matters only for unequal m (stroke_d); two trig calls saved otherwise
+    ca, sa = (T(1.0), T(0.0)) if p[3] == p[4] else (math.cos(p[5]), math.sin(p[5]))
+    val = stroke_d(hx, hy, hz2, p[3], p[4], ca, sa) * (q * q)
     val *= fresnel_average(T(0.5) * math.sqrt(g), mr, mi, mr == T(math.inf))
     if shadowing == 1:
         t = (T(4.0) / g) * hz
