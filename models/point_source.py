@@ -46,7 +46,9 @@ follow the integrand's features, which are known:
   polarization elements have a direction-dependent limit there when ``H`` lies on the disc.
 
 The disc is written in polar coordinates ``(t, chi)`` about ``H`` (when on the disc) or its
-centre, ``rho = t rho_max(chi)``, which makes the basis smooth; it is cut at ``P*`` into at most
+centre, ``rho = t rho_max(chi)``, which makes the basis smooth (about ``H`` the radial variable
+is the square root of the ray's flux share within ``rho``, so that a source near the plane,
+whose flux falls within a few ``d`` of ``H``, is no harder than a far one); it is cut at ``P*`` into at most
 four cells (``t`` below and above ``t*``, ``chi`` on either side of ``chi*``), each graded
 exponentially towards ``P*`` over the lobe's width on the disc (``width * d``), and integrated
 by adaptive cubature (:mod:`models.cubature`: Genz-Malik rules whose embedded difference, and
