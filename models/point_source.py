@@ -46,7 +46,9 @@ follow the integrand's features, which are known:
   polarization elements have a direction-dependent limit there when ``H`` lies on the disc.
 
 The disc is written in polar coordinates ``(t, chi)`` about ``H`` (when on the disc) or its
-centre, ``rho = t rho_max(chi)``, which makes the basis smooth; it is cut at ``P*`` into at most
+centre, ``rho = t rho_max(chi)``, which makes the basis smooth (about ``H`` the radial variable
+is the square root of the ray's flux share within ``rho``, so that a source near the plane,
+whose flux falls within a few ``d`` of ``H``, is no harder than a far one); it is cut at ``P*`` into at most
 four cells (``t`` below and above ``t*``, ``chi`` on either side of ``chi*``), each graded
 exponentially towards ``P*`` over the lobe's width on the disc (``width * d``), and integrated
 by adaptive cubature (:mod:`models.cubature`: Genz-Malik rules whose embedded difference, and
@@ -619,20 +621,25 @@ class _Disc:
     """The disc as the ``"auto"`` quadrature sees it, per geometry (module docstring, Accuracy).
 
     Lengths on the disc are in units of its radius ``R``; the source's height ``d`` enters
-    through ``k = R / d``.  Polar coordinates ``(t, chi)`` about ``O``, the foot ``H`` of the
-    source when it lies on the disc, else the centre: a point is ``O + t rho(chi) (cos chi,
-    sin chi)``, ``rho`` the distance from ``O`` to the rim.  ``width``: the inner model's lobe
-    width at the central incidence where its lobe is specular (centred at ``(theta_i, 0)``,
-    so that its peak or cusp sits at ``P*``), nan otherwise; ``spread``: the incidence spread.
+    through ``k = R / d``.  Polar coordinates about ``O``, the foot ``H`` of the source when it
+    lies on the disc, else the centre: a point is ``O + t rho(chi) (cos chi, sin chi)``, ``rho``
+    the distance from ``O`` to the rim.  The quadrature's radial variable ``v`` is ``t`` about
+    the centre; about ``H`` it absorbs the irradiance: ``v^2`` is the share of the ray's flux
+    within ``r = t rho`` (``cos^3 psi r dr`` with ``tan psi = k r``), so that a source near the
+    plane, whose flux falls within a few ``d`` of ``H``, is no harder than a far one, while
+    ``v`` stays linear in ``r`` at ``H``.  ``width``: the inner model's lobe width at the
+    central incidence where its lobe is specular (centred at ``(theta_i, 0)``, so that its peak
+    or cusp sits at ``P*``), nan otherwise; ``spread``: the incidence spread.
     """
 
     def __init__(self, ps, ti, tr, pr):
         self.ps, self.tr, self.pr = ps, tr, pr
-        self.k = ps.sample_radius / ps.distance
+        self.k = min(ps.sample_radius / ps.distance, 1e300)
+        self.h1 = math.hypot(1.0, self.k)
         self.tan_c = np.tan(ti)  # H to C, in units of d
-        with np.errstate(over="ignore"):  # a disc tiny against d: H is off it (xc = inf), O the centre
-            xc = self.tan_c / self.k  # H to C, in units of R
-        self.ox = np.where(xc < 1.0, -xc, 0.0)  # O from C
+        xc = _over(self.tan_c, self.k)  # H to C, in units of R
+        self.on_h = xc < 1.0
+        self.ox = np.where(self.on_h, -xc, 0.0)  # O from C
         self.width = np.full(ti.size, np.nan)
         self.spread = np.zeros(ti.size)
         uniq, inv = np.unique(ti, return_inverse=True)
@@ -647,77 +654,117 @@ class _Disc:
         """Distance from ``O`` (at ``ox``) to the rim along ``(c, s)``."""
         return np.sqrt(np.maximum(1.0 - (ox * s) ** 2, 0.0)) - ox * c
 
-    def values(self, rows, t, chi, w):
-        """``(M, J)`` at ``(t, chi)`` with quadrature weights ``w``: the 16 Mueller elements
-        ``(16, m, P)`` and the irradiance weight ``J = rho^2 t cos^3 psi w`` ``(m, P)``."""
+    def values(self, rows, v, chi, w):
+        """``(M, J)`` at ``(v, chi)`` with quadrature weights ``w``: the 16 Mueller elements
+        ``(16, m, P)`` and the irradiance weight ``J`` ``(m, P)`` (per row up to a constant:
+        ``rho^2 t cos^3 psi / cos^3 psi_c w`` about the centre, ``2 v rho^2 / (h (h + 1)) w``
+        about ``H``, ``h = hypot(1, k rho)``, scaled by the unit disc's)."""
+        on_h = self.on_h[rows][:, None]
         ox = self.ox[rows][:, None]
         c, s = np.cos(chi), np.sin(chi)
         rho = self.rho(ox, c, s)
+        h = np.hypot(1.0, self.k * rho)
+        t = np.where(on_h, _t_of_v(v, h, self.k * rho), v)
         r = rho * t
-        x = self.tan_c[rows][:, None] + self.k * (ox + r * c)  # from H, units of d
+        tan_c = self.tan_c[rows][:, None]
+        x = tan_c + self.k * (ox + r * c)  # from H, units of d
         y = self.k * r * s
-        tan_psi = np.hypot(x, y)  # hypot: a disc huge against d does not overflow x^2 (R up to 1e300)
-        cos_psi = 1.0 / np.hypot(1.0, tan_psi)
-        J = w * rho * rho * t * (cos_psi * cos_psi * cos_psi)
+        tan_psi = np.hypot(x, y)
+        cos_ratio = np.hypot(1.0, tan_c) / np.hypot(1.0, tan_psi)  # cos psi / cos psi_c
+        J = (
+            w
+            * rho
+            * rho
+            * np.where(on_h, 2.0 * v * (self.h1 / h) * ((self.h1 + 1.0) / (h + 1.0)), t * cos_ratio**3)
+        )
         M = self.ps._local(np.arctan(tan_psi), np.arctan2(y, x), self.tr[rows], self.pr[rows])
         return M, J
 
     def cells(self, rows):
-        """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into
-        ``t`` below and above ``t*`` and ``chi`` on either side of ``chi*``, graded towards it."""
-        tq, cq, lt, lc = self._cusp(rows)
+        """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into ``v``
+        below and above ``v*`` and ``chi`` on either side of ``chi*``, graded towards it."""
+        vq, cq, bv, bc = self._cusp(rows)
         out = []
-        for span in (1.0 - tq, -tq):
+        for span, b in ((1.0 - vq, bv[1]), (-vq, bv[0])):
             for sign in (1.0, -1.0):
                 ok = np.flatnonzero(span != 0.0)
-                L = np.where(span > 0, lt[1], lt[0])[ok]  # the cell's extent on the disc along t
-                out.append((ok, tq[ok], span[ok], L, cq[ok], np.full(ok.size, sign * math.pi), lc[ok]))
-        return _Cells(*(np.concatenate(a) for a in zip(*out, strict=True)), self.width[rows] / self.k)
+                out.append((ok, vq[ok], span[ok], b[ok], cq[ok], np.full(ok.size, sign * math.pi), bc[ok]))
+        return _Cells(*(np.concatenate(a) for a in zip(*out, strict=True)))
 
     def _cusp(self, rows):
-        """``(t*, chi*)`` of ``P*`` clamped to the disc, and the disc lengths ``(inner, outer)``
-        along ``t`` and along ``chi`` (half turn at ``t*``) from it.  Without a specular lobe:
-        ``t* = 1, chi* = 0`` (no cut; no grading follows from a nan width)."""
-        tr, pr, k = self.tr[rows], self.pr[rows], self.k
+        """``(v*, chi*)`` of ``P*`` clamped to the disc, the grading exponents ``(inner,
+        outer)`` along ``v`` and the one along ``chi`` (a half turn at ``t*``): the log of the
+        cell's extent over the lobe's (``width / k`` on the disc).  Without a specular lobe:
+        ``v* = 1, chi* = 0`` (no cut) and no grading."""
+        tr, pr, k, ox, on_h = self.tr[rows], self.pr[rows], self.k, self.ox[rows], self.on_h[rows]
         tt = np.tan(np.minimum(tr, 0.5 * math.pi - 1e-12))
-        px = (tt * np.cos(pr) - self.tan_c[rows]) / k  # P* from C, units of R
-        py = tt * np.sin(pr) / k
+        px = _over(tt * np.cos(pr) - self.tan_c[rows], k)  # P* from C, units of R
+        py = _over(tt * np.sin(pr), k)
         big = np.hypot(px, py)
         f = np.where(big > 1.0, 1.0 / np.where(big > 1.0, big, 1.0), 1.0)
-        qx, qy = px * f - self.ox[rows], py * f
+        qx, qy = px * f - ox, py * f
         cq = np.arctan2(qy, qx)
-        rq = self.rho(self.ox[rows], np.cos(cq), np.sin(cq))
+        rq = self.rho(ox, np.cos(cq), np.sin(cq))
         tq = np.clip(np.hypot(qx, qy) / np.where(rq > 0, rq, 1.0), 0.0, 1.0)
         none = np.isnan(self.width[rows])
         tq, cq = np.where(none, 1.0, tq), np.where(none, 0.0, cq)
-        return tq, cq, (tq * rq, (1.0 - tq) * rq), tq * rq * math.pi
+        lobe_t = _over(np.where(none, 1.0, self.width[rows]), k) / np.where(rq > 0, rq, 1.0)
+
+        def v_of(t):
+            return np.where(on_h, _v_of_t(t, k * rq), t)
+
+        vq = v_of(tq)
+        lobe_v = np.maximum(v_of(np.minimum(tq + lobe_t, 1.0)) - vq, vq - v_of(np.maximum(tq - lobe_t, 0.0)))
+        bv = tuple(_beta(span, lobe_v, none) for span in (vq, 1.0 - vq))
+        return vq, cq, bv, _beta(math.pi * tq, lobe_t, none)
+
+
+def _over(a, k):
+    """``a / k`` clipped to +-1e300 (no overflow for a vanishing disc, ``k`` ~ 1e-300)."""
+    lim = k * 1e300
+    return np.clip(a, -lim, lim) / k
+
+
+def _beta(extent, lobe, none):
+    """The grading exponent of a cell of ``extent`` over a lobe of ``lobe`` (same units): its
+    points cluster within ~1/beta of the corner; >= 1e-3, and 1e-3 without a lobe."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        b = np.log1p(extent / lobe)
+    return np.where(none | ~np.isfinite(b), 1e-3, np.maximum(b, 1e-3))
+
+
+def _v_of_t(t, krho):
+    """The radial variable about ``H`` at ``t``: ``v = t sqrt(h (h + 1) / (g (g + 1)))``, ``g =
+    hypot(1, k rho t)``, ``h = hypot(1, k rho)`` (written as ratios: no overflow, no underflow)."""
+    h, g = np.hypot(1.0, krho), np.hypot(1.0, krho * t)
+    return t * np.sqrt(h / g) * np.sqrt((h + 1.0) / (g + 1.0))
+
+
+def _t_of_v(v, h, krho):
+    """The inverse of :func:`_v_of_t`: ``t = v sqrt((2 - v^2 A) / (h (h + 1))) / (1 - v^2 A)``,
+    ``A = 1 - 1/h``; clipped to the rim (at ``v`` -> 1 with ``h`` huge, ``1 - v^2 A`` rounds:
+    it is at least ``1 / h``, its value at the rim)."""
+    a = (krho / h) * (krho / (h + 1.0))
+    s = np.maximum(1.0 - v * v * a, 1.0 / h)
+    return np.minimum(v * np.sqrt(2.0 - v * v * a) / (np.sqrt(h) * np.sqrt(h + 1.0) * s), 1.0)
 
 
 @dataclass
 class _Cells:
-    """Cells of the ``(t, chi)`` plane per geometry: ``t = t0 + dt g_t(u)``, ``chi = c0 + dc
-    g_c(v)`` on the unit square, graded from the corner ``(t0, c0)`` at ``P*`` over the lobe's
-    width on the disc ``lobe`` (per geometry: lengths ``lt``, ``lc`` of the cell along t, chi)."""
+    """Cells of the ``(v, chi)`` plane per geometry: ``v = v0 + dv g(u)``, ``chi = c0 + dc g(u')``
+    on the unit square, graded (exponents ``bv``, ``bc``) from the corner ``(v0, c0)`` at ``P*``."""
 
     row: np.ndarray
-    t0: np.ndarray
-    dt: np.ndarray
-    lt: np.ndarray
+    v0: np.ndarray
+    dv: np.ndarray
+    bv: np.ndarray
     c0: np.ndarray
     dc: np.ndarray
-    lc: np.ndarray
-    lobe: np.ndarray
+    bc: np.ndarray
 
-    def __post_init__(self):
-        # cluster over the lobe's width; without a specular lobe (nan) barely at all
-        lobe = self.lobe[self.row]
-        self.bt, self.bc = (
-            np.maximum(np.nan_to_num(np.log1p(length / lobe), nan=0.0), 1e-3) for length in (self.lt, self.lc)
-        )
-
-    def point(self, cell, u, v):
-        """``(t, chi, w)`` ``(m, P)`` of unit-square points of ``cell``, ``w`` the map's Jacobian."""
-        gt, dgt = _graded(self.bt[cell][:, None], u)
-        gc, dgc = _graded(self.bc[cell][:, None], v)
-        dt, dc = self.dt[cell][:, None], self.dc[cell][:, None]
-        return self.t0[cell][:, None] + dt * gt, self.c0[cell][:, None] + dc * gc, np.abs(dt * dc) * dgt * dgc
+    def point(self, cell, u, w):
+        """``(v, chi, J)`` ``(m, P)`` of unit-square points ``(u, w)`` of ``cell``, ``J`` the map's Jacobian."""
+        gv, dgv = _graded(self.bv[cell][:, None], u)
+        gc, dgc = _graded(self.bc[cell][:, None], w)
+        dv, dc = self.dv[cell][:, None], self.dc[cell][:, None]
+        return self.v0[cell][:, None] + dv * gv, self.c0[cell][:, None] + dc * gc, np.abs(dv * dc) * dgv * dgc
