@@ -114,12 +114,10 @@ def point_source_geometry(lo_deg, hi_deg):
     return math.atan(0.5 * (tl + th)), 2.0 / (th - tl)
 
 
-#: ``resolution="auto"`` refines to ``tol`` for discs up to this many source heights in radius;
-#: a wider disc puts nearly all the flux within ``~d`` of the source's foot, a speck the
-#: cubature's cells (in units of ``R``) do not resolve, and gets the product rule of
-#: :meth:`PointSourceBRDF.resolution_at` instead, whose error is not estimated (the cubature's
-#: weights underflowed to 0/0 at R/d = 1e298)
-CUBATURE_SPAN = 1e3
+#: ``resolution="auto"`` integrates about the source's foot ``H`` over the wedge of directions
+#: that meet the disc when ``H`` is off the disc by less than ``WEDGE_SPAN - 1`` radii (farther
+#: off, the irradiance varies on the disc's scale and the centre's polar coordinates follow it)
+WEDGE_SPAN = 2.0
 
 #: :meth:`PointSourceBRDF.resolution_at` (the shift method's node count) for ``"auto"``: nodes
 #: per (incidence spread / lobe width), and the bounds
@@ -286,16 +284,11 @@ class PointSourceBRDF(_Wrapper):
         lo = math.atan2(max(xc - R, 0.0), d)
         return lo, math.atan2(xc + R, d)
 
-    @property
-    def _cubature_resolves(self):
-        """Whether ``"auto"`` refines by cubature (:data:`CUBATURE_SPAN`)."""
-        return self.sample_radius <= CUBATURE_SPAN * self.distance
-
     # -- evaluation -----------------------------------------------------------------------
     def _mueller16(self, ti, tr, pr):
         if self.distance == math.inf or self.sample_radius / self.distance == 0.0:
             return self.model._m16(ti, tr, pr)
-        if self.resolution == "auto" and self.method == "exact" and self._cubature_resolves:
+        if self.resolution == "auto" and self.method == "exact":
             res = self._auto(ti, tr, pr)
             if res.capped.any():
                 k = int(res.capped.sum())
@@ -640,6 +633,10 @@ class _Disc:
         xc = _over(self.tan_c, self.k)  # H to C, in units of R
         self.on_h = xc < 1.0
         self.ox = np.where(self.on_h, -xc, 0.0)  # O from C
+        # H off the disc but near it: the flux crowds at the rim by H, which polar coordinates
+        # about the centre miss (their error estimate with them); the wedge about H follows it
+        self.xc = np.where((xc >= 1.0) & (xc < WEDGE_SPAN), xc, np.nan)
+        self.wedge = ~np.isnan(self.xc)
         self.width = np.full(ti.size, np.nan)
         self.spread = np.zeros(ti.size)
         uniq, inv = np.unique(ti, return_inverse=True)
@@ -671,31 +668,34 @@ class _Disc:
         y = self.k * r * s
         tan_psi = np.hypot(x, y)
         cos_ratio = np.hypot(1.0, tan_c) / np.hypot(1.0, tan_psi)  # cos psi / cos psi_c
-        J = (
-            w
-            * rho
-            * rho
-            * np.where(on_h, 2.0 * v * (self.h1 / h) * ((self.h1 + 1.0) / (h + 1.0)), t * cos_ratio**3)
-        )
+        J = np.where(on_h, 2.0 * v * (self.h1 / h) * ((self.h1 + 1.0) / (h + 1.0)), t * cos_ratio**3)
+        J = w * rho * rho * J
+        sel = self.wedge[rows]
+        if sel.any():
+            vw, cw, ww = (np.broadcast_to(a, x.shape)[sel] for a in (v, chi, w))
+            x[sel], y[sel], J[sel] = _wedge(self.xc[rows][sel][:, None], self.k, vw, cw)
+            J[sel] *= ww
+            tan_psi[sel] = np.hypot(x[sel], y[sel])
         M = self.ps._local(np.arctan(tan_psi), np.arctan2(y, x), self.tr[rows], self.pr[rows])
         return M, J
 
     def cells(self, rows):
         """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into ``v``
         below and above ``v*`` and ``chi`` on either side of ``chi*``, graded towards it."""
-        vq, cq, bv, bc = self._cusp(rows)
+        vq, cq, bv, bc, turns = self._cusp(rows)
         out = []
         for span, b in ((1.0 - vq, bv[1]), (-vq, bv[0])):
-            for sign in (1.0, -1.0):
-                ok = np.flatnonzero(span != 0.0)
-                out.append((ok, vq[ok], span[ok], b[ok], cq[ok], np.full(ok.size, sign * math.pi), bc[ok]))
+            for turn in turns:
+                ok = np.flatnonzero((span != 0.0) & (turn != 0.0))
+                out.append((ok, vq[ok], span[ok], b[ok], cq[ok], turn[ok], bc[ok]))
         return _Cells(*(np.concatenate(a) for a in zip(*out, strict=True)))
 
     def _cusp(self, rows):
         """``(v*, chi*)`` of ``P*`` clamped to the disc, the grading exponents ``(inner,
         outer)`` along ``v`` and the one along ``chi`` (a half turn at ``t*``): the log of the
-        cell's extent over the lobe's (``width / k`` on the disc).  Without a specular lobe:
-        ``v* = 1, chi* = 0`` (no cut) and no grading."""
+        cell's extent over the lobe's (``width / k`` on the disc), and the angular spans of the
+        cells on either side of ``chi*`` (a half turn each; in the wedge, to its edges).
+        Without a specular lobe: ``v* = 1, chi* = 0`` (no cut) and no grading."""
         tr, pr, k, ox, on_h = self.tr[rows], self.pr[rows], self.k, self.ox[rows], self.on_h[rows]
         tt = np.tan(np.minimum(tr, 0.5 * math.pi - 1e-12))
         px = _over(tt * np.cos(pr) - self.tan_c[rows], k)  # P* from C, units of R
@@ -715,8 +715,79 @@ class _Disc:
 
         vq = v_of(tq)
         lobe_v = np.maximum(v_of(np.minimum(tq + lobe_t, 1.0)) - vq, vq - v_of(np.maximum(tq - lobe_t, 0.0)))
-        bv = tuple(_beta(span, lobe_v, none) for span in (vq, 1.0 - vq))
-        return vq, cq, bv, _beta(math.pi * tq, lobe_t, none)
+        bv = [_beta(span, lobe_v, none) for span in (vq, 1.0 - vq)]
+        bc = _beta(math.pi * tq, lobe_t, none)
+        turns = (np.full(rows.size, math.pi), np.full(rows.size, -math.pi))
+        sel = self.wedge[rows]
+        if sel.any():
+            xc = self.xc[rows][sel]
+            width = np.where(none, 1.0, self.width[rows])[sel]
+            got = _wedge_cusp(xc, k, px[sel] * f[sel] + xc, py[sel] * f[sel], width, none[sel])
+            vq[sel], cq[sel], bv[0][sel], bv[1][sel], bc[sel] = got
+            turns[0][sel], turns[1][sel] = math.pi - cq[sel], -math.pi - cq[sel]
+        return vq, cq, bv, bc, turns
+
+
+def _wedge_ray(xc, k, phi):
+    """The ray from ``H`` (``xc`` from the centre, units of ``R``, ``1 <= xc``) at wedge angle
+    ``phi`` (``sin chi = sin phi / xc``, ``chi`` from the direction HC): ``cos chi``, ``sin chi``,
+    the distances ``r_n``, ``r_f`` to where it enters and leaves the disc and ``hypot(1, k r)``
+    at both (the rim's tangents, ``phi = +-pi/2``, have ``r_n = r_f``: no square-root edge)."""
+    sc = np.sin(phi) / xc
+    cc = np.sqrt(1.0 - sc * sc)
+    r_f = xc * cc + np.cos(phi)
+    # (xc^2 - 1) / r_f: no cancellation when H is at the rim (xc cos chi ~ cos phi)
+    r_n = np.divide((xc - 1.0) * (xc + 1.0), r_f, out=np.zeros_like(r_f), where=r_f > 0)
+    return cc, sc, r_n, r_f, np.hypot(1.0, k * r_n), np.hypot(1.0, k * r_f)
+
+
+def _share(r, h):
+    """``G(r) = r^2 / (h (h + 1))``: the flux share within ``r`` of ``H`` over ``k^2``
+    (``dG = cos^3 psi r dr``, ``h = hypot(1, k r) = 1 / cos psi``)."""
+    return r * (r / (h * (h + 1.0)))
+
+
+def _wedge(xc, k, u, alpha):
+    """``(x, y, J)``: the point of the wedge about ``H`` at ``(u, alpha)`` from ``H`` in units of
+    ``d``, and the flux weight of ``du dalpha``.  ``phi = alpha / 2`` (``alpha`` taken modulo a
+    turn); ``u`` the share of the ray's flux between ``r_n`` and ``r``, so that ``J = (G(r_f) -
+    G(r_n)) dchi / dalpha = 2 cos^2 phi / (h_n h_f (h_n + h_f))`` is smooth.  ``G`` and ``1 -
+    k^2 G = 1 / h`` are both linear in ``u`` (no cancellation at either end)."""
+    phi = 0.5 * (np.remainder(alpha + math.pi, 2.0 * math.pi) - math.pi)
+    cc, sc, r_n, r_f, h_n, h_f = _wedge_ray(xc, k, phi)
+    g = (1.0 - u) * _share(r_n, h_n) + u * _share(r_f, h_f)
+    a = (1.0 - u) / h_n + u / h_f  # cos psi
+    r = np.sqrt(g * (1.0 + a)) / a  # r^2 = G (2 - k^2 G) / (1 - k^2 G)^2
+    cp = np.cos(phi)
+    return k * r * cc, k * r * sc, 2.0 * cp * cp / (h_n * h_f * (h_n + h_f))
+
+
+def _wedge_u(xc, k, phi, r):
+    """``u`` of the point at ``r`` from ``H`` along the wedge angle ``phi`` (clipped to the disc)."""
+    _, _, r_n, r_f, h_n, h_f = _wedge_ray(xc, k, phi)
+    r = np.clip(r, r_n, r_f)
+    h = np.hypot(1.0, k * r)
+    num = (r - r_n) * (r + r_n) / (h * h_n * (h + h_n))
+    den = (r_f - r_n) * (r_f + r_n) / (h_f * h_n * (h_f + h_n))
+    return np.clip(np.divide(num, den, out=np.zeros_like(num), where=den > 0), 0.0, 1.0)
+
+
+def _wedge_cusp(xc, k, hx, hy, width, none):
+    """``(u*, alpha*, inner and outer grading along u, grading along alpha)`` of ``P*`` at
+    ``(hx, hy)`` from ``H`` (units of ``R``, on the disc), the lobe ``width`` (radians: taken
+    as ``width d`` along the ray, as about ``H`` on the disc, and ``width / tan psi`` of
+    azimuth across it, where a grazing lobe is narrowest)."""
+    chi, r = np.arctan2(hy, hx), np.hypot(hx, hy)
+    phi = np.arcsin(np.clip(xc * np.sin(chi), -1.0, 1.0))
+    u = _wedge_u(xc, k, phi, r)
+    lr = width / k
+    lobe_u = np.maximum(_wedge_u(xc, k, phi, r + lr) - u, u - _wedge_u(xc, k, phi, r - lr))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # across the ray the lobe spans width / tan psi of azimuth (as about H on the disc);
+        # dalpha = 2 xc cos chi dchi / cos phi
+        lobe_a = 2.0 * (width / (k * r)) * xc * np.cos(chi) / np.cos(phi)
+    u, a = np.where(none, 1.0, u), np.where(none, 0.0, 2.0 * phi)
+    return u, a, _beta(u, lobe_u, none), _beta(1.0 - u, lobe_u, none), _beta(math.pi, lobe_a, none)
 
 
 def _over(a, k):
