@@ -115,9 +115,10 @@ def point_source_geometry(lo_deg, hi_deg):
 
 
 #: ``resolution="auto"`` integrates about the source's foot ``H`` over the wedge of directions
-#: that meet the disc when ``H`` is off the disc by less than ``WEDGE_SPAN - 1`` radii (farther
-#: off, the irradiance varies on the disc's scale and the centre's polar coordinates follow it)
-WEDGE_SPAN = 2.0
+#: that meet the disc when ``H`` is off the disc and the irradiance's poles, ``d`` above and
+#: below ``H``, are within this many radii of the rim (``hypot(|HC| / R - 1, d / R)``); farther,
+#: the irradiance varies on the disc's scale and the centre's polar coordinates follow it
+WEDGE_REACH = 1.0
 
 #: :meth:`PointSourceBRDF.resolution_at` (the shift method's node count) for ``"auto"``: nodes
 #: per (incidence spread / lobe width), and the bounds
@@ -635,7 +636,8 @@ class _Disc:
         self.ox = np.where(self.on_h, -xc, 0.0)  # O from C
         # H off the disc but near it: the flux crowds at the rim by H, which polar coordinates
         # about the centre miss (their error estimate with them); the wedge about H follows it
-        self.xc = np.where((xc >= 1.0) & (xc < WEDGE_SPAN), xc, np.nan)
+        near = np.hypot(xc - 1.0, 1.0 / self.k) < WEDGE_REACH  # (xc: at most 1e300)
+        self.xc = np.where((xc >= 1.0) & near, xc, np.nan)
         self.wedge = ~np.isnan(self.xc)
         self.width = np.full(ti.size, np.nan)
         self.spread = np.zeros(ti.size)

@@ -306,4 +306,6 @@ def test_a_narrow_cook_torrance_lobe_on_wide_discs_meets_tol(k, foot):
     lb = INNERS[2].lobe(ti)
     tr, pr = np.array(_WIDE_SCAN + [(lb[0], lb[1])]).T
     err, scale, _ = _held(ps, ti, ps.tol, finer=1e-2, scan=(tr, pr))  # 1e-7 caps at grazing
+    # what a user gets is what accuracy() measured (no other rule for wide discs)
+    np.testing.assert_array_equal(ps.mueller(ti, tr, pr), ps.accuracy(ti, tr, pr).mueller)
     assert np.all(err <= ps.tol * scale), f"worst error / scale {np.max(err / scale):.3g} > tol {ps.tol:g}"
