@@ -48,12 +48,21 @@ follow the integrand's features, which are known:
 The disc is written in polar coordinates ``(t, chi)`` about ``H`` (when on the disc) or its
 centre, ``rho = t rho_max(chi)``, which makes the basis smooth (about ``H`` the radial variable
 is the square root of the ray's flux share within ``rho``, so that a source near the plane,
-whose flux falls within a few ``d`` of ``H``, is no harder than a far one); it is cut at ``P*`` into at most
-four cells (``t`` below and above ``t*``, ``chi`` on either side of ``chi*``), each graded
-exponentially towards ``P*`` over the lobe's width on the disc (``width * d``), and integrated
-by adaptive cubature (:mod:`models.cubature`: Genz-Malik rules whose embedded difference, and
-the change a split makes, bound each region's error; regions above their share are halved until
-the geometry meets ``tol``).  A lobe broad compared with the incidence spread (``spread <=
+whose flux falls within a few ``d`` of ``H``, is no harder than a far one).  When ``H`` is off
+the disc but the irradiance's poles (``d`` above and below ``H``) lie within a radius of its rim
+(:data:`WEDGE_REACH`), the flux crowds at the rim by ``H``, which the centre's coordinates
+miss, their error estimate with them (1e-3 of the peak with ``H`` 2 ``d`` off a disc of 10
+``d``, estimated below 1e-4); the disc is then the wedge of rays from ``H`` that meet it,
+``sin chi = sin phi / |HC|`` (no square-root edge at the tangents), each ray's flux share
+between where it enters and leaves the disc the radial variable.  Every ``R / d`` in the
+declared range is refined so, with no other rule (``tests/test_point_source_accuracy.py``
+holds ``R / d`` up to 1e6 against an independent integration in units of ``d``).  The
+coordinates are cut at ``P*`` into at most four cells (``t`` below and above ``t*``, ``chi``
+on either side of ``chi*``), each graded exponentially towards ``P*`` over the lobe's width on
+the disc (``width * d``; across the wedge's rays ``width / tan psi`` of azimuth, where a lobe at
+grazing incidence is narrowest), and integrated by adaptive cubature (:mod:`models.cubature`:
+Genz-Malik rules whose embedded difference, and the change a split makes, bound each region's
+error; regions above their share are halved until the geometry meets ``tol``).  A lobe broad compared with the incidence spread (``spread <=
 2 width``) or no lobe at all is tried first with the product rule in ``(t, chi)`` at 4 and 8
 radial nodes (160 evaluations; the difference of the two is the estimate): geometries it
 settles skip the cubature.  A geometry that reaches :data:`MAX_REGIONS` regions stops there with
