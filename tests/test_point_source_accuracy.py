@@ -309,3 +309,18 @@ def test_a_narrow_cook_torrance_lobe_on_wide_discs_meets_tol(k, foot):
     # what a user gets is what accuracy() measured (no other rule for wide discs)
     np.testing.assert_array_equal(ps.mueller(ti, tr, pr), ps.accuracy(ti, tr, pr).mueller)
     assert np.all(err <= ps.tol * scale), f"worst error / scale {np.max(err / scale):.3g} > tol {ps.tol:g}"
+
+
+@pytest.mark.parametrize("k", [10.0, 1e3])
+@pytest.mark.parametrize("foot", ["inside-rim", "outside-rim"])
+def test_a_model_without_a_lobe_by_the_rim_meets_tol(k, foot):
+    """No lobe: the first try (a product rule over the whole disc or wedge) or the cubature
+    without a cut, against the independent reference."""
+    inner = S.DiffuseSubsurfaceBRDF()
+    ti = math.atan(FEET[foot](k))
+    ps = S.PointSourceBRDF(model=inner, distance=1.0, sample_radius=k)
+    ref = np.array([_wide_reference(inner, k, ti, tr, pr) for tr, pr in _WIDE_SCAN])
+    acc = ps.accuracy(ti, *np.array(_WIDE_SCAN).T)
+    assert not acc.capped.any() and np.all(acc.error <= ps.tol)
+    err = np.max(np.abs(acc.mueller - ref), axis=(-2, -1))
+    assert np.all(err <= ps.tol * acc.scale), f"worst error / scale {np.max(err / acc.scale):.3g}"
