@@ -46,12 +46,23 @@ follow the integrand's features, which are known:
   polarization elements have a direction-dependent limit there when ``H`` lies on the disc.
 
 The disc is written in polar coordinates ``(t, chi)`` about ``H`` (when on the disc) or its
-centre, ``rho = t rho_max(chi)``, which makes the basis smooth; it is cut at ``P*`` into at most
-four cells (``t`` below and above ``t*``, ``chi`` on either side of ``chi*``), each graded
-exponentially towards ``P*`` over the lobe's width on the disc (``width * d``), and integrated
-by adaptive cubature (:mod:`models.cubature`: Genz-Malik rules whose embedded difference, and
-the change a split makes, bound each region's error; regions above their share are halved until
-the geometry meets ``tol``).  A lobe broad compared with the incidence spread (``spread <=
+centre, ``rho = t rho_max(chi)``, which makes the basis smooth (about ``H`` the radial variable
+is the square root of the ray's flux share within ``rho``, so that a source near the plane,
+whose flux falls within a few ``d`` of ``H``, is no harder than a far one).  When ``H`` is off
+the disc but the irradiance's poles (``d`` above and below ``H``) lie within a radius of its rim
+(:data:`WEDGE_REACH`), the flux crowds at the rim by ``H``, which the centre's coordinates
+miss, their error estimate with them (1e-3 of the peak with ``H`` 2 ``d`` off a disc of 10
+``d``, estimated below 1e-4); the disc is then the wedge of rays from ``H`` that meet it,
+``sin chi = sin phi / |HC|`` (no square-root edge at the tangents), each ray's flux share
+between where it enters and leaves the disc the radial variable.  Every ``R / d`` in the
+declared range is refined so, with no other rule (``tests/test_point_source_accuracy.py``
+holds ``R / d`` up to 1e6 against an independent integration in units of ``d``).  The
+coordinates are cut at ``P*`` into at most four cells (``t`` below and above ``t*``, ``chi``
+on either side of ``chi*``), each graded exponentially towards ``P*`` over the lobe's width on
+the disc (``width * d``; across the wedge's rays ``width / tan psi`` of azimuth, where a lobe at
+grazing incidence is narrowest), and integrated by adaptive cubature (:mod:`models.cubature`:
+Genz-Malik rules whose embedded difference, and the change a split makes, bound each region's
+error; regions above their share are halved until the geometry meets ``tol``).  A lobe broad compared with the incidence spread (``spread <=
 2 width``) or no lobe at all is tried first with the product rule in ``(t, chi)`` at 4 and 8
 radial nodes (160 evaluations; the difference of the two is the estimate): geometries it
 settles skip the cubature.  A geometry that reaches :data:`MAX_REGIONS` regions stops there with
@@ -112,12 +123,11 @@ def point_source_geometry(lo_deg, hi_deg):
     return math.atan(0.5 * (tl + th)), 2.0 / (th - tl)
 
 
-#: ``resolution="auto"`` refines to ``tol`` for discs up to this many source heights in radius;
-#: a wider disc puts nearly all the flux within ``~d`` of the source's foot, a speck the
-#: cubature's cells (in units of ``R``) do not resolve, and gets the product rule of
-#: :meth:`PointSourceBRDF.resolution_at` instead, whose error is not estimated (the cubature's
-#: weights underflowed to 0/0 at R/d = 1e298)
-CUBATURE_SPAN = 1e3
+#: ``resolution="auto"`` integrates about the source's foot ``H`` over the wedge of directions
+#: that meet the disc when ``H`` is off the disc and the irradiance's poles, ``d`` above and
+#: below ``H``, are within this many radii of the rim (``hypot(|HC| / R - 1, d / R)``); farther,
+#: the irradiance varies on the disc's scale and the centre's polar coordinates follow it
+WEDGE_REACH = 1.0
 
 #: :meth:`PointSourceBRDF.resolution_at` (the shift method's node count) for ``"auto"``: nodes
 #: per (incidence spread / lobe width), and the bounds
@@ -284,16 +294,11 @@ class PointSourceBRDF(_Wrapper):
         lo = math.atan2(max(xc - R, 0.0), d)
         return lo, math.atan2(xc + R, d)
 
-    @property
-    def _cubature_resolves(self):
-        """Whether ``"auto"`` refines by cubature (:data:`CUBATURE_SPAN`)."""
-        return self.sample_radius <= CUBATURE_SPAN * self.distance
-
     # -- evaluation -----------------------------------------------------------------------
     def _mueller16(self, ti, tr, pr):
         if self.distance == math.inf or self.sample_radius / self.distance == 0.0:
             return self.model._m16(ti, tr, pr)
-        if self.resolution == "auto" and self.method == "exact" and self._cubature_resolves:
+        if self.resolution == "auto" and self.method == "exact":
             res = self._auto(ti, tr, pr)
             if res.capped.any():
                 k = int(res.capped.sum())
@@ -619,20 +624,30 @@ class _Disc:
     """The disc as the ``"auto"`` quadrature sees it, per geometry (module docstring, Accuracy).
 
     Lengths on the disc are in units of its radius ``R``; the source's height ``d`` enters
-    through ``k = R / d``.  Polar coordinates ``(t, chi)`` about ``O``, the foot ``H`` of the
-    source when it lies on the disc, else the centre: a point is ``O + t rho(chi) (cos chi,
-    sin chi)``, ``rho`` the distance from ``O`` to the rim.  ``width``: the inner model's lobe
-    width at the central incidence where its lobe is specular (centred at ``(theta_i, 0)``,
-    so that its peak or cusp sits at ``P*``), nan otherwise; ``spread``: the incidence spread.
+    through ``k = R / d``.  Polar coordinates about ``O``, the foot ``H`` of the source when it
+    lies on the disc, else the centre: a point is ``O + t rho(chi) (cos chi, sin chi)``, ``rho``
+    the distance from ``O`` to the rim.  The quadrature's radial variable ``v`` is ``t`` about
+    the centre; about ``H`` it absorbs the irradiance: ``v^2`` is the share of the ray's flux
+    within ``r = t rho`` (``cos^3 psi r dr`` with ``tan psi = k r``), so that a source near the
+    plane, whose flux falls within a few ``d`` of ``H``, is no harder than a far one, while
+    ``v`` stays linear in ``r`` at ``H``.  ``width``: the inner model's lobe width at the
+    central incidence where its lobe is specular (centred at ``(theta_i, 0)``, so that its peak
+    or cusp sits at ``P*``), nan otherwise; ``spread``: the incidence spread.
     """
 
     def __init__(self, ps, ti, tr, pr):
         self.ps, self.tr, self.pr = ps, tr, pr
-        self.k = ps.sample_radius / ps.distance
+        self.k = min(ps.sample_radius / ps.distance, 1e300)
+        self.h1 = math.hypot(1.0, self.k)
         self.tan_c = np.tan(ti)  # H to C, in units of d
-        with np.errstate(over="ignore"):  # a disc tiny against d: H is off it (xc = inf), O the centre
-            xc = self.tan_c / self.k  # H to C, in units of R
-        self.ox = np.where(xc < 1.0, -xc, 0.0)  # O from C
+        xc = _over(self.tan_c, self.k)  # H to C, in units of R
+        self.on_h = xc < 1.0
+        self.ox = np.where(self.on_h, -xc, 0.0)  # O from C
+        # H off the disc but near it: the flux crowds at the rim by H, which polar coordinates
+        # about the centre miss (their error estimate with them); the wedge about H follows it
+        near = np.hypot(xc - 1.0, 1.0 / self.k) < WEDGE_REACH  # (xc: at most 1e300)
+        self.xc = np.where((xc >= 1.0) & near, xc, np.nan)
+        self.wedge = ~np.isnan(self.xc)
         self.width = np.full(ti.size, np.nan)
         self.spread = np.zeros(ti.size)
         uniq, inv = np.unique(ti, return_inverse=True)
@@ -647,77 +662,191 @@ class _Disc:
         """Distance from ``O`` (at ``ox``) to the rim along ``(c, s)``."""
         return np.sqrt(np.maximum(1.0 - (ox * s) ** 2, 0.0)) - ox * c
 
-    def values(self, rows, t, chi, w):
-        """``(M, J)`` at ``(t, chi)`` with quadrature weights ``w``: the 16 Mueller elements
-        ``(16, m, P)`` and the irradiance weight ``J = rho^2 t cos^3 psi w`` ``(m, P)``."""
+    def values(self, rows, v, chi, w):
+        """``(M, J)`` at ``(v, chi)`` with quadrature weights ``w``: the 16 Mueller elements
+        ``(16, m, P)`` and the irradiance weight ``J`` ``(m, P)`` (per row up to a constant:
+        ``rho^2 t cos^3 psi / cos^3 psi_c w`` about the centre, ``2 v rho^2 / (h (h + 1)) w``
+        about ``H``, ``h = hypot(1, k rho)``, scaled by the unit disc's)."""
+        on_h = self.on_h[rows][:, None]
         ox = self.ox[rows][:, None]
         c, s = np.cos(chi), np.sin(chi)
         rho = self.rho(ox, c, s)
+        h = np.hypot(1.0, self.k * rho)
+        t = np.where(on_h, _t_of_v(v, h, self.k * rho), v)
         r = rho * t
-        x = self.tan_c[rows][:, None] + self.k * (ox + r * c)  # from H, units of d
+        tan_c = self.tan_c[rows][:, None]
+        x = tan_c + self.k * (ox + r * c)  # from H, units of d
         y = self.k * r * s
-        tan_psi = np.hypot(x, y)  # hypot: a disc huge against d does not overflow x^2 (R up to 1e300)
-        cos_psi = 1.0 / np.hypot(1.0, tan_psi)
-        J = w * rho * rho * t * (cos_psi * cos_psi * cos_psi)
+        tan_psi = np.hypot(x, y)
+        cos_ratio = np.hypot(1.0, tan_c) / np.hypot(1.0, tan_psi)  # cos psi / cos psi_c
+        J = np.where(on_h, 2.0 * v * (self.h1 / h) * ((self.h1 + 1.0) / (h + 1.0)), t * cos_ratio**3)
+        J = w * rho * rho * J
+        sel = self.wedge[rows]
+        if sel.any():
+            vw, cw, ww = (np.broadcast_to(a, x.shape)[sel] for a in (v, chi, w))
+            x[sel], y[sel], J[sel] = _wedge(self.xc[rows][sel][:, None], self.k, vw, cw)
+            J[sel] *= ww
+            tan_psi[sel] = np.hypot(x[sel], y[sel])
         M = self.ps._local(np.arctan(tan_psi), np.arctan2(y, x), self.tr[rows], self.pr[rows])
         return M, J
 
     def cells(self, rows):
-        """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into
-        ``t`` below and above ``t*`` and ``chi`` on either side of ``chi*``, graded towards it."""
-        tq, cq, lt, lc = self._cusp(rows)
+        """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into ``v``
+        below and above ``v*`` and ``chi`` on either side of ``chi*``, graded towards it."""
+        vq, cq, bv, bc, turns = self._cusp(rows)
         out = []
-        for span in (1.0 - tq, -tq):
-            for sign in (1.0, -1.0):
-                ok = np.flatnonzero(span != 0.0)
-                L = np.where(span > 0, lt[1], lt[0])[ok]  # the cell's extent on the disc along t
-                out.append((ok, tq[ok], span[ok], L, cq[ok], np.full(ok.size, sign * math.pi), lc[ok]))
-        return _Cells(*(np.concatenate(a) for a in zip(*out, strict=True)), self.width[rows] / self.k)
+        for span, b in ((1.0 - vq, bv[1]), (-vq, bv[0])):
+            for turn in turns:
+                ok = np.flatnonzero((span != 0.0) & (turn != 0.0))
+                out.append((ok, vq[ok], span[ok], b[ok], cq[ok], turn[ok], bc[ok]))
+        return _Cells(*(np.concatenate(a) for a in zip(*out, strict=True)))
 
     def _cusp(self, rows):
-        """``(t*, chi*)`` of ``P*`` clamped to the disc, and the disc lengths ``(inner, outer)``
-        along ``t`` and along ``chi`` (half turn at ``t*``) from it.  Without a specular lobe:
-        ``t* = 1, chi* = 0`` (no cut; no grading follows from a nan width)."""
-        tr, pr, k = self.tr[rows], self.pr[rows], self.k
+        """``(v*, chi*)`` of ``P*`` clamped to the disc, the grading exponents ``(inner,
+        outer)`` along ``v`` and the one along ``chi`` (a half turn at ``t*``): the log of the
+        cell's extent over the lobe's (``width / k`` on the disc), and the angular spans of the
+        cells on either side of ``chi*`` (a half turn each; in the wedge, to its edges).
+        Without a specular lobe: ``v* = 1, chi* = 0`` (no cut) and no grading."""
+        tr, pr, k, ox, on_h = self.tr[rows], self.pr[rows], self.k, self.ox[rows], self.on_h[rows]
         tt = np.tan(np.minimum(tr, 0.5 * math.pi - 1e-12))
-        px = (tt * np.cos(pr) - self.tan_c[rows]) / k  # P* from C, units of R
-        py = tt * np.sin(pr) / k
+        px = _over(tt * np.cos(pr) - self.tan_c[rows], k)  # P* from C, units of R
+        py = _over(tt * np.sin(pr), k)
         big = np.hypot(px, py)
         f = np.where(big > 1.0, 1.0 / np.where(big > 1.0, big, 1.0), 1.0)
-        qx, qy = px * f - self.ox[rows], py * f
+        qx, qy = px * f - ox, py * f
         cq = np.arctan2(qy, qx)
-        rq = self.rho(self.ox[rows], np.cos(cq), np.sin(cq))
+        rq = self.rho(ox, np.cos(cq), np.sin(cq))
         tq = np.clip(np.hypot(qx, qy) / np.where(rq > 0, rq, 1.0), 0.0, 1.0)
         none = np.isnan(self.width[rows])
         tq, cq = np.where(none, 1.0, tq), np.where(none, 0.0, cq)
-        return tq, cq, (tq * rq, (1.0 - tq) * rq), tq * rq * math.pi
+        lobe_t = _over(np.where(none, 1.0, self.width[rows]), k) / np.where(rq > 0, rq, 1.0)
+
+        def v_of(t):
+            return np.where(on_h, _v_of_t(t, k * rq), t)
+
+        vq = v_of(tq)
+        lobe_v = np.maximum(v_of(np.minimum(tq + lobe_t, 1.0)) - vq, vq - v_of(np.maximum(tq - lobe_t, 0.0)))
+        bv = [_beta(span, lobe_v, none) for span in (vq, 1.0 - vq)]
+        bc = _beta(math.pi * tq, lobe_t, none)
+        turns = (np.full(rows.size, math.pi), np.full(rows.size, -math.pi))
+        sel = self.wedge[rows]
+        if sel.any():
+            xc = self.xc[rows][sel]
+            width = np.where(none, 1.0, self.width[rows])[sel]
+            got = _wedge_cusp(xc, k, px[sel] * f[sel] + xc, py[sel] * f[sel], width, none[sel])
+            vq[sel], cq[sel], bv[0][sel], bv[1][sel], bc[sel] = got
+            turns[0][sel], turns[1][sel] = math.pi - cq[sel], -math.pi - cq[sel]
+        return vq, cq, bv, bc, turns
+
+
+def _wedge_ray(xc, k, phi):
+    """The ray from ``H`` (``xc`` from the centre, units of ``R``, ``1 <= xc``) at wedge angle
+    ``phi`` (``sin chi = sin phi / xc``, ``chi`` from the direction HC): ``cos chi``, ``sin chi``,
+    the distances ``r_n``, ``r_f`` to where it enters and leaves the disc and ``hypot(1, k r)``
+    at both (the rim's tangents, ``phi = +-pi/2``, have ``r_n = r_f``: no square-root edge)."""
+    sc = np.sin(phi) / xc
+    cc = np.sqrt(1.0 - sc * sc)
+    r_f = xc * cc + np.cos(phi)
+    # (xc^2 - 1) / r_f: no cancellation when H is at the rim (xc cos chi ~ cos phi)
+    r_n = np.divide((xc - 1.0) * (xc + 1.0), r_f, out=np.zeros_like(r_f), where=r_f > 0)
+    return cc, sc, r_n, r_f, np.hypot(1.0, k * r_n), np.hypot(1.0, k * r_f)
+
+
+def _share(r, h):
+    """``G(r) = r^2 / (h (h + 1))``: the flux share within ``r`` of ``H`` over ``k^2``
+    (``dG = cos^3 psi r dr``, ``h = hypot(1, k r) = 1 / cos psi``)."""
+    return r * (r / (h * (h + 1.0)))
+
+
+def _wedge(xc, k, u, alpha):
+    """``(x, y, J)``: the point of the wedge about ``H`` at ``(u, alpha)`` from ``H`` in units of
+    ``d``, and the flux weight of ``du dalpha``.  ``phi = alpha / 2`` (``alpha`` taken modulo a
+    turn); ``u`` the share of the ray's flux between ``r_n`` and ``r``, so that ``J = (G(r_f) -
+    G(r_n)) dchi / dalpha = 2 cos^2 phi / (h_n h_f (h_n + h_f))`` is smooth.  ``G`` and ``1 -
+    k^2 G = 1 / h`` are both linear in ``u`` (no cancellation at either end)."""
+    phi = 0.5 * (np.remainder(alpha + math.pi, 2.0 * math.pi) - math.pi)
+    cc, sc, r_n, r_f, h_n, h_f = _wedge_ray(xc, k, phi)
+    g = (1.0 - u) * _share(r_n, h_n) + u * _share(r_f, h_f)
+    a = (1.0 - u) / h_n + u / h_f  # cos psi
+    r = np.sqrt(g * (1.0 + a)) / a  # r^2 = G (2 - k^2 G) / (1 - k^2 G)^2
+    cp = np.cos(phi)
+    return k * r * cc, k * r * sc, 2.0 * cp * cp / (h_n * h_f * (h_n + h_f))
+
+
+def _wedge_u(xc, k, phi, r):
+    """``u`` of the point at ``r`` from ``H`` along the wedge angle ``phi`` (clipped to the disc)."""
+    _, _, r_n, r_f, h_n, h_f = _wedge_ray(xc, k, phi)
+    r = np.clip(r, r_n, r_f)
+    h = np.hypot(1.0, k * r)
+    num = (r - r_n) * (r + r_n) / (h * h_n * (h + h_n))
+    den = (r_f - r_n) * (r_f + r_n) / (h_f * h_n * (h_f + h_n))
+    return np.clip(np.divide(num, den, out=np.zeros_like(num), where=den > 0), 0.0, 1.0)
+
+
+def _wedge_cusp(xc, k, hx, hy, width, none):
+    """``(u*, alpha*, inner and outer grading along u, grading along alpha)`` of ``P*`` at
+    ``(hx, hy)`` from ``H`` (units of ``R``, on the disc), the lobe ``width`` (radians: taken
+    as ``width d`` along the ray, as about ``H`` on the disc, and ``width / tan psi`` of
+    azimuth across it, where a grazing lobe is narrowest)."""
+    chi, r = np.arctan2(hy, hx), np.hypot(hx, hy)
+    phi = np.arcsin(np.clip(xc * np.sin(chi), -1.0, 1.0))
+    u = _wedge_u(xc, k, phi, r)
+    lr = width / k
+    lobe_u = np.maximum(_wedge_u(xc, k, phi, r + lr) - u, u - _wedge_u(xc, k, phi, r - lr))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # across the ray the lobe spans width / tan psi of azimuth (as about H on the disc);
+        # dalpha = 2 xc cos chi dchi / cos phi
+        lobe_a = 2.0 * (width / (k * r)) * xc * np.cos(chi) / np.cos(phi)
+    u, a = np.where(none, 1.0, u), np.where(none, 0.0, 2.0 * phi)
+    return u, a, _beta(u, lobe_u, none), _beta(1.0 - u, lobe_u, none), _beta(math.pi, lobe_a, none)
+
+
+def _over(a, k):
+    """``a / k`` clipped to +-1e300 (no overflow for a vanishing disc, ``k`` ~ 1e-300)."""
+    lim = k * 1e300
+    return np.clip(a, -lim, lim) / k
+
+
+def _beta(extent, lobe, none):
+    """The grading exponent of a cell of ``extent`` over a lobe of ``lobe`` (same units): its
+    points cluster within ~1/beta of the corner; >= 1e-3, and 1e-3 without a lobe."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        b = np.log1p(extent / lobe)
+    return np.where(none | ~np.isfinite(b), 1e-3, np.maximum(b, 1e-3))
+
+
+def _v_of_t(t, krho):
+    """The radial variable about ``H`` at ``t``: ``v = t sqrt(h (h + 1) / (g (g + 1)))``, ``g =
+    hypot(1, k rho t)``, ``h = hypot(1, k rho)`` (written as ratios: no overflow, no underflow)."""
+    h, g = np.hypot(1.0, krho), np.hypot(1.0, krho * t)
+    return t * np.sqrt(h / g) * np.sqrt((h + 1.0) / (g + 1.0))
+
+
+def _t_of_v(v, h, krho):
+    """The inverse of :func:`_v_of_t`: ``t = v sqrt((2 - v^2 A) / (h (h + 1))) / (1 - v^2 A)``,
+    ``A = 1 - 1/h``; clipped to the rim (at ``v`` -> 1 with ``h`` huge, ``1 - v^2 A`` rounds:
+    it is at least ``1 / h``, its value at the rim)."""
+    a = (krho / h) * (krho / (h + 1.0))
+    s = np.maximum(1.0 - v * v * a, 1.0 / h)
+    return np.minimum(v * np.sqrt(2.0 - v * v * a) / (np.sqrt(h) * np.sqrt(h + 1.0) * s), 1.0)
 
 
 @dataclass
 class _Cells:
-    """Cells of the ``(t, chi)`` plane per geometry: ``t = t0 + dt g_t(u)``, ``chi = c0 + dc
-    g_c(v)`` on the unit square, graded from the corner ``(t0, c0)`` at ``P*`` over the lobe's
-    width on the disc ``lobe`` (per geometry: lengths ``lt``, ``lc`` of the cell along t, chi)."""
+    """Cells of the ``(v, chi)`` plane per geometry: ``v = v0 + dv g(u)``, ``chi = c0 + dc g(u')``
+    on the unit square, graded (exponents ``bv``, ``bc``) from the corner ``(v0, c0)`` at ``P*``."""
 
     row: np.ndarray
-    t0: np.ndarray
-    dt: np.ndarray
-    lt: np.ndarray
+    v0: np.ndarray
+    dv: np.ndarray
+    bv: np.ndarray
     c0: np.ndarray
     dc: np.ndarray
-    lc: np.ndarray
-    lobe: np.ndarray
+    bc: np.ndarray
 
-    def __post_init__(self):
-        # cluster over the lobe's width; without a specular lobe (nan) barely at all
-        lobe = self.lobe[self.row]
-        self.bt, self.bc = (
-            np.maximum(np.nan_to_num(np.log1p(length / lobe), nan=0.0), 1e-3) for length in (self.lt, self.lc)
-        )
-
-    def point(self, cell, u, v):
-        """``(t, chi, w)`` ``(m, P)`` of unit-square points of ``cell``, ``w`` the map's Jacobian."""
-        gt, dgt = _graded(self.bt[cell][:, None], u)
-        gc, dgc = _graded(self.bc[cell][:, None], v)
-        dt, dc = self.dt[cell][:, None], self.dc[cell][:, None]
-        return self.t0[cell][:, None] + dt * gt, self.c0[cell][:, None] + dc * gc, np.abs(dt * dc) * dgt * dgc
+    def point(self, cell, u, w):
+        """``(v, chi, J)`` ``(m, P)`` of unit-square points ``(u, w)`` of ``cell``, ``J`` the map's Jacobian."""
+        gv, dgv = _graded(self.bv[cell][:, None], u)
+        gc, dgc = _graded(self.bc[cell][:, None], w)
+        dv, dc = self.dv[cell][:, None], self.dc[cell][:, None]
+        return self.v0[cell][:, None] + dv * gv, self.c0[cell][:, None] + dc * gc, np.abs(dv * dc) * dgv * dgc
