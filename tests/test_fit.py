@@ -125,6 +125,23 @@ def test_likelihood_prefers_the_truth_and_uses_declared_terms(coated, data):
         fitspec_from(sc, None, ["brdf=off"])
 
 
+def test_a_brdf_only_fit_predicts_from_the_first_row_alone(coated, data):
+    """With BRDF the only fitted term the likelihood skips eta, P and P_C (the Mueller matrix's
+    first row against each row's incident Stokes vector): the same BRDF as :meth:`predict`
+    to rounding, whatever the rows' incident polarizations, and the same ln L."""
+    spec = fitspec_from(coated, ["sigma:0.01:1:log", "coating:1.2:2"], ["brdf=0.05"])
+    lik = Likelihood(coated, spec, data)
+    assert lik.terms == ("brdf",) and len(np.unique(data.incident, axis=0)) > 1
+    values, noise = lik.walkers(np.array([[math.log(0.1), 1.5], [math.log(0.2), 1.3]]))
+    model = lik.model(values)
+    fast, full = lik._predict_terms(model), lik.predict(model)
+    assert set(fast) == {"brdf"}
+    np.testing.assert_allclose(fast["brdf"], full["brdf"], rtol=1e-14, atol=0)
+    ll_fast = lik._pointwise_rows(noise, fast)
+    ll_full = lik._pointwise_rows(noise, full)
+    assert np.max(np.abs(ll_fast - ll_full)) <= 1e-12 * np.max(np.abs(ll_full))
+
+
 @pytest.mark.parametrize(
     "scene_file, data_file",
     [

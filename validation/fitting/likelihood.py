@@ -115,6 +115,8 @@ class Likelihood:
         self._log_obs = np.log(d.brdf)
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
         self.terms = _terms(spec, d)
+        # a BRDF-only fit needs the Mueller matrix's first row alone (no polarization state)
+        self._brdf_only = self.terms == ("brdf",)
         self.n_points = len(d)
         # Whether the point source and the aperture matter (and the aperture's quadrature) is
         # decided once, at the scene's own values: re-deciding per evaluation would make ln L
@@ -154,6 +156,17 @@ class Likelihood:
             S = np.einsum("ab...n,nb->a...n", M, d.incident)
         i, eta, pc, p = ellipsometric(np.moveaxis(S, 0, -1))
         return {"brdf": i / d.incident[:, 0], "eta": eta, "P": p, "P_C": pc}
+
+    def _predict_terms(self, model) -> dict:
+        """:meth:`predict` at the fitted rows, of the fitted terms only: a BRDF-only fit takes
+        the scattered ``S0`` from the Mueller matrix's first row (no ``eta``, ``P``, ``P_C``)."""
+        if not self._brdf_only:
+            return self.predict(model)
+        d = self.data
+        shape, M = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
+        M = M.reshape((4, 4) + shape)
+        s0 = np.einsum("b...n,nb->...n", M[0], d.incident)
+        return {"brdf": s0 / d.incident[:, 0]}
 
     # -- likelihood ----------------------------------------------------------------
     def _variances(self, noise):
@@ -201,7 +214,7 @@ class Likelihood:
             self.binding.check(model)  # vectorized: every walker's parameters at once
         except ValueError:
             return self._pointwise_valid(U)
-        return self._pointwise_rows(noise, self.predict(model))
+        return self._pointwise_rows(noise, self._predict_terms(model))
 
     def _pointwise_valid(self, U):
         """Rows of ``-inf`` for the positions the scene refuses (rebuilt and validated one by
@@ -236,7 +249,9 @@ class Likelihood:
         """Per-row log-likelihood at one position with the scene rebuilt and validated there (the
         per-walker path before model sets; a ``ValueError`` where the scene refuses ``u``)."""
         values = self.spec.physical(u)
-        return self._pointwise_rows(self.spec.noise_values(values), self.predict(self.model_rebuilt(values)))
+        return self._pointwise_rows(
+            self.spec.noise_values(values), self._predict_terms(self.model_rebuilt(values))
+        )
 
     def pointwise(self, u) -> np.ndarray:
         """Per-row log-likelihood (all terms summed per row), ``-inf`` where impossible."""
@@ -250,7 +265,7 @@ class Likelihood:
         """Residuals divided by their standard deviations (for least squares); large
         finite values where the model predicts no light."""
         values, noise = self.walkers(np.asarray(u, dtype=float)[None])
-        res = self.residuals(self.predict(self.model(values)))
+        res = self.residuals(self._predict_terms(self.model(values)))
         var = self._variances(noise)
         out = []
         for t in self.terms:
