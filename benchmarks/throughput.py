@@ -55,7 +55,7 @@ k = int(round(math.sqrt(n / 4)))
 tr = np.linspace(0, 1.5, k)[:, None]
 pr = np.linspace(-math.pi, math.pi, n // k)[None, :]
 N = tr.size * pr.size
-# warm up: 4 and 16384 geometries reach the serial and the parallel kernels (from 8192 on),
+# warm up: 4 and 16384 geometries reach the serial and the parallel kernels (from 1024 on),
 # so compiling or loading them is part of the baseline, not of the evaluation measured
 for size in (2, 128):
     wt, wp = np.linspace(0, 1.5, size)[:, None], np.linspace(-math.pi, math.pi, size)[None, :]

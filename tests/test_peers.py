@@ -103,7 +103,7 @@ def test_main_writes_the_measured_table_with_provenance(peers, one_call, tmp_pat
 
 
 def test_our_timed_calls_run_on_one_thread(peers, monkeypatch):
-    """The kernels' prange would use every core above 8192 geometries: pinned to one thread
+    """The kernels' prange would use every core from 1024 geometries: pinned to one thread
     while timed (as Dr.Jit is), the count restored after, and recorded in the table."""
     numba = pytest.importorskip("numba")
     seen = []

@@ -145,7 +145,7 @@ def render(s, d: SpeedData):
     caption = (
         f"throughput: one mueller call on {d.geometries} random geometries (200 for Monte Carlo and "
         "wrapper models), this run; best batch of validation.studies.tradeoff.time_call, CPU time of "
-        "every thread of the process (the kernels run on every core above 8192 geometries) and wall time"
+        "every thread of the process (the kernels run on every core from 1024 geometries) and wall time"
     )
     s.blocks.append(table_block(s, "throughput", _THROUGHPUT, d.throughput_rows, caption=caption))
     run = d.peer_run
