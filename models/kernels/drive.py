@@ -76,7 +76,7 @@ def store(out, i, m):
 
 
 #: geometries per task of :func:`run_parallel` (each runs :func:`run_range`'s serial loop)
-BLOCK = 512
+BLOCK = 1024
 
 
 @njit(cache=True)
