@@ -35,8 +35,8 @@ sensitivity to it; ``u = EPS / 2`` is the unit roundoff, ``Delta`` the sine erro
   still charges ``Delta``, an allowance that also covers what a bound from the accurate sines
   would have to add and that is not derived here: the polar angles' own rounding (up to
   ``(pi / 4) EPS`` per sine and cosine) moved into the slopes by ``1 / h_z``, which grows
-  towards grazing.  (Measured, ``tests/test_float32_domain.py``: a Cook-Torrance lobe of
-  ``m = 1e-3`` errs by 5.9e-4 near 79 deg, four times a bound that charged the sines 1.125 EPS.)
+  towards grazing.  (``tests/test_float32_domain.py`` measures a varnished Cook-Torrance
+  lobe of ``m = 1e-3`` erring by more than a bound that charges the sines 1.125 EPS.)
 * lobe width ``w`` (the narrowest of ``sigma``, ``alpha``, the stroke ``m``; Cook-Torrance's
   ``m``): ``L Delta / (EPS w)``.  The bisector's slope ``z = h_x / h_z`` has ``h_z >= 1`` near
   normal, so the sines' error moves it by ``<= Delta``; a slope density ``P(z / w)`` then moves

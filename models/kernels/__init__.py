@@ -37,8 +37,9 @@ __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 
 #: geometries from which the kernels run on every core (below: the serial loop, which has
 #: no thread start-up cost).  A fit's half-ensemble step is 16 walkers x ~110 rows: from
-#: 8192 down to 1024 its likelihood evaluations rose from 24,600 to 27,900 per second
-#: (``benchmarks/fit_speed.py``, 2 cores); small calls (<= 100 geometries) stay serial
+#: 8192 down to 1024 its likelihood evaluations rose from 24,786 to 27,867 per second (the
+#: ``fit`` command of ``benchmarks/fit_speed.py``, best of three runs each, 2 cores); small
+#: calls (<= 100 geometries) stay serial
 PARALLEL_MIN = 1024
 _HALF_PI = 0.5 * math.pi
 _FLOAT64 = np.dtype(np.float64)

@@ -33,9 +33,11 @@ ROWS = {
 }
 
 
-#: rows of ``prm`` and entries of ``iopt`` every kernel is given (``Compiled`` pads to them)
+#: rows of ``prm`` and entries of ``iopt`` every kernel is given (``Compiled`` pads to them;
+#: :func:`params` and :func:`options` read exactly these)
 PARAM_ROWS = max(len(r) for r in ROWS.values())
 OPTIONS = 3
+assert PARAM_ROWS == 11, "params() reads 11 rows"
 
 
 @njit(cache=True, inline="always")
@@ -64,6 +66,12 @@ def params(prm, j):
 
 
 @njit(cache=True)
+def options(iopt):
+    """The options as a tuple."""
+    return (iopt[0], iopt[1], iopt[2])
+
+
+@njit(cache=True)
 def store(out, i, m):
     """The elements ``m`` into ``out[:, i]`` (only ``M00`` when ``out`` has one row)."""
     out[0, i] = m[0]
@@ -83,7 +91,7 @@ BLOCK = 1024
 def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
     """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``, serially."""
     a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
-    o = (iopt[0], iopt[1], iopt[2])
+    o = options(iopt)
     for i in range(lo, hi):
         store(out, start + i, element(code, ti[i * a], tr[i * b], pr[i * c], params(prm, i * p), o))
 
@@ -118,7 +126,7 @@ def run_checked(code, ti, tr, pr, prm, iopt, out):
 @njit(cache=True)
 def run_one(code, ti, tr, pr, prm, iopt, out):
     """One geometry given as scalars (the small-call path)."""
-    store(out, 0, element(code, ti, tr, pr, params(prm, 0), (iopt[0], iopt[1], iopt[2])))
+    store(out, 0, element(code, ti, tr, pr, params(prm, 0), options(iopt)))
 
 
 @njit(cache=True)

@@ -77,7 +77,7 @@ def single(ti, tr, pr, p, o):
 
 @njit(cache=True, inline="always")
 def diffuse(ti, tr, pr, p, o):
-    """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``prm[1]``: its scale."""
+    """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``p[1]``: its scale."""
     n = p[0]
     ci_e, si_e = polar(ti)
     cr_e, sr_e = polar(tr)

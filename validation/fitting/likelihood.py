@@ -115,8 +115,6 @@ class Likelihood:
         self._log_obs = np.log(d.brdf)
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
         self.terms = _terms(spec, d)
-        # a BRDF-only fit needs the Mueller matrix's first row alone (no polarization state)
-        self._brdf_only = self.terms == ("brdf",)
         self.n_points = len(d)
         # Whether the point source and the aperture matter (and the aperture's quadrature) is
         # decided once, at the scene's own values: re-deciding per evaluation would make ln L
@@ -140,12 +138,16 @@ class Likelihood:
         """The scene rebuilt and validated at scalar ``values`` (no model set)."""
         return self.scene.with_values(self.spec.scene_values(values)).build(decisions=self.decisions)
 
-    def predict(self, model, data=None) -> dict:
+    def predict(self, model, data=None, terms=None) -> dict:
         """Model ``brdf, eta, P, P_C`` at the rows of ``data`` (default: the fitted rows); a
-        model set of shape ``(W, 1)`` gives ``(W, rows)`` arrays."""
+        model set of shape ``(W, 1)`` gives ``(W, rows)`` arrays.  ``terms``: the fitted terms
+        (default: all four); for ``("brdf",)``, a BRDF-only fit, only the BRDF, from the
+        Mueller matrix's first row (no polarization state)."""
         d = self.data if data is None else data
         shape, M = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
         M = M.reshape((4, 4) + shape)
+        if terms == ("brdf",):
+            M = M[:1]
         if self._same_incident and data is None:
             inc = d.incident[0]
             S = M[:, 0] * inc[0]
@@ -154,19 +156,10 @@ class Likelihood:
                     S += M[:, b] * inc[b]
         else:
             S = np.einsum("ab...n,nb->a...n", M, d.incident)
+        if terms == ("brdf",):
+            return {"brdf": S[0] / d.incident[:, 0]}
         i, eta, pc, p = ellipsometric(np.moveaxis(S, 0, -1))
         return {"brdf": i / d.incident[:, 0], "eta": eta, "P": p, "P_C": pc}
-
-    def _predict_terms(self, model) -> dict:
-        """:meth:`predict` at the fitted rows, of the fitted terms only: a BRDF-only fit takes
-        the scattered ``S0`` from the Mueller matrix's first row (no ``eta``, ``P``, ``P_C``)."""
-        if not self._brdf_only:
-            return self.predict(model)
-        d = self.data
-        shape, M = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
-        M = M.reshape((4, 4) + shape)
-        s0 = np.einsum("b...n,nb->...n", M[0], d.incident)
-        return {"brdf": s0 / d.incident[:, 0]}
 
     # -- likelihood ----------------------------------------------------------------
     def _variances(self, noise):
@@ -214,7 +207,7 @@ class Likelihood:
             self.binding.check(model)  # vectorized: every walker's parameters at once
         except ValueError:
             return self._pointwise_valid(U)
-        return self._pointwise_rows(noise, self._predict_terms(model))
+        return self._pointwise_rows(noise, self.predict(model, terms=self.terms))
 
     def _pointwise_valid(self, U):
         """Rows of ``-inf`` for the positions the scene refuses (rebuilt and validated one by
@@ -250,7 +243,7 @@ class Likelihood:
         per-walker path before model sets; a ``ValueError`` where the scene refuses ``u``)."""
         values = self.spec.physical(u)
         return self._pointwise_rows(
-            self.spec.noise_values(values), self._predict_terms(self.model_rebuilt(values))
+            self.spec.noise_values(values), self.predict(self.model_rebuilt(values), terms=self.terms)
         )
 
     def pointwise(self, u) -> np.ndarray:
@@ -265,7 +258,7 @@ class Likelihood:
         """Residuals divided by their standard deviations (for least squares); large
         finite values where the model predicts no light."""
         values, noise = self.walkers(np.asarray(u, dtype=float)[None])
-        res = self.residuals(self._predict_terms(self.model(values)))
+        res = self.residuals(self.predict(self.model(values), terms=self.terms))
         var = self._variances(noise)
         out = []
         for t in self.terms:
