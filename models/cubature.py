@@ -53,7 +53,7 @@ class Cubature:
     """The result of :func:`adaptive`: ``value`` ``(k + 1, n_rows)`` the integrals, ``error``
     ``(n_rows,)`` the summed regional error estimates (the units of ``norm``), ``regions``
     ``(n_rows,)`` how many regions each row ended with, ``capped`` ``(n_rows,)`` True where a
-    row stopped at ``max_regions`` before meeting its budget."""
+    row stopped at ``max_regions`` before meeting its budget, or has an error that is not finite."""
 
     value: np.ndarray
     error: np.ndarray
@@ -188,13 +188,14 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
         row_err = np.bincount(row, weights=err, minlength=n_rows)
         count = np.bincount(row, minlength=n_rows)
         allowed = budget(total)
-        todo = row_err > allowed
-        capped |= todo & (count >= max_regions)
+        todo = ~(row_err <= allowed)  # a NaN error is not converged
+        # rows at the cap, or whose error is not finite (no split can repair it), are reported
+        capped |= todo & ((count >= max_regions) | ~np.isfinite(row_err))
         todo &= ~capped
         # the worst regions are split: those above both their fair share of the row's budget
         # and a fraction of the row's worst (the share alone would soon split nearly all)
         worst = np.zeros(n_rows)
-        np.maximum.at(worst, row, err)
+        np.maximum.at(worst, row, np.where(np.isfinite(err), err, 0.0))  # NaN rows are capped
         split = todo[row] & (err > np.maximum(allowed[row] / count[row], WORST * worst[row]))
         if not split.any():
             return Cubature(total, row_err, count, capped)

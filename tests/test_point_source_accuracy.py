@@ -10,6 +10,7 @@ import pytest
 
 import models
 import models.point_source as point_source
+from models import cubature
 from models.point_source import AUTO_FACTOR, AccuracyWarning
 
 S = models
@@ -324,3 +325,23 @@ def test_a_model_without_a_lobe_by_the_rim_meets_tol(k, foot):
     assert not acc.capped.any() and np.all(acc.error <= ps.tol)
     err = np.max(np.abs(acc.mueller - ref), axis=(-2, -1))
     assert np.all(err <= ps.tol * acc.scale), f"worst error / scale {np.max(err / acc.scale):.3g}"
+
+
+def test_a_row_whose_error_is_not_finite_is_reported_not_converged():
+    """A NaN in one row's integrand gives a NaN error estimate: that row is reported capped (so
+    PointSourceBRDF warns), the finite row still converges; NaN once counted as converged."""
+
+    def integrand(cell, u, v):
+        f = np.stack([np.where(cell[:, None] == 1, np.nan, np.sin(3.0 * u) * v)])
+        return f, np.ones_like(u)
+
+    res = cubature.adaptive(
+        integrand,
+        np.array([0, 1]),
+        2,
+        norm=lambda diff, value: np.abs(diff[0]),
+        budget=lambda value: np.full(2, 1e-10),
+        max_regions=1000,
+    )
+    assert list(res.capped) == [False, True]
+    assert res.error[0] <= 1e-10 and not np.isfinite(res.error[1])
