@@ -496,13 +496,13 @@ class PointSourceBRDF(_Wrapper):
             ok = tt < 0.5 * math.pi
             self._accumulate(out, self.model, np.broadcast_to(ti[:, None], tt.shape), tt, pp, w * ok, ok)
             return out
-        isotropic = self.model.rotated(1.0) is self.model
-        if isotropic:
-            self._accumulate(
-                out, self.model, psi, np.broadcast_to(tr[:, None], psi.shape), pr[:, None] - Phi, w, None
-            )
+        if self._rotates:  # the local models in one call per block of nodes (:meth:`_local`)
+            step = max(1, _BLOCK // ti.size)
+            for k0 in range(0, psi.shape[1], step):
+                sl = slice(k0, k0 + step)
+                out += np.einsum("eik,ik->ei", self._local(psi[:, sl], Phi[:, sl], tr, pr), w[:, sl])
             return out
-        # Anisotropic sample: rotate it per node; Phi depends on theta_i only.
+        # A sample that cannot rotate by an array: rotated per node; Phi depends on theta_i only.
         for t in np.unique(ti):
             rows = np.flatnonzero(ti == t)
             j0 = rows[0]
