@@ -48,6 +48,12 @@ WORST = 0.25
 GM_POINTS = GM_U.size
 
 
+class AccuracyWarning(RuntimeWarning):
+    """A refinement stopped at its cap before its estimated error met the tolerance (the
+    adaptive quadratures of :class:`models.PointSourceBRDF` and of
+    :func:`models.smooth_interface.film_hemispherical_reflectance`)."""
+
+
 @dataclass
 class Cubature:
     """The result of :func:`adaptive`: ``value`` ``(k + 1, n_rows)`` the integrals, ``error``

@@ -102,6 +102,7 @@ from scipy import signal
 
 from . import cubature
 from .base import Model, _Wrapper
+from .cubature import AccuracyWarning
 from .geometry import disc_quadrature
 from .params import param
 
@@ -143,10 +144,6 @@ _FIRST, _PRODUCT_MAX = (4, 8), 4096
 _BROAD = 2.0
 #: ``tol``: below ~1e-13 the rounding of the sums dominates; above 0.1 it is no statement
 _TOL_MIN, _TOL_MAX = 1e-13, 0.1
-
-
-class AccuracyWarning(RuntimeWarning):
-    """Some geometries reached the refinement cap before their estimated error met ``tol``."""
 
 
 @dataclass(frozen=True)

@@ -53,10 +53,12 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 
 import numpy as np
 from scipy import integrate
 
+from .cubature import AccuracyWarning
 from .fresnel import coating_cos, fresnel_reflectance
 from .thin_film import FilmStack
 
@@ -192,7 +194,8 @@ def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> floa
     times constants).  Composite 16-point Gauss-Legendre, panels doubled until two estimates
     differ by at most ``tol`` (interference fringes of thick films need many panels); at
     2^14 panels the last estimate stands (a film thousands of wavelengths thick, whose
-    fringes are finer than any measurement resolves).
+    fringes are finer than any measurement resolves), with an :class:`~models.cubature.AccuracyWarning`
+    giving the last two estimates' difference.
     """
     n = stack.indices[1].real
     up = stack.upward(1.0)
@@ -218,5 +221,11 @@ def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> floa
         new = estimate(panels)
         if abs(new - last) <= tol:
             return new
-        last = new
+        diff, last = abs(new - last), new
+    warnings.warn(
+        f"film_hemispherical_reflectance: {panels} panels, the last two estimates differ by {diff:.3g} "
+        f"(tol {tol:g}); the last stands",
+        AccuracyWarning,
+        stacklevel=2,
+    )
     return last

@@ -15,6 +15,7 @@ from test_thin_film import _absorbed
 import models
 import references
 from models import scene
+from models.cubature import AccuracyWarning
 from models.smooth_interface import (
     film_hemispherical_reflectance,
     film_transmission,
@@ -141,6 +142,15 @@ def test_hemispherical_reflectance_of_the_stack():
 
         want, _ = integrate.quad(r10, 0.0, 1.0, points=[1 / N**2], epsabs=1e-14, epsrel=1e-13, limit=500)
         assert abs(film_hemispherical_reflectance(st) - want) <= 1e-13
+
+
+def test_hemispherical_reflectance_warns_at_its_panel_cap():
+    """A tolerance no doubling can meet stops at 2^14 panels with an AccuracyWarning (the last
+    estimate still returned, within 1e-13 of the converged one), not silently."""
+    st = ABSORBING.on(N)
+    with pytest.warns(AccuracyWarning, match="16384 panels"):
+        got = film_hemispherical_reflectance(st, tol=-1.0)  # never met
+    assert abs(got - film_hemispherical_reflectance(st)) <= 1e-13
 
 
 # ------------------------------------------------------------------ the models
