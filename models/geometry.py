@@ -109,6 +109,16 @@ def broadcast_angles(*arrays):
     return shape, [np.ascontiguousarray(x).reshape(-1) for x in b]
 
 
+def polar_rule(n):
+    """``(t, chi, w)``, flat: Gauss-Legendre in ``t`` on [0, 1] (``n`` nodes) times the periodic
+    trapezoid rule in ``chi`` (``2 n`` nodes), ``w`` the product of their weights (no area
+    element: ``sum w f ~ int_0^1 int_0^2pi f dchi dt``).  :func:`disc_quadrature` and the point
+    source's polar cells build on it."""
+    x, wx = np.polynomial.legendre.leggauss(n)
+    chi = (np.arange(2 * n) + 0.5) * (np.pi / n)
+    return np.repeat(0.5 * (x + 1.0), 2 * n), np.tile(chi, n), np.repeat(0.5 * wx, 2 * n) * (np.pi / n)
+
+
 def disc_quadrature(n, radius, unit_weights=False):
     """Nodes ``(x, y)`` and weights ``w`` integrating over a disc of ``radius``
     (``sum w f(x, y) ~ integral f dA``): Gauss-Legendre in the radius (``n`` nodes,
@@ -120,10 +130,6 @@ def disc_quadrature(n, radius, unit_weights=False):
     ``unit_weights=True``: the weights of the unit disc (``radius^2`` times them are the
     disc's), for callers that use only their ratios: they never leave the float64 range,
     however large or small ``radius`` is."""
-    x, w = np.polynomial.legendre.leggauss(n)
-    r = 0.5 * radius * (x + 1.0)
-    wr = 0.5 * w * (0.5 * (x + 1.0)) if unit_weights else 0.5 * radius * w * r  # r dr
-    chi = (np.arange(2 * n) + 0.5) * (np.pi / n)
-    px = (r[:, None] * np.cos(chi)[None, :]).ravel()
-    py = (r[:, None] * np.sin(chi)[None, :]).ravel()
-    return px, py, np.repeat(wr, 2 * n) * (np.pi / n)
+    t, chi, w = polar_rule(n)
+    r = radius * t
+    return r * np.cos(chi), r * np.sin(chi), w * t if unit_weights else w * (radius * r)  # r dr

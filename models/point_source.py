@@ -103,7 +103,7 @@ from scipy import signal
 from . import cubature
 from .base import Model, _Wrapper
 from .cubature import AccuracyWarning
-from .geometry import disc_quadrature
+from .geometry import disc_quadrature, polar_rule
 from .params import param
 
 __all__ = ["PointSourceBRDF", "point_source_geometry", "Accuracy", "AccuracyWarning", "MAX_REGIONS"]
@@ -601,13 +601,9 @@ def _weighted_mean(M, J):
 
 
 def _product_nodes(n_r):
-    """``(t, chi, w)`` ``(1, K)``: Gauss-Legendre in ``t`` (``n_r`` nodes) times the periodic
-    trapezoid rule in ``chi`` (``2 n_r`` nodes); the area element is the integrand's."""
-    x, wx = np.polynomial.legendre.leggauss(n_r)
-    chi = (np.arange(2 * n_r) + 0.5) * (math.pi / n_r)
-    t = np.repeat(0.5 * (x + 1.0), 2 * n_r)[None, :]
-    w = np.repeat(0.5 * wx, 2 * n_r)[None, :] * (math.pi / n_r)
-    return t, np.tile(chi, n_r)[None, :], w
+    """``(t, chi, w)`` ``(1, K)`` of :func:`models.geometry.polar_rule`; the area element is the
+    integrand's."""
+    return tuple(a[None, :] for a in polar_rule(n_r))
 
 
 def _graded(beta, x):
