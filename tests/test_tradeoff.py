@@ -54,7 +54,9 @@ def test_choose_meets_tolerance_against_reference(results):
                         # a point whose error another point reaches with fewer evaluations is
                         # that point's duplicate (the same work: its CPU time differs by noise)
                         tie = p.error == pick.error and p.evaluations >= pick.evaluations
-                        duplicate = p not in tradeoff._untied(r.points)
+                        duplicate = any(
+                            q.error == p.error and q.evaluations < p.evaluations for q in r.points
+                        )
                         assert p.seconds >= pick.seconds or tie or duplicate
                         if tie and p.evaluations == pick.evaluations:
                             assert r.points.index(p) > r.points.index(pick)  # pick is the coarser
@@ -158,7 +160,6 @@ class _Clock:
 
 
 def test_time_call_measures_the_work_of_one_call(monkeypatch):
-    from validation.studies import tradeoff
 
     clock = _Clock()
     fake = types.SimpleNamespace(perf_counter=lambda: clock.wall, process_time=lambda: clock.cpu)
@@ -245,7 +246,7 @@ def test_precision_knob_is_unavailable_with_its_reason_without_a_float32_kernel(
 
 
 def test_scene_precision_is_decided_and_measured_on_the_scenes_model(monkeypatch):
-    from validation.studies import scenes, tradeoff
+    from validation.studies import scenes
 
     notes = []
     assert scenes._choose_precision(NO_KERNEL[0], 1e-3, notes) == "float64"

@@ -21,6 +21,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .common import mueller16
 from .facet import btdf_jones, cross3, dot3
 
 __all__ = ["estimate", "exit_transmittance"]
@@ -79,26 +80,6 @@ def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
 
 
 @njit(cache=True, inline="always")
-def _real_mueller(x, a, b, c, d):
-    """Add the Mueller elements of the real Jones matrix ``ss, ps, sp, pp = a, b, c, d`` to
-    ``x`` (:func:`models.polarization.mueller16_from_jones` with zero imaginary parts)."""
-    s_ = a * a + d * d
-    dd = a * a - d * d
-    o_ = b * b + c * c
-    od = c * c - b * b
-    x[0] += 0.5 * (s_ + o_)
-    x[1] += 0.5 * (dd + od)
-    x[4] += 0.5 * (dd - od)
-    x[5] += 0.5 * (s_ - o_)
-    x[2] += a * b + d * c
-    x[6] += a * b - d * c
-    x[8] += a * c + d * b
-    x[9] += a * c - d * b
-    x[10] += d * a + b * c
-    x[15] += d * a - b * c
-
-
-@njit(cache=True, inline="always")
 def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
     """One live pair's Mueller estimate into ``x``: the totally diffuse term and the single
     scattering (depolarizing: a scalar; polarized: the Jones chain of Eq. 4-5)."""
@@ -132,13 +113,19 @@ def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
             (ph[1][0] * ji[0] + ph[1][1] * ji[2], ph[1][0] * ji[1] + ph[1][1] * ji[3]),
         )
         root = math.sqrt(single * base * dens * depth * 2.0 / (1.0 + cos_scat * cos_scat))
-        _real_mueller(
-            x,
+        z = 0.0  # a real Jones matrix: its Mueller elements outside _REACHED are zero
+        m = mueller16(
             (jo[0] * t[0][0] + jo[1] * t[1][0]) * root,
+            z,
             (jo[0] * t[0][1] + jo[1] * t[1][1]) * root,
+            z,
             (jo[2] * t[0][0] + jo[3] * t[1][0]) * root,
+            z,
             (jo[2] * t[0][1] + jo[3] * t[1][1]) * root,
+            z,
         )
+        for e in _REACHED:
+            x[e] += m[e]
 
 
 @njit(cache=True)

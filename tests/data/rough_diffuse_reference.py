@@ -1,6 +1,6 @@
 """Write ``rough_diffuse_a0b9da6.npz``: RoughDiffuseBRDF's estimates (mean and standard
 error, 16 elements) and its rough R-bar as computed at commit a0b9da6, before the Monte
-Carlo was vectorized and compiled, so the tests hold today's paths to the same numbers.
+Carlo was compiled, so the tests hold today's paths to the same numbers.
 
     mkdir /tmp/a0b9da6 && git archive a0b9da6 | tar -x -C /tmp/a0b9da6
     PYTHONPATH=/tmp/a0b9da6 python tests/data/rough_diffuse_reference.py
