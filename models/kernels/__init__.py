@@ -6,7 +6,12 @@ One function per model evaluates one geometry in real arithmetic, with no tempor
 :mod:`~models.kernels.drive` loops it over flat arrays, serially for small calls and over
 the cores (``prange``) from :data:`PARALLEL_MIN` geometries on, writing the element-major
 ``(16, N)`` result directly.  Parameters are per element (a model set) or shared, so a
-likelihood evaluates all walkers of an emcee step in one call.
+likelihood evaluates all walkers of an emcee step in one call.  Float64 calls of the models
+whose kernels have no C library call left (:func:`~models.kernels.vector.vectorized`: the
+facet reflection models with exponential, Gaussian or GGX slopes and no shadowing, single
+scattering, the diffuse subsurface) run :mod:`~models.kernels.vector`'s loops instead, which
+compile to SIMD instructions (:mod:`~models.kernels.vector_math`: polynomial cosines, sines
+and exponentials) and give the scalar loop's bits.
 
 The numpy implementation of every model stays the reference (``with models.backend("numpy")``);
 the tests hold the kernels to it within 1e-12 relative to ``M00``.  A model's
@@ -94,7 +99,7 @@ def _caching_in(path):
 
 with _caching_in(cache_dir()):
     # montecarlo: RoughDiffuseBRDF's Monte Carlo, which the model imports itself
-    from . import drive, montecarlo  # noqa: E402, F401  (decorated here, cached there)
+    from . import drive, montecarlo, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
 class Compiled:
@@ -124,6 +129,7 @@ class Compiled:
         self.prm = {"float64": prm}
         self.iopt = np.zeros(drive.OPTIONS, dtype=np.int64)
         self.iopt[: len(options)] = options
+        self.vectorized = vector.vectorized(self.code, self.iopt)
 
     def params(self, precision):
         """The parameter rows in ``precision``; float32 rows take the angle rows (rotations)
@@ -140,7 +146,8 @@ class Compiled:
     def call(self, ti, tr, pr, out, start, precision="float64"):
         """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
-        fn = drive.run_parallel if n >= PARALLEL_MIN else drive.run
+        loops = vector if precision == "float64" and self.vectorized else drive
+        fn = loops.run_parallel if n >= PARALLEL_MIN else loops.run
         # contiguous inputs: one compiled specialization (and no view of a broadcast array)
         ti, tr, pr = (np.ascontiguousarray(x) for x in (ti, tr, pr))
         fn(self.code, ti, tr, pr, self.params(precision), self.iopt, out, start)

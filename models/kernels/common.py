@@ -25,6 +25,7 @@ from ..kernel_specs import (
     SHADOWING_KINDS,
     UNIT,
 )
+from .vector_math import REDUCED_MAX, exp_neg, sincos, sqrt
 
 NO_SHADOWING, SMITH = SHADOWING_KINDS["none"], SHADOWING_KINDS["smith"]
 
@@ -32,60 +33,69 @@ _SQRT6 = math.sqrt(6.0)
 _INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def polar(t):
     """``(cos t, sin t)`` of a polar angle ``t`` in its precision, the sine as the numpy path
     takes it, ``sqrt(1 - cos^2)``, both computed in float64: in float32 that formula loses the
     sine near normal incidence (``cos`` rounds to 1 below 3.5e-4 rad: off by up to 2.4e-4);
     from float64 the float32 sine is off by at most 1.125 float32 epsilons
     (``tests/test_float32_domain.py``)."""
+    return polar_from(sincos(t)[1], t)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def polar_from(c, t):
+    """:func:`polar` of ``t`` from its cosine ``c``, computed in float64."""
     T = type(t)
-    c = math.cos(np.float64(t))
-    return T(c), T(math.sqrt(1.0 - c * c))
+    return T(c), T(sqrt(1.0 - c * c))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
+def azimuth(p):
+    """``(cos p, sin p)`` of an azimuth (float64; :func:`~models.kernels.vector_math.sincos`,
+    the C library beyond its range)."""
+    if abs(p) <= REDUCED_MAX:
+        s, c = sincos(p)
+        return c, s
+    v = np.float64(p)
+    return math.cos(v), math.sin(v)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def internal_sine(c_int, s_ext, n):
     """Sine of the refracted angle in a coating ``n`` of cosine ``c_int``, external sine
     ``s_ext``: float64 ``sqrt(1 - c_int^2)`` (the numpy path's); float32 ``s_ext / n`` (Snell;
     the cosine near 1 has lost the sine, see :func:`polar`)."""
     T = type(c_int)
     if T(1e-300) > T(0.0):  # float64 (1e-300 is 0 in float32)
-        return math.sqrt(T(1.0) - c_int * c_int)
+        return sqrt(T(1.0) - c_int * c_int)
     return s_ext / n
 
 
-@njit(cache=True)
-def exp_neg(x):
-    """``exp(-x)`` for ``x >= 0``, exactly zero from 700 on (as :func:`models.slopes._exp_neg`)."""
-    T = type(x)
-    if x < T(700.0):
-        return math.exp(-x)
-    return T(0.0)
-
-
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def csqrt(a, b):
-    """Principal square root of ``a + ib`` (a ``+0`` imaginary part: the ``+i`` branch, TIR)."""
+    """Principal square root of ``a + ib`` (a ``+0`` imaginary part: the ``+i`` branch, TIR).
+    No call (a loop that uses it vectorizes; its branches become selects there)."""
     T = type(a)
     if a == T(0.0) and b == T(0.0):
         return T(0.0), T(0.0)
     # |a|, |b| are index-sized (up to |n + ik|^2 ~ 3.3e32): their squares overflow float32 from
-    # 1.8e19 and underflow below 1.1e-19 (float64 only near INDEX_MIN); hypot keeps r, hence
-    # t, finite and nonzero there
+    # 1.8e19 and underflow below 1.1e-19 (float64 only near INDEX_MIN); scaled by the larger,
+    # r (hence t) stays finite and nonzero there
     s = max(abs(a), abs(b))
     if T(1.0e-19) < s < T(1.0e19):
-        r = math.sqrt(a * a + b * b)
+        r = sqrt(a * a + b * b)
     else:
-        r = math.hypot(a, b)
+        a_s, b_s = a / s, b / s
+        r = s * sqrt(a_s * a_s + b_s * b_s)
     if a >= T(0.0):
-        t = math.sqrt((a + r) * T(0.5))
+        t = sqrt((a + r) * T(0.5))
         return t, b / (T(2.0) * t)
-    t = math.sqrt((r - a) * T(0.5))
+    t = sqrt((r - a) * T(0.5))
     return abs(b) / (T(2.0) * t), math.copysign(t, b)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def cdiv(a, b, c, d):
     """``(a + ib) / (c + id)`` as numpy divides complex numbers (Smith's algorithm with one
     reciprocal, ``scl = 1 / den``, and two products: bit for bit numpy's result, and one
@@ -100,7 +110,7 @@ def cdiv(a, b, c, d):
     return (a * r + b) * scl, (b * r - a) * scl
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def refraction_w(c, mr, mi):
     """``m^2`` and ``w = m cos(theta_t) = sqrt(m^2 - 1 + c^2)`` (principal branch) as
     ``(re, im)`` pairs, for cosine ``c`` and relative index ``m = mr + i mi``
@@ -112,7 +122,7 @@ def refraction_w(c, mr, mi):
     return m2r, m2i, wr, wi
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def rs_k(c, mr, mi, pec):
     """``r_s`` and ``K = (r_s + r_p) / sin^2`` at cosine ``c`` for relative index ``m = mr + i mi``
     (:func:`models.fresnel.reflection_rs_k`); ``pec``: a perfect conductor."""
@@ -131,23 +141,23 @@ def rs_k(c, mr, mi, pec):
     return rsr, rsi, kr, ki
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def coating_cos(c, n):
     """Cosine of the refracted angle in a non-absorbing coating ``n`` from the external cosine
     ``c`` (:func:`models.fresnel.coating_cos`: no cancellation near grazing)."""
     T = type(c)
-    return math.sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)
+    return sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def coating_t(c, n):
     """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`models.fresnel.coating_transmission`)."""
     T = type(c)
-    w = math.sqrt(n * n - T(1.0) + c * c)
+    w = sqrt(n * n - T(1.0) + c * c)
     return T(2.0) * c / (c + w), T(2.0) * n * c / (n * n * c + w)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def p3(kind, zx, zy, sx, sy, rot, cov):
     """Slope density ``P3^xy`` of ``kind`` at ``(zx, zy)``; ``sx``, ``sy`` the widths (sigma,
     alpha; ``m_parallel``, ``m_perpendicular`` for strokes), ``rot`` the axes' rotation."""
@@ -156,7 +166,7 @@ def p3(kind, zx, zy, sx, sy, rot, cov):
     if kind == UNIT:
         return T(1.0)
     if kind == EXPONENTIAL:
-        z = math.sqrt(zx * zx + zy * zy)
+        z = sqrt(zx * zx + zy * zy)
         return cov * ((T(3.0) / (pi * sx * sx)) * exp_neg(T(_SQRT6) * z / sx))
     if kind == GAUSSIAN:
         return cov * (exp_neg((zx * zx + zy * zy) / (sx * sx)) / (pi * sx * sx))
@@ -168,7 +178,7 @@ def p3(kind, zx, zy, sx, sy, rot, cov):
     u = c * zx + s * zy
     v = -s * zx + c * zy
     if kind == ANISO_EXPONENTIAL:
-        r = math.sqrt((u / sx) ** 2 + (v / sy) ** 2)
+        r = sqrt((u / sx) ** 2 + (v / sy) ** 2)
         return cov * (T(3.0) / (pi * sx * sy) * exp_neg(T(_SQRT6) * r))
     if kind == ANISO_GAUSSIAN:
         return cov * (exp_neg((u / sx) ** 2 + (v / sy) ** 2) / (pi * sx * sy))
@@ -178,7 +188,7 @@ def p3(kind, zx, zy, sx, sy, rot, cov):
     return cov * (stroke_d(zx, zy, T(1.0), sx, sy, c, s) / pi)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     """``exp(-tan^2 alpha / m(beta)^2) / m(beta)^2`` for a bisector ``h`` (seed 001 Eq. 8, 19;
     :func:`models.stroke_slopes.stroke_d`); ``c``, ``s``: cosine and sine of the strokes' azimuth."""
@@ -196,7 +206,7 @@ def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     return exp_neg(q / hz2) * inv_m2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def lam_unit(kind, mu):
     """Smith ``Lambda`` of the unit-width Gaussian or GGX family at ``mu = |cot theta|``."""
     T = type(mu)
@@ -208,10 +218,10 @@ def lam_unit(kind, mu):
     if mu == T(0.0):
         return T(math.inf)
     x = T(1.0) / mu
-    return T(0.5) * x * x / (T(1.0) + math.sqrt(T(1.0) + x * x))
+    return T(0.5) * x * x / (T(1.0) + sqrt(T(1.0) + x * x))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
     """Smith ``Lambda`` (:func:`models.shadowing.smith_lambda`) of the Gaussian and GGX
     families, isotropic or elliptical, for a direction (cosine, sine, azimuth)."""
@@ -223,11 +233,11 @@ def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
         cr, sr = math.cos(rot), math.sin(rot)
         cl = cphi * cr + sphi * sr
         sl = sphi * cr - cphi * sr
-        alpha = math.sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
+        alpha = sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
     return lam_unit(kind, mu / alpha)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def smith_g(shadowing, kind, di, dio, sx, sy, rot):
     """Shadowing-masking ``G`` for directions ``di``, ``dio`` = ``(cos, sin, cos phi, sin phi)``
     (no back-facing test: both see the facet from its front)."""
@@ -239,7 +249,7 @@ def smith_g(shadowing, kind, di, dio, sx, sy, rot):
     return T(1.0) / (T(1.0) + (li + lo))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     """The 16 Mueller elements (row-major) of a Jones matrix (Bohren & Huffman, as
     :func:`models.polarization.mueller16_from_jones`)."""
@@ -267,14 +277,14 @@ def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     )  # fmt: skip
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def diag16(m00):
     """A depolarizer ``diag(m00, 0, 0, 0)`` (the scalar models)."""
     z = type(m00)(0.0)
     return (m00, z, z, z, z, z, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def scaled16(m, f):
     """The 16 elements ``m`` times ``f``."""
     return (

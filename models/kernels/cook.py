@@ -10,12 +10,13 @@ from numba import njit
 
 from ..kernel_specs import ANISO_GAUSSIAN, GAUSSIAN
 from .common import SMITH, cdiv, coating_cos, diag16, internal_sine, polar, refraction_w, smith_g, stroke_d
+from .vector_math import sqrt
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def fresnel_average(c, mr, mi, pec):
     """Natural-light reflectance ``(|r_s|^2 + |r_p|^2) / 2`` at cosine ``c`` for relative index
     ``mr + i mi`` (:func:`models.cook_torrance.fresnel_average`)."""
@@ -31,7 +32,7 @@ def fresnel_average(c, mr, mi, pec):
     return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
     and sines ``si``, ``sr``;
@@ -48,7 +49,7 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     # the strokes' azimuth matters only for unequal m (stroke_d); two trig calls saved otherwise
     ca, sa = (T(1.0), T(0.0)) if p[3] == p[4] else (math.cos(p[5]), math.sin(p[5]))
     val = stroke_d(hx, hy, hz2, p[3], p[4], ca, sa) * (q * q)
-    val *= fresnel_average(T(0.5) * math.sqrt(g), mr, mi, mr == T(math.inf))
+    val *= fresnel_average(T(0.5) * sqrt(g), mr, mi, mr == T(math.inf))
     if shadowing == 1:
         t = (T(4.0) / g) * hz
         val *= min(T(1.0), t * min(ci, cr))
@@ -58,17 +59,17 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     return val
 
 
-@njit(cache=True, inline="always")
-def cook(ti, tr, pr, p, o):
+@njit(cache=True, error_model="numpy", inline="always")
+def cook(geo, p, o):
     """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
     convention, ``o[2]``: the shadowing (:data:`models.kernel_specs.COOK_SHADOWING`)."""
+    ti, tr, _, cp, sp = geo
     T = type(ti)
     half_pi = T(0.5 * math.pi)
     if ti >= half_pi or tr >= half_pi:
         return diag16(T(0.0))
     ci, si = polar(ti)
     cr, sr = polar(tr)
-    cp, sp = math.cos(pr), math.sin(pr)
     nv, sub_r, sub_i = p[0], p[1], p[2]
     if o[0] == 0:
         val = ct_value(ci, si, cr, sr, cp, sp, p, sub_r, sub_i, o[2])

@@ -15,6 +15,7 @@ import math
 
 from numba import njit, prange
 
+from .common import azimuth
 from .cook import COOK_ROWS, cook
 from .facet import BTDF_ROWS, FACET_ROWS, btdf, facet
 from .maxwell import MAXWELL_ROWS, maxwell
@@ -40,38 +41,46 @@ OPTIONS = 3
 assert PARAM_ROWS == 11, "params() reads 11 rows"
 
 
-@njit(cache=True, inline="always")
-def element(code, a, b, c, p, o):
-    """The 16 Mueller elements of one geometry of model ``code``; ``p``, ``o``: its parameters
-    and options as tuples (no array enters the inlined kernels: numba would count references
-    to it with atomic operations in every geometry)."""
+@njit(cache=True, error_model="numpy", inline="always")
+def element(code, g, p, o):
+    """The 16 Mueller elements of one geometry ``g`` (:func:`geometry`) of model ``code``;
+    ``p``, ``o``: its parameters and options as tuples (no array enters the inlined kernels:
+    numba would count references to it with atomic operations in every geometry)."""
     if code == FACET:
-        return facet(a, b, c, p, o)
+        return facet(g, p, o)
     if code == BTDF:
-        return btdf(a, b, c, p, o)
+        return btdf(g, p, o)
     if code == SINGLE:
-        return single(a, b, c, p, o)
+        return single(g, p, o)
     if code == DIFFUSE:
-        return diffuse(a, b, c, p, o)
+        return diffuse(g, p, o)
     if code == COOK:
-        return cook(a, b, c, p, o)
-    return maxwell(a, b, c, p, o)
+        return cook(g, p, o)
+    return maxwell(g, p, o)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
+def geometry(ti, tr, pr):
+    """``(theta_i, theta_r, phi_r, cos phi_r, sin phi_r)`` in the angles' precision."""
+    T = type(pr)
+    c, s = azimuth(pr)
+    return ti, tr, pr, T(c), T(s)
+
+
+@njit(cache=True, error_model="numpy")
 def params(prm, j):
     """Column ``j`` of the parameter rows as a tuple."""
     return (prm[0, j], prm[1, j], prm[2, j], prm[3, j], prm[4, j], prm[5, j],
             prm[6, j], prm[7, j], prm[8, j], prm[9, j], prm[10, j])  # fmt: skip
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def options(iopt):
     """The options as a tuple."""
     return (iopt[0], iopt[1], iopt[2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def store(out, i, m):
     """The elements ``m`` into ``out[:, i]`` (only ``M00`` when ``out`` has one row)."""
     out[0, i] = m[0]
@@ -87,23 +96,42 @@ def store(out, i, m):
 BLOCK = 1024
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
+def _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi):
+    """:func:`run_range`'s loop for one kernel (compiled once per kernel: a loop that
+    dispatches on the model per geometry holds every kernel's code and runs slower)."""
+    a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
+    for i in range(lo, hi):
+        g = geometry(ti[i * a], tr[i * b], pr[i * c])
+        store(out, start + i, kernel(g, params(prm, i * p), o))
+
+
+@njit(cache=True, error_model="numpy")
 def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
     """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``, serially."""
-    a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
     o = options(iopt)
-    for i in range(lo, hi):
-        store(out, start + i, element(code, ti[i * a], tr[i * b], pr[i * c], params(prm, i * p), o))
+    if code == FACET:
+        _serial(facet, ti, tr, pr, prm, o, out, start, lo, hi)
+    elif code == BTDF:
+        _serial(btdf, ti, tr, pr, prm, o, out, start, lo, hi)
+    elif code == SINGLE:
+        _serial(single, ti, tr, pr, prm, o, out, start, lo, hi)
+    elif code == DIFFUSE:
+        _serial(diffuse, ti, tr, pr, prm, o, out, start, lo, hi)
+    elif code == COOK:
+        _serial(cook, ti, tr, pr, prm, o, out, start, lo, hi)
+    else:
+        _serial(maxwell, ti, tr, pr, prm, o, out, start, lo, hi)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run(code, ti, tr, pr, prm, iopt, out, start):
     """Serial loop over the geometries ``0 .. len - 1`` of the inputs, into ``out[:, start + i]``."""
     n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
     run_range(code, ti, tr, pr, prm, iopt, out, start, 0, n)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def run_parallel(code, ti, tr, pr, prm, iopt, out, start):
     """:func:`run` with blocks of :data:`BLOCK` geometries spread over the cores (``prange``;
     each block the serial loop, which compiles to tighter code than a ``prange`` body)."""
@@ -113,7 +141,7 @@ def run_parallel(code, ti, tr, pr, prm, iopt, out, start):
         run_range(code, ti, tr, pr, prm, iopt, out, start, lo, min(lo + BLOCK, n))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_checked(code, ti, tr, pr, prm, iopt, out):
     """:func:`run` from column 0 when every angle is valid (:func:`angles_ok`), returning True;
     False, writing nothing, otherwise (one call into numba for a small call)."""
@@ -123,13 +151,13 @@ def run_checked(code, ti, tr, pr, prm, iopt, out):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_one(code, ti, tr, pr, prm, iopt, out):
     """One geometry given as scalars (the small-call path)."""
-    store(out, 0, element(code, ti, tr, pr, params(prm, 0), options(iopt)))
+    store(out, 0, element(code, geometry(ti, tr, pr), params(prm, 0), options(iopt)))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def angles_ok(ti, tr, pr):
     """True when every polar angle lies in [0, pi/2] and every azimuth is finite (the small-call
     path's validation; the general path raises the error that names the angle)."""

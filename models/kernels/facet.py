@@ -10,26 +10,34 @@ import math
 from numba import njit
 
 from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, rs_k, smith_g
+from .vector_math import sqrt
 
 #: parameter rows of the facet reflection kernel
 FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
 
 
-@njit(cache=True, inline="always")
-def facet_jones(ti, tr, pr, p, o):
+@njit(cache=True, error_model="numpy", inline="always")
+def facet_jones(g, p, o):
     """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
-    Mueller matrix is the BRDF (:func:`models.facet.facet_jones`)."""
+    Mueller matrix is the BRDF (:func:`models.facet.facet_jones`); ``g``: the geometry
+    (:func:`models.kernels.drive.geometry`)."""
+    return facet_jones_at(g, polar(g[0]), polar(g[1]), p, o)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def facet_jones_at(g, pol_i, pol_r, p, o):
+    """:func:`facet_jones` given the polar angles' ``(cos, sin)`` (:func:`~models.kernels.common.polar`)."""
+    ti, tr, _, cp, sp = g
     T = type(ti)
     n, sub_r, sub_i = p[0], p[1], p[2]
-    ci_e, si_e = polar(ti)
-    cr_e, sr_e = polar(tr)
+    ci_e, si_e = pol_i
+    cr_e, sr_e = pol_r
     if n == T(1.0):
         si, sr, ci, cr = si_e, sr_e, ci_e, cr_e
     else:
         inv_n = T(1.0) / n
         si, sr = si_e * inv_n, sr_e * inv_n
         ci, cr = coating_cos(ci_e, n), coating_cos(cr_e, n)
-    sp, cp = math.sin(pr), math.cos(pr)
     hx = sr * cp - si
     hy = sr * sp
     hz = cr + ci
@@ -43,7 +51,7 @@ def facet_jones(ti, tr, pr, p, o):
         S = T(0.0)
     if o[1] != NO_SHADOWING:
         S = S * smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], p[5])
-    c = T(0.5) * math.sqrt(g)
+    c = T(0.5) * sqrt(g)
     rsr, rsi, kr, ki = rs_k(c, sub_r / n, sub_i / n, sub_r == T(math.inf))
     inv_g = T(1.0) / g
     ho_s, ho_p = si * sp, cr * cp * si + sr * ci
@@ -55,7 +63,7 @@ def facet_jones(ti, tr, pr, p, o):
         ho_s, ho_p, hi_s, hi_p = ho_s * tsr, ho_p * tpr, hi_s * tsi, hi_p * tpi
         d_ss, d_ps = d_ss * (tsr * tsi), d_ps * (tsr * tpi)
         d_sp, d_pp = d_sp * (tpr * tsi), d_pp * (tpr * tpi)
-    root = math.sqrt(S)
+    root = sqrt(S)
     r_re, r_im = rsr * root, rsi * root
     k_re = kr * root - T(2.0) * r_re
     k_im = ki * root - T(2.0) * r_im
@@ -72,10 +80,10 @@ def facet_jones(ti, tr, pr, p, o):
     )
 
 
-@njit(cache=True, inline="always")
-def facet(ti, tr, pr, p, o):
+@njit(cache=True, error_model="numpy", inline="always")
+def facet(geo, p, o):
     """:class:`models.FacetBRDF` and :class:`models.SubsurfaceFacetBRDF` at one geometry."""
-    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, p, o)
+    a, b, c, d, e, f, g, h = facet_jones(geo, p, o)
     return mueller16(a, b, c, d, e, f, g, h)
 
 
@@ -83,17 +91,17 @@ def facet(ti, tr, pr, p, o):
 BTDF_ROWS = ("substrate", "sx", "sy", "rotation", "coverage")
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dot3(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cross3(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def transmission_factors(c, mr):
     """``t_s`` and ``(t_p - t_s) / sin^2`` of refraction at local cosine ``c`` into relative
     index ``mr`` (zero beyond the critical angle), as :func:`models.facet_btdf.facet_transmission_jones`."""
@@ -101,7 +109,7 @@ def transmission_factors(c, mr):
     arg = mr * mr - T(1.0) + c * c
     if not arg > T(0.0):
         return T(0.0), T(0.0)
-    w = math.sqrt(arg)
+    w = sqrt(arg)
     den_s = c + w
     if not den_s > T(0.0):
         return T(0.0), T(0.0)
@@ -114,7 +122,7 @@ def transmission_factors(c, mr):
     return ts, delta * (T(1.0) / (w + mr * c))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     """Real Jones elements ``(ss, ps, sp, pp)`` of refraction through facet ``m`` and the local
     cosines ``(cos iota_in, cos iota_out)`` (the dyadic of seed 003 Eq. 40, Rodrigues' rotation)."""
@@ -136,16 +144,17 @@ def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     return ss, ps, sp, pp, c, c_out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _btdf_element(ea, eb, v, a_in, a_out, cg, inv1, ts, delta):
     """One element of :func:`btdf_jones`: out-basis vector ``ea``, in-basis vector ``eb``."""
     rot = cg * dot3(ea, eb) + dot3(ea, cross3(v, eb)) + dot3(ea, v) * dot3(v, eb) * inv1
     return ts * rot + delta * dot3(ea, a_out) * dot3(a_in, eb)
 
 
-@njit(cache=True, inline="always")
-def btdf(ti, tt, pt, p, o):
+@njit(cache=True, error_model="numpy", inline="always")
+def btdf(g, p, o):
     """:class:`models.FacetBTDF` (``convention="paper"``) at one geometry."""
+    ti, tt, pt, _, _ = g
     T = type(ti)
     n = p[0]
     si, ci = math.sin(ti), math.cos(ti)
@@ -155,7 +164,7 @@ def btdf(ti, tt, pt, p, o):
     k_out = (st * cp, st * sp, -ct)
     h = (k_in[0] - n * k_out[0], k_in[1] - n * k_out[1], k_in[2] - n * k_out[2])
     D2 = dot3(h, h)
-    D = math.sqrt(D2)
+    D = sqrt(D2)
     mz = h[2] / D
     half_pi = T(0.5 * math.pi)
     if not (mz > T(0.0) and n * dot3(k_in, k_out) - T(1.0) > T(0.0) and ti < half_pi and tt < half_pi):
@@ -175,6 +184,6 @@ def btdf(ti, tt, pt, p, o):
         g = smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (-ct, st, cp, sp), p[1], p[2], p[3])
         # back-facing (chi+) tests of Walter et al. Eq. 21-23: both local cosines positive here
         S = S * (g if (c_in * ci > T(0.0) and c_out * ct > T(0.0)) else T(0.0))
-    root = math.sqrt(S)
+    root = sqrt(S)
     zr = z[0]
     return mueller16(ss * root, zr, ps * root, zr, sp_ * root, zr, pp * root, zr)

@@ -6,26 +6,27 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
-from .common import diag16, mueller16, scaled16
-from .facet import FACET_ROWS, facet_jones
+from .common import diag16, mueller16, polar_from, scaled16
+from .facet import FACET_ROWS, facet_jones_at
+from .vector_math import sqrt
 
 #: parameter rows: the facet kernel's, then rho_d, rho_v, tau, omega
 MAXWELL_ROWS = FACET_ROWS + ("rho_d", "rho_v", "tau", "omega")
 
 
-@njit(cache=True)
-def shadow(ti, tr, pr, tau, omega):
-    """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`models.maxwell_beard.maxwell_beard_shadow`)."""
-    T = type(ti)
-    si, ci, sr, cr = math.sin(ti), math.cos(ti), math.sin(tr), math.cos(tr)
-    cp = math.cos(pr)
+@njit(cache=True, error_model="numpy")
+def shadow(si, ci, sr, cr, cp, tau, omega):
+    """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`models.maxwell_beard.maxwell_beard_shadow`)
+    from the angles' sines and cosines."""
+    T = type(si)
     t = si * si - T(2.0) * si * sr * cp + sr * sr
     den = ci + cr
-    slope = math.sqrt(max(t, T(0.0))) / (den if den > T(0.0) else T(1.0))
+    slope = sqrt(max(t, T(0.0))) / (den if den > T(0.0) else T(1.0))
     theta_n = math.atan(slope)
-    cos_beta = math.sqrt(min(max(T(0.5) * (T(1.0) - si * sr * cp + ci * cr), T(0.0)), T(1.0)))
+    cos_beta = sqrt(min(max(T(0.5) * (T(1.0) - si * sr * cp + ci * cr), T(0.0)), T(1.0)))
     beta = math.acos(min(cos_beta, T(1.0)))
     x = theta_n / omega
     e = math.exp(-T(2.0) * beta / tau)
@@ -34,17 +35,22 @@ def shadow(ti, tr, pr, tau, omega):
     return (T(1.0) + x * e) / (T(1.0) + x)
 
 
-@njit(cache=True, inline="always")
-def maxwell(ti, tr, pr, p, o):
+@njit(cache=True, error_model="numpy", inline="always")
+def maxwell(geo, p, o):
     """Maxwell-Beard at one geometry; ``o[2]``: the facet Mueller matrix on the specular term."""
+    ti, tr, pr = geo[0], geo[1], geo[2]
     T = type(ti)
-    so = shadow(ti, tr, pr, p[9], p[10])
-    a, b, c, d, e, f, g, h = facet_jones(ti, tr, pr, p, o)
+    # the C library's cosines and sines, as numpy's: near retroreflection ``beta = acos(~1)``
+    # in :func:`shadow` turns an ulp of them into 1e-10 of the result
+    si, ci, sr, cr = math.sin(ti), math.cos(ti), math.sin(tr), math.cos(tr)
+    cp, sp = math.cos(pr), math.sin(pr)
+    so = shadow(si, ci, sr, cr, cp, p[9], p[10])
+    pol_i, pol_r = polar_from(math.cos(np.float64(ti)), ti), polar_from(math.cos(np.float64(tr)), tr)
+    a, b, c, d, e, f, g, h = facet_jones_at((ti, tr, pr, cp, sp), pol_i, pol_r, p, o)
     if o[2] == 1:
         m = scaled16(mueller16(a, b, c, d, e, f, g, h), so)
     else:
         m = diag16(T(0.5) * ((a * a + b * b) + (c * c + d * d) + (e * e + f * f) + (g * g + h * h)) * so)
-    ci, cr = math.cos(ti), math.cos(tr)
     den = ci + cr
     vol = T(2.0) * p[8] / (den if den > T(0.0) else T(1.0))
     half_pi = T(0.5 * math.pi)

@@ -9,13 +9,14 @@ import math
 from numba import njit
 
 from .common import coating_cos, mueller16, polar
+from .vector_math import sqrt
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
 SINGLE_ROWS = ("coating", "g")
 DIFFUSE_ROWS = ("coating", "scale")
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", forceinline=True)
 def amplitudes(c, s, n):
     """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`
     for the external cosine and sine ``c``, ``s`` (:func:`models.kernels.common.polar`)."""
@@ -26,7 +27,7 @@ def amplitudes(c, s, n):
         c, s = T(0.0), T(1.0)
     s_int = s * (T(1.0) / n)
     c_int = coating_cos(c, n)
-    root = T(2.0) * math.sqrt(c * c_int)
+    root = T(2.0) * sqrt(c * c_int)
     # n = 1 at grazing: both denominators vanish with the numerator (no projected flux): 0;
     # otherwise root / den <= 1 (den >= c + c_int >= root for n >= 1), so no guard is needed
     den_s, den_p = c + n * c_int, n * c + c_int
@@ -35,7 +36,7 @@ def amplitudes(c, s, n):
     return s_int, c_int, a_s, a_p
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def depolarized16(asi, api, asr, apr, scale):
     """:func:`models.smooth_interface.depolarized_between`'s 16 elements."""
     T = type(asi)
@@ -48,25 +49,25 @@ def depolarized16(asi, api, asr, apr, scale):
     return (s_out * s_in, s_out * d_in, z, z, d_out * s_in, d_out * d_in, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(cache=True, inline="always")
-def single(ti, tr, pr, p, o):
+@njit(cache=True, error_model="numpy", inline="always")
+def single(geo, p, o):
     """Single scattering under a smooth interface (seed 003 Eq. 20); ``o[0]``: polarized phase."""
+    ti, tr, _, cp, sp = geo
     T = type(ti)
     n, g = p[0], p[1]
     ci_e, si_e = polar(ti)
     cr_e, sr_e = polar(tr)
     si, ci, asi, api = amplitudes(ci_e, si_e, n)
     sr, cr, asr, apr = amplitudes(cr_e, sr_e, n)
-    cp, sp = math.cos(pr), math.sin(pr)
     cos_scat = si * sr * cp - ci * cr
     base = T(1.0) + g * g - T(2.0) * g * cos_scat
-    dens = (T(1.0) - g * g) / (T(4.0 * math.pi) * base * math.sqrt(base))
+    dens = (T(1.0) - g * g) / (T(4.0 * math.pi) * base * sqrt(base))
     # both internal cosines zero (grazing under n = 1): no projected flux and zero amplitudes;
     # dens / tiny would overflow float32 and give inf * 0
     K = dens / (ci + cr) if ci + cr > T(0.0) else T(0.0)
     if o[0] == 0:
         return depolarized16(asi, api, asr, apr, K)
-    root = math.sqrt(T(2.0) * K / (T(1.0) + cos_scat * cos_scat))
+    root = sqrt(T(2.0) * K / (T(1.0) + cos_scat * cos_scat))
     ss = asr * asi * root * cp
     ps = -(asr * api * root) * sp * ci
     sp_ = -(apr * asi * root) * sp * cr
@@ -75,9 +76,10 @@ def single(ti, tr, pr, p, o):
     return mueller16(ss, z, ps, z, sp_, z, pp, z)
 
 
-@njit(cache=True, inline="always")
-def diffuse(ti, tr, pr, p, o):
+@njit(cache=True, error_model="numpy", inline="always")
+def diffuse(geo, p, o):
     """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``p[1]``: its scale."""
+    ti, tr = geo[0], geo[1]
     n = p[0]
     ci_e, si_e = polar(ti)
     cr_e, sr_e = polar(tr)

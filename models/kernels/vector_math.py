@@ -1,0 +1,105 @@
+"""Cosine, sine and ``exp(-x)`` in float64 without a call: code the compiler vectorizes.
+
+A call to the C library's ``cos``, ``sin`` or ``exp`` costs about 5-10 ns per value and
+keeps any loop around it scalar: in the facet kernel those calls were a fifth of a
+geometry's cost, and they stopped the whole loop from running on SIMD lanes.  The
+functions here are polynomials with no branch and no call, so a loop over geometries that
+uses them (and only arithmetic and ``sqrt`` besides) compiles to vector instructions
+(:func:`models.kernels.drive.run_vector`).
+
+:func:`sincos` uses Cody and Waite's reduction and Taylor series: ``x = k pi/2 + r`` with
+``k`` the nearest integer to ``2x/pi`` and ``|r| <= pi/4``; ``pi/2`` is split in three
+parts, the first two of 30 significant bits, so ``k * part`` is exact for ``|k| < 2^23``
+and ``r`` is exact to about an ulp of ``x`` up to :data:`REDUCED_MAX`.  On ``|r| <= pi/4``
+the series of ``sin`` to ``r^17`` and of ``cos`` to ``r^16`` leave less than 1e-17 (the
+next terms).  Beyond :data:`REDUCED_MAX` (an azimuth of 1e6 rad) the result is wrong: the
+callers use the C library there (:func:`models.kernels.drive.azimuth`).
+
+:func:`exp_neg` reduces ``-x = k ln 2 + r`` (``ln 2`` in two parts), ``|r| <= ln2 / 2``,
+takes the Taylor series of ``exp r`` to ``r^13`` (the next term: 4e-18) and scales by
+``2^k`` built from its bits.  From ``x = 700`` on it is exactly zero, as the numpy path's
+:func:`models.slopes._exp_neg`.
+
+Both agree with the C library within 2 ulp (``tests/test_vector_math.py`` measures it).
+Float32 arguments are computed in float64 and rounded.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
+
+#: ``pi/2`` in three parts: 30 + 30 significant bits, and the rest
+_P1, _P2, _P3 = 1.570796325802803, 9.920935791635221e-10, 5.170182981794105e-19
+_TWO_OVER_PI = 0.6366197723675814
+#: the largest ``|x|`` :func:`sincos` reduces exactly (``k < 2^23`` with margin)
+REDUCED_MAX = 1.0e6
+# Taylor coefficients, sin: (-1)^k / (2k + 1)!, cos: (-1)^k / (2k)!, k = 1 .. 8
+S1, S2, S3, S4, S5, S6, S7, S8 = ((-1) ** k / math.factorial(2 * k + 1) for k in range(1, 9))
+C1, C2, C3, C4, C5, C6, C7, C8 = ((-1) ** k / math.factorial(2 * k) for k in range(1, 9))
+#: ``ln 2`` in two parts (the first with 32 significant bits: ``k * _LN2_HI`` exact)
+_LN2_HI, _LN2_LO = 6.93147180369123816490e-01, 1.90821492927058770002e-10
+_INV_LN2 = 1.4426950408889634
+# 1 / k!, k = 2 .. 13
+E2, E3, E4, E5, E6, E7, E8, E9, E10, E11, E12, E13 = (1.0 / math.factorial(k) for k in range(2, 14))
+#: from here on ``exp(-x)`` is exactly zero (as the numpy path's)
+EXP_ZERO = 700.0
+
+
+@intrinsic
+def _from_bits(typingctx, bits):
+    """The float64 whose IEEE bits are the int64 ``bits`` (a register move, vectorizable)."""
+    sig = types.float64(types.int64)
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.DoubleType())
+
+    return sig, codegen
+
+
+@intrinsic
+def sqrt(typingctx, x):
+    """``math.sqrt`` as the ``llvm.sqrt`` intrinsic: numba calls the C library's ``sqrt``,
+    which the vectorizer leaves alone (same IEEE result; NaN below zero, as both)."""
+    if not isinstance(x, types.Float):
+        return None
+
+    def codegen(context, builder, signature, args):
+        fn = builder.module.declare_intrinsic("llvm.sqrt", [context.get_value_type(signature.args[0])])
+        return builder.call(fn, args)
+
+    return x(x), codegen
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sincos(x):
+    """``(sin x, cos x)`` in float64 for ``|x| <= REDUCED_MAX`` (no branch, no call)."""
+    v = np.float64(x)
+    q = np.rint(v * _TWO_OVER_PI)
+    r = ((v - q * _P1) - q * _P2) - q * _P3
+    r2 = r * r
+    s = r + r * r2 * (S1 + r2 * (S2 + r2 * (S3 + r2 * (S4 + r2 * (S5 + r2 * (S6 + r2 * (S7 + r2 * S8)))))))
+    c = 1.0 + r2 * (C1 + r2 * (C2 + r2 * (C3 + r2 * (C4 + r2 * (C5 + r2 * (C6 + r2 * (C7 + r2 * C8)))))))
+    quad = np.int64(q) & 3
+    odd = (quad & 1) == 1
+    sv = c if odd else s
+    cv = s if odd else c
+    return (-sv if quad >= 2 else sv), (-cv if (quad == 1 or quad == 2) else cv)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def exp_neg(x):
+    """``exp(-x)`` in the precision of ``x >= 0``, exactly zero from :data:`EXP_ZERO` on."""
+    T = type(x)
+    v = np.float64(x)
+    y = -min(v, EXP_ZERO)
+    k = np.rint(y * _INV_LN2)
+    r = (y - k * _LN2_HI) - k * _LN2_LO
+    p = E9 + r * (E10 + r * (E11 + r * (E12 + r * E13)))
+    p = 1.0 + r * (1.0 + r * (E2 + r * (E3 + r * (E4 + r * (E5 + r * (E6 + r * (E7 + r * (E8 + r * p))))))))
+    e = p * _from_bits((np.int64(k) + 1023) << 52)
+    return T(e if v < EXP_ZERO else 0.0)

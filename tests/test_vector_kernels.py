@@ -1,0 +1,125 @@
+"""The vectorized loops (:mod:`models.kernels.vector`) and their call-free math
+(:mod:`models.kernels.vector_math`): the same bits as the scalar loop, compiled to SIMD
+instructions, and the polynomials within 2 ulp of the C library."""
+
+import math
+import platform
+
+import numpy as np
+import pytest
+from numba import njit
+from test_kernels import CONFIGS, _geometries
+
+import models
+from models.kernels import Compiled, drive, vector
+from models.kernels.vector_math import REDUCED_MAX, exp_neg, sincos, sqrt
+
+VECTORIZED = [m for m in CONFIGS if Compiled(m, *m._kernel_spec()).vectorized]
+#: azimuths beyond the polynomial's range (the C library's there), and at its edge
+FAR = np.array([REDUCED_MAX, -REDUCED_MAX, 3.0e6, -1.0e7, 1.0e300])
+
+
+def _inputs():
+    ti, tr, pr = _geometries()
+    k = np.arange(FAR.size)
+    return np.concatenate([ti, ti[k]]), np.concatenate([tr, tr[k]]), np.concatenate([pr, FAR])
+
+
+def _both(kernel, ti, tr, pr):
+    """The scalar and the vector loop's ``(16, n)`` results."""
+    prm = kernel.params("float64")
+    n = max(ti.size, prm.shape[1])
+    a, b = np.empty((16, n)), np.empty((16, n))
+    drive.run(kernel.code, ti, tr, pr, prm, kernel.iopt, a, 0)
+    vector.run(kernel.code, ti, tr, pr, prm, kernel.iopt, b, 0)
+    return a, b
+
+
+def test_the_vectorized_models_are_the_ones_meant():
+    names = {type(m).__name__ for m in VECTORIZED}
+    assert names == {"FacetBRDF", "SubsurfaceFacetBRDF", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF"}
+    kinds = {type(m.slopes).__name__ for m in VECTORIZED if hasattr(m, "slopes")}
+    assert kinds == {"ExponentialSlopes", "GaussianSlopes", "GGXSlopes"}
+    assert all(m.shadowing == "none" for m in VECTORIZED if hasattr(m, "shadowing"))
+
+
+@pytest.mark.parametrize("model", VECTORIZED, ids=lambda m: type(m).__name__)
+def test_vector_loop_gives_the_scalar_loops_bits(model):
+    a, b = _both(Compiled(model, *model._kernel_spec()), *_inputs())
+    assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("model", VECTORIZED[::3], ids=lambda m: type(m).__name__)
+def test_vector_loop_model_sets_and_broadcast_angles(model):
+    """Parameters per geometry (a model set's rows, gathered into the scratch) and angles of
+    length 1: the scalar loop's bits."""
+    ti, tr, pr = _inputs()
+    kernel = Compiled(model, *model._kernel_spec())
+    prm = kernel.params("float64")
+    rng = np.random.default_rng(3)
+    kernel.prm["float64"] = prm * (1.0 + 0.01 * rng.random((prm.shape[0], ti.size)))
+    a, b = _both(kernel, ti, tr, pr)
+    assert np.array_equal(a, b)
+    a, b = _both(kernel, ti[:1], tr, pr[:1])
+    assert np.array_equal(a, b)
+
+
+def test_models_take_the_vector_loop_and_agree_with_numpy():
+    """Large calls of a vectorized model run :mod:`~models.kernels.vector` and stay within
+    test_kernels' 1e-12 of the numpy reference (relative to M00)."""
+    from test_kernels import TOL, _relative
+
+    ti, tr, pr = (np.resize(x, 3000) for x in _inputs())
+    m = models.SubsurfaceFacetBRDF(slopes=models.GaussianSlopes(0.2))
+    mk = m.mueller(ti, tr, pr)
+    with models.backend("numpy"):
+        mn = m.mueller(ti, tr, pr)
+    assert _relative(mk, mn) <= TOL
+
+
+@pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="x86 instruction names")
+def test_the_lanes_compile_to_simd_instructions():
+    """The loop's square roots are packed (``sqrtpd``: two or more float64 per instruction);
+    a scalar loop has only ``sqrtsd``.  Fails when a change puts a call or an exception back
+    in a kernel the vector path takes."""
+    from models.kernel_specs import EXPONENTIAL
+    from models.kernels.facet import facet
+
+    @njit(error_model="numpy")  # not cached: a cached function keeps no assembly to inspect
+    def exponential_facets(sc, m):
+        vector._loop(facet, sc, m, (EXPONENTIAL, 0, 0))
+
+    sc = np.zeros(vector._ROWS * vector.VBLOCK)
+    exponential_facets(sc, 8)
+    asm = "".join(exponential_facets.inspect_asm().values())
+    assert "sqrtpd" in asm
+
+
+@njit
+def _math(x, y):
+    s, c, e, r = np.empty_like(x), np.empty_like(x), np.empty_like(x), np.empty_like(x)
+    for i in range(x.size):
+        s[i], c[i] = sincos(x[i])
+        e[i] = exp_neg(y[i])
+        r[i] = sqrt(x[i])
+    return s, c, e, r
+
+
+def _ulps(got, ref):
+    return float(np.max(np.abs(got - ref) / np.spacing(np.abs(ref))))
+
+
+@pytest.mark.parametrize("span", [math.pi / 2, 4.0, 1e3, REDUCED_MAX])
+def test_sincos_and_exp_within_two_ulp(span):
+    rng = np.random.default_rng(7)
+    x = rng.uniform(-span, span, 200_000)
+    y = rng.uniform(0.0, 710.0, x.size)
+    s, c, e, r = _math(x, y)
+    assert _ulps(s, np.sin(x)) <= 2.0
+    assert _ulps(c, np.cos(x)) <= 2.0
+    live = y < 700.0
+    assert _ulps(e[live], np.exp(-y[live])) <= 2.0
+    assert np.all(e[~live] == 0.0)  # exactly zero from 700 on, as the numpy path
+    ok = x >= 0
+    assert np.array_equal(r[ok], np.sqrt(x[ok]))  # IEEE: the same bits
+    assert np.all(np.isnan(r[~ok]))
