@@ -127,3 +127,22 @@ def test_bad_arguments():
         integrated_reflectance(Lambert(), 0.1, tol=True)
     with pytest.raises(ValueError, match="theta_i"):
         integrated_reflectance(Lambert(), math.nan)
+
+
+def test_zero_d_array_incidence_is_the_scalar():
+    """A 0-d array is the scalar it holds, as the models' angle arguments take it."""
+    m = models.FacetBRDF(slopes=models.ExponentialSlopes(0.2), substrate=1.37 + 7.62j)
+    M = m.mueller(0.3, 0.2, 0.1)
+    assert np.array_equal(m.mueller(np.array(0.3), 0.2, 0.1), M)
+    assert np.array_equal(m.mueller(np.float64(0.3), 0.2, 0.1), M)
+    ref = integrated_reflectance(m, 0.3, tol=1e-4)
+    for theta_i in (np.array(0.3), np.float64(0.3)):
+        r = integrated_reflectance(m, theta_i, tol=1e-4)
+        assert (r.value, r.error, r.evaluations) == (ref.value, ref.error, ref.evaluations)
+    with pytest.raises(ValueError, match="theta_i"):
+        integrated_reflectance(m, np.array(2.0))
+    with pytest.raises(ValueError, match="theta_i .*bool"):
+        integrated_reflectance(m, np.array(True))
+    # one incidence per call: an array of them is refused by name, not by a TypeError
+    with pytest.raises(ValueError, match="theta_i .*shape"):
+        integrated_reflectance(m, np.array([0.3]))

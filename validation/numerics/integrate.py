@@ -127,7 +127,7 @@ def integrated_reflectance(
     model : models.Model
         Any BRDF (for a BTDF, the integral over the transmitted hemisphere).
     theta_i : float
-        Polar angle of incidence, radians in [0, pi/2].
+        Polar angle of incidence, radians in [0, pi/2] (a scalar or a 0-d array).
     tol : float
         Absolute error requested on the integral (the result's ``error`` is the
         summed Kronrod-Gauss estimate, which bounds it conservatively).
@@ -158,7 +158,7 @@ def integrated_reflectance(
     """
     # check_real: a bool is no tolerance (True would integrate to tol = 1)
     tol = check_real("tol", tol, 0.0, low_open=True)
-    theta_i = check_real("theta_i", theta_i, 0.0, 0.5 * math.pi)
+    theta_i = _check_incidence(theta_i)
     s_in = np.asarray(stokes(incident), dtype=float)
     if symmetric is None:
         symmetric = bool(getattr(model, "mirror_symmetric", False)) and s_in[2] == 0 and s_in[3] == 0
@@ -170,6 +170,19 @@ def integrated_reflectance(
     return IntegralResult(
         value=factor * value, error=factor * error, evaluations=int(evals), converged=converged
     )
+
+
+def _check_incidence(theta_i):
+    """``theta_i`` as a float in [0, pi/2]: a 0-d array is the scalar it holds, as for the
+    models' angles (its item keeps its numpy type, so a 0-d bool is still refused)."""
+    if isinstance(theta_i, np.ndarray):
+        if theta_i.ndim:
+            raise ValueError(
+                f"theta_i must be one real number in [0, 1.5708] (a scalar or a 0-d array); "
+                f"got an array of shape {theta_i.shape}"
+            )
+        theta_i = theta_i[()]
+    return check_real("theta_i", theta_i, 0.0, 0.5 * math.pi)
 
 
 def _integrand(model, theta_i, s_in):
