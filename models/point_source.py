@@ -101,7 +101,7 @@ import numpy as np
 from scipy import signal
 
 from . import cubature
-from .base import Model, _Wrapper
+from .base import Model, _Wrapper, is_isotropic
 from .cubature import AccuracyWarning
 from .geometry import disc_quadrature, polar_rule
 from .params import param
@@ -395,7 +395,7 @@ class PointSourceBRDF(_Wrapper):
 
     @cached_property
     def _isotropic(self):
-        return self.model.rotated(1.0) is self.model
+        return is_isotropic(self.model)
 
     @cached_property
     def _rotates(self):
