@@ -129,25 +129,53 @@ def test_anisotropic_models_are_rotated_per_node_as_a_model_set():
     assert np.all(err <= 2e-4 * a.scale)
 
 
-class _ScalarTurn(models.FacetBRDF):
-    """A FacetBRDF whose ``rotated`` takes one angle only (as a model written without model
-    sets might): the point source must fall back to its doubled product rule."""
+class _UserAnisotropic:
+    """A user's model (the protocol of tests/kit_models.py: ``mueller``, and the optional
+    ``rotated`` and ``lobe``), written without model sets: ``rotated`` takes one angle.  Its
+    values are an anisotropic FacetBRDF's, so the rotate-by-array path is the reference."""
+
+    mirror_symmetric = False
+
+    def __init__(self, inner):
+        self.inner = inner
+
+    def mueller(self, theta_i, theta_r, phi_r):
+        return self.inner.mueller(theta_i, theta_r, phi_r)
 
     def rotated(self, angle):
-        return super().rotated(float(angle))
+        return _UserAnisotropic(self.inner.rotated(float(angle)))  # an array: TypeError
+
+    def lobe(self, theta_i):
+        return self.inner.lobe(theta_i)
 
 
-def test_a_model_that_cannot_rotate_per_node_falls_back_to_doubling():
-    """(A broad lobe: the fallback rotates the model node by node in Python, slowly.)"""
-    slopes = S.AnisotropicGaussianSlopes(0.2, 0.3, 0.4)
-    plain = S.PointSourceBRDF(model=S.FacetBRDF(slopes=slopes), distance=10.0)
-    odd = S.PointSourceBRDF(model=_ScalarTurn(slopes=slopes), distance=10.0)
-    assert plain._rotates and not odd._rotates
-    tr, pr = (a[::4] for a in _scan())
-    a, b = plain.accuracy(0.3, tr, pr), odd.accuracy(0.3, tr, pr)
-    assert np.all(b.error <= odd.tol) and not b.capped.any()
+def test_a_model_that_cannot_rotate_by_an_array_is_rotated_node_by_node():
+    """The per-azimuth fallback of ``_local``: the same cubature as the rotate-by-array path (to
+    1e-12, with the same evaluations), refined to ``tol``, and within ``tol`` of a reference
+    refined 100 times further.  The lobe is narrow against the spread: the cubature, not the
+    first try, settles most geometries."""
+    from validation.checks.conformance import as_model
+
+    inner = S.FacetBRDF(slopes=S.AnisotropicGaussianSlopes(0.05, 0.08, 0.4), substrate=2.29 + 3.37j)
+    plain = S.PointSourceBRDF(model=inner, distance=3.0)
+    user = S.PointSourceBRDF(model=as_model(_UserAnisotropic(inner)), distance=3.0)
+    assert plain._rotates and not user._rotates
+    tr, pr = np.array([0.0, 0.25, 0.3, 0.35, 0.6, 0.32]), np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.2])
+    a, b = plain.accuracy(0.3, tr, pr), user.accuracy(0.3, tr, pr)
+    assert np.any(b.evaluations > 160)  # the adaptive cubature served them
+    np.testing.assert_array_equal(b.evaluations, a.evaluations)
     err = np.max(np.abs(a.mueller - b.mueller), axis=(-2, -1))
-    assert np.all(err <= 2e-4 * a.scale)
+    assert np.all(err <= 1e-12 * a.mueller[..., 0, 0]), f"{np.max(err / a.mueller[..., 0, 0]):.3g}"
+    assert np.all(b.error <= user.tol) and not b.capped.any()
+    ref = plain.replace(tol=1e-2 * plain.tol).accuracy(0.3, tr, pr)
+    assert not ref.capped.any()
+    err = np.max(np.abs(b.mueller - ref.mueller), axis=(-2, -1))
+    assert np.all(err <= user.tol * b.scale), f"{np.max(err / b.scale):.3g}"
+    # the fixed product rule takes the same path: one call per distinct node azimuth
+    np.testing.assert_allclose(
+        user.replace(resolution=8).mueller(0.3, tr, pr), plain.replace(resolution=8).mueller(0.3, tr, pr),
+        rtol=1e-12, atol=0.0,
+    )  # fmt: skip
 
 
 def test_shift_method_keeps_its_lobe_based_resolution():
