@@ -157,3 +157,13 @@ def test_the_rule_is_exact_to_degree_seven():
             assert one_region(a, b)[0] == pytest.approx(1.0 / ((a + 1) * (b + 1)), abs=1e-14)
     value, error = one_region(8, 0)
     assert abs(value - 1.0 / 9.0) > 1e-6 and error > abs(value - 1.0 / 9.0)
+
+
+@pytest.mark.parametrize("cap", [20_000, 200_000])
+def test_the_evaluation_cap_stops_refinement_and_says_so(cap):
+    """A tolerance no cap allows: refinement stops near max_evaluations (the regions of the
+    last pass may overshoot it, by 12% here), and the result says it did not converge."""
+    m = models.FacetBRDF(slopes=models.ExponentialSlopes(0.3), substrate=1.37 + 7.62j)
+    r = integrated_reflectance(m, 1.0, tol=1e-13, max_evaluations=cap)
+    assert not r.converged and r.error > 1e-13
+    assert 0.5 * cap <= r.evaluations <= 1.25 * cap

@@ -122,20 +122,26 @@ def integrated_reflectance(
     rects = _initial_rectangles(model.lobe(theta_i) if hasattr(model, "lobe") else None, symmetric)
     factor = 2.0 if symmetric else 1.0
     # the half-range integral is doubled, and so is its error
-    goal = tol / factor
-    got = cubature.adaptive(
-        _integrand(model, theta_i, s_in, rects),
-        np.zeros(len(rects), dtype=int),
-        1,
-        norm=lambda diff, total: diff[0],
-        budget=lambda total: np.full(1, goal),
-        max_regions=max(1, int(max_evaluations) // (2 * cubature.GM_POINTS)),
-    )
+    got = _refine(_integrand(model, theta_i, s_in, rects), len(rects), tol / factor, max_evaluations)
     return IntegralResult(
         value=factor * float(got.value[0, 0]),
         error=factor * float(got.error[0]),
         evaluations=int(cubature.GM_POINTS * got.evaluated[0]),
         converged=not bool(got.capped[0]),
+    )
+
+
+def _refine(f, n_cells, goal, max_evaluations):
+    """:func:`models.cubature.adaptive` on one row of ``n_cells`` cells: absolute error ``goal``,
+    regions capped so that the evaluations (each region's, and its parent's before it) stay
+    within about ``max_evaluations``."""
+    return cubature.adaptive(
+        f,
+        np.zeros(n_cells, dtype=int),
+        1,
+        norm=lambda diff, total: diff[0],
+        budget=lambda total: np.full(1, goal),
+        max_regions=max(1, int(max_evaluations) // (2 * cubature.GM_POINTS)),
     )
 
 
