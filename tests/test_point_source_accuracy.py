@@ -310,15 +310,22 @@ def test_auto_meets_tol_on_discs_much_wider_than_the_source_height(inner, k, foo
     ps = S.PointSourceBRDF(model=inner, distance=1.0, sample_radius=k)
     lb = inner.lobe(ti)
     geos = _WIDE_SCAN + [(lb[0], lb[1])]  # the lobe centre, where the scale is taken
-    refs = [_wide_reference(inner, k, ti, tr, pr) for tr, pr in geos]
-    scale = np.maximum([abs(r[0, 0]) for r in refs], abs(refs[-1][0, 0]))
-    coarse = np.array([_wide_reference(inner, k, ti, tr, pr, n=10, levels=14) for tr, pr in geos])
-    assert np.all(np.max(np.abs(coarse - refs), axis=(-2, -1)) <= 0.1 * ps.tol * scale)
+    _held_to_wide_reference(ps, k, ti, geos, fine=(12, 16), coarse=(10, 14))
+
+
+def _held_to_wide_reference(ps, k, ti, geos, fine, coarse):
+    """``ps`` (no cap warning) within ``tol * max(M00, M00_c)`` of :func:`_wide_reference` at
+    ``geos`` (the inner lobe's centre last: ``M00_c``), both taken from the reference at ``fine``
+    ``(n, levels)``, whose change from ``coarse`` must be a tenth of that."""
+    refs = np.array([_wide_reference(ps.model, k, ti, tr, pr, *fine) for tr, pr in geos])
+    scale = np.maximum(np.abs(refs[:, 0, 0]), abs(refs[-1][0, 0]))
+    rough = np.array([_wide_reference(ps.model, k, ti, tr, pr, *coarse) for tr, pr in geos])
+    assert np.all(np.max(np.abs(rough - refs), axis=(-2, -1)) <= 0.1 * ps.tol * scale)
     tr, pr = np.array(geos).T
     with warnings.catch_warnings():
         warnings.simplefilter("error", AccuracyWarning)
         got = ps.mueller(ti, tr, pr)
-    err = np.max(np.abs(got - np.array(refs)), axis=(-2, -1))
+    err = np.max(np.abs(got - refs), axis=(-2, -1))
     worst = int(np.argmax(err / scale))
     assert np.all(err <= ps.tol * scale), (
         f"error {err[worst]:.3g} > tol {ps.tol:g} x scale {scale[worst]:.4g} at {geos[worst]}"
@@ -343,19 +350,7 @@ def test_auto_meets_tol_against_the_independent_reference(inner, ratio, ti):
     ps = S.PointSourceBRDF(model=inner, distance=ratio, sample_radius=1.0)
     lb = inner.lobe(ti)
     geos = _WIDE_SCAN + [(lb[0] + 0.05, 0.0), (lb[0], lb[1])]  # the lobe centre last: the scale
-    refs = np.array([_wide_reference(inner, k, ti, tr, pr, n=10, levels=10) for tr, pr in geos])
-    scale = np.maximum(np.abs(refs[:, 0, 0]), abs(refs[-1][0, 0]))
-    coarse = np.array([_wide_reference(inner, k, ti, tr, pr, n=8, levels=8) for tr, pr in geos])
-    assert np.all(np.max(np.abs(coarse - refs), axis=(-2, -1)) <= 0.1 * ps.tol * scale)
-    tr, pr = np.array(geos).T
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", AccuracyWarning)
-        got = ps.mueller(ti, tr, pr)
-    err = np.max(np.abs(got - refs), axis=(-2, -1))
-    worst = int(np.argmax(err / scale))
-    assert np.all(err <= ps.tol * scale), (
-        f"error {err[worst]:.3g} > tol {ps.tol:g} x scale {scale[worst]:.4g} at {geos[worst]}"
-    )
+    _held_to_wide_reference(ps, k, ti, geos, fine=(10, 10), coarse=(8, 8))
 
 
 @pytest.mark.parametrize("k", WIDE_K)
