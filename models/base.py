@@ -28,7 +28,13 @@ from .modelset import array_leaves
 from .params import Declared, param
 from .polarization import ellipsometric, stokes
 
-__all__ = ["Model", "Sum", "CHUNK"]
+__all__ = ["Model", "Sum", "CHUNK", "is_isotropic"]
+
+
+def is_isotropic(model) -> bool:
+    """True when ``model`` has no preferred azimuth: :meth:`Model.rotated` returns the model
+    itself (its documented contract), so a rotated sample need not be built."""
+    return model.rotated(1.0) is model
 
 
 class Model(Declared):
@@ -284,7 +290,7 @@ class Model(Declared):
     def rotated(self, angle):
         """The model of the sample rotated by ``angle`` about z.  Models with no
         preferred azimuth (isotropic slopes, smooth interfaces) return themselves:
-        callers test ``model.rotated(a) is model`` to take their isotropic paths."""
+        callers test it (:func:`is_isotropic`) to take their isotropic paths."""
         return self
 
     def _rotated_slopes(self, angle):

@@ -59,12 +59,15 @@ class Cubature:
     """The result of :func:`adaptive`: ``value`` ``(k + 1, n_rows)`` the integrals, ``error``
     ``(n_rows,)`` the summed regional error estimates (the units of ``norm``), ``regions``
     ``(n_rows,)`` how many regions each row ended with, ``capped`` ``(n_rows,)`` True where a
-    row stopped at ``max_regions`` before meeting its budget, or has an error that is not finite."""
+    row stopped at ``max_regions`` before meeting its budget, or has an error that is not finite,
+    ``evaluated`` ``(n_rows,)`` how many regions each row evaluated, split ones included (the
+    integrand's points spent: ``GM_POINTS * evaluated``)."""
 
     value: np.ndarray
     error: np.ndarray
     regions: np.ndarray
     capped: np.ndarray
+    evaluated: np.ndarray
 
 
 def _rule(integrand, r):
@@ -187,6 +190,7 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
     regions = _start(cell_row.size, start)
     regions.evaluate(integrand, block)
     capped = np.zeros(n_rows, dtype=bool)
+    evaluated = np.bincount(cell_row[regions.cell], minlength=n_rows)
     while True:
         row = cell_row[regions.cell]
         total = np.stack([np.bincount(row, weights=x, minlength=n_rows) for x in regions.val])
@@ -204,5 +208,6 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
         np.maximum.at(worst, row, np.where(np.isfinite(err), err, 0.0))  # NaN rows are capped
         split = todo[row] & (err > np.maximum(allowed[row] / count[row], WORST * worst[row]))
         if not split.any():
-            return Cubature(total, row_err, count, capped)
+            return Cubature(total, row_err, count, capped, evaluated)
+        evaluated += 2 * np.bincount(row[split], minlength=n_rows)
         regions = _refine(regions, split, integrand, block)

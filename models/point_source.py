@@ -68,8 +68,9 @@ radial nodes (160 evaluations; the difference of the two is the estimate): geome
 settles skip the cubature.  A geometry that reaches :data:`MAX_REGIONS` regions stops there with
 an :class:`AccuracyWarning` naming how many did and their estimated error;
 :meth:`PointSourceBRDF.accuracy` returns the estimates themselves.  An anisotropic inner model
-is rotated per node as a model set (``model.rotated(array)``); one that cannot be falls back to
-the product rule about the disc centre, doubled from 4 radial nodes up to 4096.
+is rotated per node as a model set (``model.rotated(array)``, one call per block of nodes); one
+whose ``rotated`` takes a single angle (a user's model) is rotated node by node, one call per
+distinct azimuth, on the same nodes: the same quadrature, only slower.
 
 A fixed ``resolution`` (an int) is the product rule of earlier versions, unrefined and
 unestimated: Gauss-Legendre in the radius about the disc centre (``resolution`` nodes, weight
@@ -101,7 +102,7 @@ import numpy as np
 from scipy import signal
 
 from . import cubature
-from .base import Model, _Wrapper
+from .base import Model, _Wrapper, is_isotropic
 from .cubature import AccuracyWarning
 from .geometry import disc_quadrature, polar_rule
 from .params import param
@@ -138,8 +139,8 @@ _AUTO_MIN, _AUTO_MAX = 16, 4096
 #: ``resolution="auto"``: the regions per geometry at which refinement stops (each region a
 #: 17-point rule: at most ~70,000 inner-model evaluations per geometry)
 MAX_REGIONS = 4096
-#: the product rule's node counts of the first try, and the largest doubling of the fallback
-_FIRST, _PRODUCT_MAX = (4, 8), 4096
+#: the product rule's node counts of the first try
+_FIRST = (4, 8)
 #: the first try is made when the incidence spread is at most this many lobe widths
 _BROAD = 2.0
 #: ``tol``: below ~1e-13 the rounding of the sums dominates; above 0.1 it is no statement
@@ -153,8 +154,7 @@ class Accuracy:
     ``mueller`` ``(..., 4, 4)`` the result; ``error`` the estimated error of its worst element
     over ``scale``, comparable with ``tol``; ``scale`` ``max(M00, M00_c)`` (module docstring,
     Accuracy); ``evaluations`` the inner-model evaluations spent; ``capped`` True where the
-    refinement stopped at :data:`MAX_REGIONS` (or the fallback's 4096 radial nodes) before
-    ``error`` met ``tol``."""
+    refinement stopped at :data:`MAX_REGIONS` before ``error`` met ``tol``."""
 
     mueller: np.ndarray
     error: np.ndarray
@@ -379,8 +379,6 @@ class PointSourceBRDF(_Wrapper):
 
     def _refined(self, ti, tr, pr, scale):
         """Every geometry refined until its estimated error is within ``tol * max(M00, scale)``."""
-        if not self._rotates:
-            return self._doubled(ti, tr, pr, scale)
         disc = _Disc(self, ti, tr, pr)
         n = ti.size
         res = _Result(np.zeros((16, n)), np.zeros(n), np.zeros(n), np.zeros(n, int), np.zeros(n, bool))
@@ -395,7 +393,7 @@ class PointSourceBRDF(_Wrapper):
 
     @cached_property
     def _isotropic(self):
-        return self.model.rotated(1.0) is self.model
+        return is_isotropic(self.model)
 
     @cached_property
     def _rotates(self):
@@ -412,9 +410,20 @@ class PointSourceBRDF(_Wrapper):
         """The inner model's Mueller elements ``(16, m, P)`` at local incidences ``(psi, Phi)``
         ``(m, P)`` for the observations ``(tr, pr)`` ``(m,)``: the sample rotated by ``-Phi``."""
         m, P = psi.shape
-        model = self.model if self._isotropic else self.model.rotated(-Phi.ravel())
-        M = model._m16(psi.ravel(), np.repeat(tr, P), (pr[:, None] - Phi).ravel())
-        return M.reshape(16, m, P)
+        psi, Phi, tr, pr = psi.ravel(), Phi.ravel(), np.repeat(tr, P), (pr[:, None] - Phi).ravel()
+        if self._rotates:
+            model = self.model if self._isotropic else self.model.rotated(-Phi)
+            return model._m16(psi, tr, pr).reshape(16, m, P)
+        # a sample that cannot rotate by an array: one call per distinct azimuth (the product
+        # rule's nodes share theirs across the geometries of an incidence; the cubature's do not)
+        out = np.empty((16, psi.size))
+        uniq, inv = np.unique(Phi, return_inverse=True)
+        order = np.argsort(inv, kind="stable")
+        ends = np.searchsorted(inv[order], np.arange(uniq.size + 1))
+        for j, phi in enumerate(uniq.tolist()):
+            idx = order[ends[j] : ends[j + 1]]
+            out[:, idx] = self.model.rotated(-phi)._m16(psi[idx], tr[idx], pr[idx])
+        return out.reshape(16, m, P)
 
     def _first_try(self, disc, rows, scale, res):
         """The product rule in ``(t, chi)`` at 4 and 8 radial nodes on ``rows``; where the two agree
@@ -458,28 +467,6 @@ class PointSourceBRDF(_Wrapper):
         res.error[rows] = _ratio(got.error / W, sc)
         res.evaluations[rows] += cubature.GM_POINTS * got.regions
 
-    def _doubled(self, ti, tr, pr, scale):
-        """The fallback for an anisotropic model that cannot be rotated per node in one call: the
-        product rule about the disc centre, doubled from 4 radial nodes until two successive
-        counts agree within the budget (or 4096 nodes are reached)."""
-        n = ti.size
-        res = _Result(np.zeros((16, n)), np.full(n, np.inf), np.zeros(n), np.zeros(n, int), np.zeros(n, bool))
-        todo, prev, N = np.arange(n), self._superpose(ti, tr, pr, 2), 4
-        res.evaluations[:] = 8
-        while todo.size:
-            cur = self._superpose(ti[todo], tr[todo], pr[todo], N)
-            res.evaluations[todo] += 2 * N * N
-            sc = np.maximum(np.abs(cur[0]), scale[todo])
-            err = _ratio(np.max(np.abs(cur - prev), axis=0), sc)
-            res.mueller[:, todo], res.scale[todo], res.error[todo] = cur, sc, err
-            res.capped[todo[~np.isfinite(err)]] = True  # reported, not refined: no N repairs it
-            more = err > self.tol
-            if N >= _PRODUCT_MAX:
-                res.capped[todo[more]] = True
-                break
-            todo, prev, N = todo[more], cur[:, more], 2 * N
-        return res
-
     def _superpose(self, ti, tr, pr, resolution):
         """Eq. 28 (or the shift approximation) at ``resolution`` radial nodes: ``(16, n)``."""
         out = np.zeros((16, ti.size))
@@ -493,20 +480,10 @@ class PointSourceBRDF(_Wrapper):
             ok = tt < 0.5 * math.pi
             self._accumulate(out, self.model, np.broadcast_to(ti[:, None], tt.shape), tt, pp, w * ok, ok)
             return out
-        if self._rotates:  # the local models in one call per block of nodes (:meth:`_local`)
-            step = max(1, _BLOCK // ti.size)
-            for k0 in range(0, psi.shape[1], step):
-                sl = slice(k0, k0 + step)
-                out += np.einsum("eik,ik->ei", self._local(psi[:, sl], Phi[:, sl], tr, pr), w[:, sl])
-            return out
-        # A sample that cannot rotate by an array: rotated per node; Phi depends on theta_i only.
-        for t in np.unique(ti):
-            rows = np.flatnonzero(ti == t)
-            j0 = rows[0]
-            for k in range(psi.shape[1]):
-                m = self.model.rotated(-float(Phi[j0, k]))
-                M = m._m16(np.full(rows.size, psi[j0, k]), tr[rows], pr[rows] - Phi[j0, k])
-                out[:, rows] += w[j0, k] * M
+        step = max(1, _BLOCK // ti.size)  # the local models in one call per block of nodes
+        for k0 in range(0, psi.shape[1], step):
+            sl = slice(k0, k0 + step)
+            out += np.einsum("eik,ik->ei", self._local(psi[:, sl], Phi[:, sl], tr, pr), w[:, sl])
         return out
 
     @staticmethod

@@ -51,11 +51,14 @@ def test_choose_meets_tolerance_against_reference(results):
                 for p in r.points:
                     if p.error <= tol and p is not pick:
                         # costs at least as much, or ties with it (same error) and loses the tie;
-                        # a point whose error another point reaches with fewer evaluations is
-                        # that point's duplicate (the same work: its CPU time differs by noise)
+                        # a point whose error another point reaches with fewer evaluations, or
+                        # with as many from a coarser setting (listed earlier), is that point's
+                        # duplicate (the same work: its CPU time differs by noise)
                         tie = p.error == pick.error and p.evaluations >= pick.evaluations
                         duplicate = any(
-                            q.error == p.error and q.evaluations < p.evaluations for q in r.points
+                            q.error == p.error
+                            and (q.evaluations, r.points.index(q)) < (p.evaluations, r.points.index(p))
+                            for q in r.points
                         )
                         assert p.seconds >= pick.seconds or tie or duplicate
                         if tie and p.evaluations == pick.evaluations:

@@ -1,4 +1,4 @@
-"""Hemispherical integrals of BRDFs: globally adaptive Gauss-Kronrod cubature.
+"""Hemispherical integrals of BRDFs: globally adaptive cubature (:func:`models.cubature.adaptive`).
 
 ``integrated_reflectance(model, theta_i, tol)`` integrates ``M00 cos(tr) dOmega``
 over the hemisphere for unpolarized incidence (or ``(M @ S_in)[0]`` for a given
@@ -7,19 +7,20 @@ which ``cos(tr) sin(tr) dtr = dt / 2``: the projected solid angle is uniform in
 ``t``, so a BRDF that grows like ``1/cos`` at grazing stays integrable without
 a singular weight.
 
-Each rectangle of ``(t, phi)`` gets a tensor 15-point Kronrod rule with its
-embedded 7-point Gauss rule; ``|K - G|`` is the rectangle's error estimate
-(conservative: it bounds the Gauss error, the returned value is the Kronrod
-one).  The rectangles with the largest errors are bisected, along the direction
-whose one-dimensional Kronrod-Gauss difference is larger, until the summed
-error estimate is below ``tol``.  All rectangles of one pass are evaluated in
-one vectorized model call.  When a model reports a narrow lobe
+The rectangles of ``(t, phi)`` of an initial partition are the cells of
+:func:`models.cubature.adaptive` (the integrator :class:`models.PointSourceBRDF` refines with):
+each region gets the Genz-Malik rule of degree 7 (17 points) and its embedded degree-5 rule,
+whose difference, or half the change a split made to its parent, is its error estimate
+(conservative: it bounds the degree-5 error, the returned value is the degree-7 one).  The
+regions with the largest errors are halved, across the direction whose fourth difference is
+larger, until the summed error estimate is below ``tol``.  All regions of one pass are
+evaluated in vectorized model calls.  When a model reports a narrow lobe
 (``model.lobe(theta_i)``), the initial partition has breakpoints at geometric
 distances from the lobe centre, so a sigma = 0.001 specular peak is resolved
 from the first pass instead of being found by chance.  Like any deterministic
 cubature, it can step over a feature narrower than its initial grid (about
-0.25 in t and pi/8 in phi) that no hint announces; every model here with a
-narrow lobe declares it.
+0.25 in t and pi/8 in phi, each cell starting as 2 x 2 regions) that no hint announces; every
+model here with a narrow lobe declares it.
 """
 
 from __future__ import annotations
@@ -29,60 +30,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from models import cubature
 from models.params import check_real
 from models.polarization import stokes
 
-__all__ = ["IntegralResult", "integrated_reflectance", "gauss_kronrod_15"]
-
-# 15-point Kronrod nodes on [-1, 1] (QUADPACK qk15) and weights; the 7-point Gauss
-# rule uses the odd-indexed nodes of the positive half (x = 0.949.., 0.741.., 0.405.., 0).
-_XK = np.array(
-    [
-        0.991455371120812639206854697526329,
-        0.949107912342758524526189684047851,
-        0.864864423359769072789712788640926,
-        0.741531185599394439863864773280788,
-        0.586087235467691130294144845693013,
-        0.405845151377397166906606412076961,
-        0.207784955007898467600689403773245,
-        0.000000000000000000000000000000000,
-    ]
-)
-_WK = np.array(
-    [
-        0.022935322010529224963732008058970,
-        0.063092092629978553290700663189204,
-        0.104790010322250183839876322541518,
-        0.140653259715525918745189590510238,
-        0.169004726639267902826583426598550,
-        0.190350578064785409913256402421014,
-        0.204432940075298892414161999234649,
-        0.209482141084727828012999174891714,
-    ]
-)
-_WG = np.array(
-    [
-        0.0,
-        0.129484966168869693270611432679082,
-        0.0,
-        0.279705391489276667901467771423780,
-        0.0,
-        0.381830050505118944950369775488975,
-        0.0,
-        0.417959183673469387755102040816327,
-    ]
-)
-
-
-def gauss_kronrod_15():
-    """Nodes on [-1, 1] (15), Kronrod weights (15), Gauss weights on the same nodes (15)."""
-    x = np.concatenate([-_XK[:-1], _XK[::-1]])
-    wk = np.concatenate([_WK[:-1], _WK[::-1]])
-    wg = np.concatenate([_WG[:-1], _WG[::-1]])
-    return x, wk, wg
-
-
-_X, _WKF, _WGF = gauss_kronrod_15()
+__all__ = ["IntegralResult", "integrated_reflectance"]
 
 
 @dataclass(frozen=True)
@@ -127,13 +79,18 @@ def integrated_reflectance(
     model : models.Model
         Any BRDF (for a BTDF, the integral over the transmitted hemisphere).
     theta_i : float
-        Polar angle of incidence, radians in [0, pi/2].
+        Polar angle of incidence, radians in [0, pi/2] (a scalar or a 0-d array).
     tol : float
         Absolute error requested on the integral (the result's ``error`` is the
-        summed Kronrod-Gauss estimate, which bounds it conservatively).
+        summed regional estimate of :func:`models.cubature.adaptive`, which bounds it
+        conservatively).
     incident : str or array
         Incident polarization (Stokes vector or name); the integrand is the
         scattered intensity ``(M @ S)[0] / S[0]``.
+    max_evaluations : int
+        Model evaluations after which refinement stops (``converged`` False): the regions are
+        capped at ``max_evaluations / (2 * 17)``, each region costing its 17 points and its
+        parent's before it.
     symmetric : bool, optional
         Integrate ``phi`` over ``[0, pi]`` and double, valid for models with a
         mirror plane at ``phi = 0``.  By default, True when the incident state
@@ -158,33 +115,65 @@ def integrated_reflectance(
     """
     # check_real: a bool is no tolerance (True would integrate to tol = 1)
     tol = check_real("tol", tol, 0.0, low_open=True)
-    theta_i = check_real("theta_i", theta_i, 0.0, 0.5 * math.pi)
+    theta_i = _check_incidence(theta_i)
     s_in = np.asarray(stokes(incident), dtype=float)
     if symmetric is None:
         symmetric = bool(getattr(model, "mirror_symmetric", False)) and s_in[2] == 0 and s_in[3] == 0
-    f = _integrand(model, theta_i, s_in)
     rects = _initial_rectangles(model.lobe(theta_i) if hasattr(model, "lobe") else None, symmetric)
     factor = 2.0 if symmetric else 1.0
     # the half-range integral is doubled, and so is its error
-    value, error, evals, converged = _adaptive(f, rects, tol / factor, max_evaluations)
+    got = _refine(_integrand(model, theta_i, s_in, rects), len(rects), tol / factor, max_evaluations)
     return IntegralResult(
-        value=factor * value, error=factor * error, evaluations=int(evals), converged=converged
+        value=factor * float(got.value[0, 0]),
+        error=factor * float(got.error[0]),
+        evaluations=int(cubature.GM_POINTS * got.evaluated[0]),
+        converged=not bool(got.capped[0]),
     )
 
 
-def _integrand(model, theta_i, s_in):
-    """The integrand over ``t = sin^2(theta_r)`` and ``phi``: the scattered intensity
-    times ``cos(tr) sin(tr) dtr dphi = dt dphi / 2``."""
+def _refine(f, n_cells, goal, max_evaluations):
+    """:func:`models.cubature.adaptive` on one row of ``n_cells`` cells: absolute error ``goal``,
+    regions capped so that the evaluations (each region's, and its parent's before it) stay
+    within about ``max_evaluations``."""
+    return cubature.adaptive(
+        f,
+        np.zeros(n_cells, dtype=int),
+        1,
+        norm=lambda diff, total: diff[0],
+        budget=lambda total: np.full(1, goal),
+        max_regions=max(1, int(max_evaluations) // (2 * cubature.GM_POINTS)),
+    )
+
+
+def _check_incidence(theta_i):
+    """``theta_i`` as a float in [0, pi/2]: a 0-d array is the scalar it holds, as for the
+    models' angles (its item keeps its numpy type, so a 0-d bool is still refused)."""
+    if isinstance(theta_i, np.ndarray):
+        if theta_i.ndim:
+            raise ValueError(
+                f"theta_i must be one real number in [0, 1.5708] (a scalar or a 0-d array); "
+                f"got an array of shape {theta_i.shape}"
+            )
+        theta_i = theta_i[()]
+    return check_real("theta_i", theta_i, 0.0, 0.5 * math.pi)
+
+
+def _integrand(model, theta_i, s_in, rects):
+    """The cubature's integrand on the cells ``rects`` (``(t0, t1, phi0, phi1)`` rows): the
+    scattered intensity times ``cos(tr) sin(tr) dtr dphi = dt dphi / 2``, and the cell's area
+    (the unit square's Jacobian) as the weight."""
     polarized = bool(np.any(s_in[1:] != 0))
 
-    def f(t, phi):
+    def f(cell, u, v):
+        t0, t1, p0, p1 = (rects[cell, j][:, None] for j in range(4))
+        t, phi = t0 + (t1 - t0) * u, p0 + (p1 - p0) * v
         th = np.arcsin(np.sqrt(np.clip(t, 0.0, 1.0)))
         if polarized:
             M = model.mueller(theta_i, th, phi)
-            v = (M[..., 0, :] @ s_in) / s_in[0]
+            val = (M[..., 0, :] @ s_in) / s_in[0]
         else:
-            v = model.brdf(theta_i, th, phi)
-        return 0.5 * v
+            val = model.brdf(theta_i, th, phi)
+        return (0.5 * val)[None], np.broadcast_to((t1 - t0) * (p1 - p0), t.shape)
 
     return f
 
@@ -207,60 +196,3 @@ def _initial_rectangles(lobe, symmetric):
     t0, p0 = np.meshgrid(tb[:-1], pb[:-1], indexing="ij")
     t1, p1 = np.meshgrid(tb[1:], pb[1:], indexing="ij")
     return np.stack([t0.ravel(), t1.ravel(), p0.ravel(), p1.ravel()], axis=1)
-
-
-def _evaluate(f, r):
-    """Tensor Gauss-Kronrod on each rectangle: Kronrod value, |Kronrod - Gauss| error,
-    the error along t and along phi (which direction to bisect), evaluations."""
-    a, b, c, d = r.T
-    ht = 0.5 * (b - a)
-    hp = 0.5 * (d - c)
-    tt = (0.5 * (a + b))[:, None] + ht[:, None] * _X[None, :]
-    pp = (0.5 * (c + d))[:, None] + hp[:, None] * _X[None, :]
-    vals = f(tt[:, :, None], pp[:, None, :])  # (R, 15, 15)
-    area = ht * hp
-    kk = np.einsum("rij,i,j->r", vals, _WKF, _WKF) * area
-    gg = np.einsum("rij,i,j->r", vals, _WGF, _WGF) * area
-    et = np.abs(np.einsum("rij,i,j->r", vals, _WKF - _WGF, _WKF)) * area
-    ep = np.abs(np.einsum("rij,i,j->r", vals, _WKF, _WKF - _WGF)) * area
-    return kk, np.abs(kk - gg), et, ep, vals.size
-
-
-def _bisected(r, et, ep):
-    """Both halves of each rectangle, cut across the direction that carries more error."""
-    along_t = et >= ep
-    mt = 0.5 * (r[:, 0] + r[:, 1])
-    mp = 0.5 * (r[:, 2] + r[:, 3])
-    c1 = r.copy()
-    c2 = r.copy()
-    c1[along_t, 1] = mt[along_t]
-    c2[along_t, 0] = mt[along_t]
-    c1[~along_t, 3] = mp[~along_t]
-    c2[~along_t, 2] = mp[~along_t]
-    return np.concatenate([c1, c2])
-
-
-def _adaptive(f, rects, goal, max_evaluations):
-    """Bisect the rectangles carrying half of the error until the summed error estimate
-    meets ``goal`` or the evaluation budget is spent: ``(value, error, evals, converged)``."""
-    kk, err, et, ep, evals = _evaluate(f, rects)
-    while True:
-        total_err = float(err.sum())
-        if total_err <= goal:
-            return float(kk.sum()), total_err, evals, True
-        if evals >= max_evaluations:
-            return float(kk.sum()), total_err, evals, False
-        order = np.argsort(err)[::-1]
-        cum = np.cumsum(err[order])
-        nsplit = int(np.searchsorted(cum, 0.5 * (total_err - 0.5 * goal))) + 1
-        split = order[:nsplit]
-        keep = np.ones(len(rects), bool)
-        keep[split] = False
-        children = _bisected(rects[split], et[split], ep[split])
-        k2, e2, et2, ep2, n2 = _evaluate(f, children)
-        evals += n2
-        rects = np.concatenate([rects[keep], children])
-        kk = np.concatenate([kk[keep], k2])
-        err = np.concatenate([err[keep], e2])
-        et = np.concatenate([et[keep], et2])
-        ep = np.concatenate([ep[keep], ep2])

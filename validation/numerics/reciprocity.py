@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from models.base import is_isotropic
 from models.polarization import reciprocal_jones, reciprocal_mueller
 
 __all__ = [
@@ -57,13 +58,9 @@ class ReciprocityResult:
     n: int  # geometries with light in at least one direction
 
 
-def _isotropic(model) -> bool:
-    return model.rotated(1.0) is model
-
-
 def _reversed(model, ti, tr, pr, method):
     """Evaluate ``method`` ('mueller' or 'jones') on the reversed paths."""
-    if _isotropic(model):
+    if is_isotropic(model):
         return getattr(model, method)(tr, ti, -pr)
     out = None
     for idx in np.ndindex(ti.shape):
