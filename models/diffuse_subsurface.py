@@ -118,7 +118,7 @@ class DiffuseSubsurfaceBRDF(Model):
             _, _, a_s, a_p = interface_amplitudes(cos_ext, self.coating)
             return a_s, a_p
         _, _, (a_s, a_p), (b_s, b_p) = film_amplitudes(cos_ext, self._top_stack)
-        return np.stack([a_s[0], b_s[1]]), np.stack([a_p[0], b_p[1]])
+        return np.stack([a_s, b_s]), np.stack([a_p, b_p])
 
     def _mueller16(self, ti, tr, pr):
         (asi, asr), (api, apr) = self._amps(ti, tr)

@@ -156,8 +156,7 @@ def _through_films(parts, cos_ext, top):
     films on the coating, ``t_out,a(theta_r) t_in,b(theta_i)`` for element ``ab``
     (:func:`models.smooth_interface.film_transmission`, F1-F2): complex products, so the
     relative s/p phase of the films' transmission reaches the Mueller matrix."""
-    (ts_in, tp_in), (ts_out, tp_out) = film_transmission(cos_ext, top)  # rows: incidence, scattering
-    tsi, tpi, tsr, tpr = ts_in[0], tp_in[0], ts_out[1], tp_out[1]
+    (tsi, tpi), (tsr, tpr) = film_transmission(cos_ext[0], cos_ext[1], top)
     out = []
     for (re, im), f in zip(parts, (tsr * tsi, tsr * tpi, tpr * tsi, tpr * tpi), strict=True):
         z = (re + 1j * im) * f

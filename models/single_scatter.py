@@ -105,8 +105,8 @@ class SingleScatterBRDF(Model):
         if self._top_stack is None:
             (si, sr), (ci, cr), (asi, asr), (api, apr) = interface_amplitudes(cos_ext, self.coating)
         else:
-            (si, sr), (ci, cr), (a_s, a_p), (b_s, b_p) = film_amplitudes(cos_ext, self._top_stack)
-            asi, api, asr, apr = a_s[0], a_p[0], b_s[1], b_p[1]  # in at theta_i, out at theta_r
+            # in at theta_i, out at theta_r
+            (si, sr), (ci, cr), (asi, api), (asr, apr) = film_amplitudes(cos_ext, self._top_stack)
         cp, sp = np.cos(pr), np.sin(pr)
         cos_scat = si * sr * cp - ci * cr  # k_i' . k_r'
         # Eq. 19-20: p4 / cos(tr) with the solid-angle factor, cos'/cos carried by the amplitudes.

@@ -209,33 +209,49 @@ class FilmStack(Declared):
     def transmission(self, cos_top, n_top=1.0):
         """``((t_s, t_p) down, (t_s, t_p) up)``: field transmission amplitudes through the films
         between the real ``n_top`` and this stack's substrate (module docstring, ``t_01`` and
-        ``t_10``).
+        ``t_10``), both at ``cos_top``: :meth:`transmission_down` and :meth:`transmission_up`."""
+        return self.transmission_down(cos_top, n_top), self.transmission_up(cos_top, n_top)
 
-        ``cos_top`` is the cosine in ``n_top`` of both rays: the one arriving from above, and
-        the one leaving the substrate upwards that emerges there.  The substrate must be real
-        and ``>= n_top`` (a coating under the ambient), so that every direction above has a
-        propagating partner below.  The upward amplitudes come from the same recursion as
-        :meth:`coefficients` (not a second transfer-matrix code) run on the reversed layers
-        from the substrate, with every layer's ``kz`` computed from ``cos_top`` as the downward
-        ones are: ``kz_0 = n_top cos_top`` exactly.  (From the substrate's cosine,
-        ``kz_0 = sqrt(n_s^2 cos^2 theta_s - n_s^2 + n_0^2)`` cancels near grazing exit: at
-        ``theta_0 = pi/2 - 1e-9`` under ``n_s = 1.5`` it came out 0 instead of 1e-9, and the
-        exit amplitudes erred by 2e-9 relative, a reciprocity error the stability sweep
-        flagged.)
+    def transmission_down(self, cos_top, n_top=1.0):
+        """``(t_s, t_p)``: ``t_01`` of a ray arriving from the real ``n_top`` at the cosine
+        ``cos_top`` and crossing the films into the substrate (as :meth:`transmission_up`
+        requires, a real index ``>= n_top``)."""
+        n0 = self._top_index(n_top)
+        _, _, ts, tp = self.coefficients(np.asarray(cos_top, dtype=float), n0)
+        return ts, tp
+
+    def transmission_up(self, cos_top, n_top=1.0):
+        """``(t_s, t_p)``: ``t_10`` of a ray leaving the substrate upwards that emerges in the
+        real ``n_top`` at the cosine ``cos_top``.
+
+        The substrate must be real and ``>= n_top`` (a coating under the ambient), so that
+        every direction above has a propagating partner below.  The amplitudes come from the
+        same recursion as :meth:`coefficients` (not a second transfer-matrix code) run on the
+        reversed layers from the substrate, with every layer's ``kz`` computed from
+        ``cos_top`` as the downward ones are: ``kz_0 = n_top cos_top`` exactly.  (From the
+        substrate's cosine, ``kz_0 = sqrt(n_s^2 cos^2 theta_s - n_s^2 + n_0^2)`` cancels near
+        grazing exit: at ``theta_0 = pi/2 - 1e-9`` under ``n_s = 1.5`` it came out 0 instead
+        of 1e-9, and the exit amplitudes erred by 2e-9 relative, a reciprocity error the
+        stability sweep flagged.)
         """
-        n0 = check_real("n_top", n_top, 0.0, low_open=True)
+        n0 = self._top_index(n_top)
         films, sub = self.indices
-        if sub == math.inf or sub.imag != 0 or sub.real < n0:
-            raise ValueError(
-                f"substrate must be a real index >= n_top ({n0:g}) for transmission both ways; got {sub!r}"
-            )
         c = np.asarray(cos_top, dtype=float)
-        _, _, ts, tp = self.coefficients(c, n0)
         kz = [n0 * _w(c, sub / n0)] + [n0 * _w(c, n / n0) for n in films[::-1]]
         ns = [sub] + list(films[::-1])
         r, t = (list(x) for x in _interface(kz[-1], n0 * c + 0j, ns[-1], complex(n0)))
         _, _, us, up = _rouard(kz, ns, [d for _, d in self.layers[::-1]], self.wavelength_nm, r, t)
-        return (ts, tp), (us, up)
+        return us, up
+
+    def _top_index(self, n_top):
+        """``n_top`` checked (real, > 0), with the substrate real and ``>= n_top``."""
+        n0 = check_real("n_top", n_top, 0.0, low_open=True)
+        sub = self.indices[1]
+        if sub == math.inf or sub.imag != 0 or sub.real < n0:
+            raise ValueError(
+                f"substrate must be a real index >= n_top ({n0:g}) for transmission both ways; got {sub!r}"
+            )
+        return n0
 
     def upward(self, n_top=1.0):
         """The stack as light leaving the substrate meets it: the films in reverse order on

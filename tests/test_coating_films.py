@@ -240,7 +240,7 @@ def test_jones_through_films_is_the_complex_product():
     bare = models.SubsurfaceFacetBRDF(slopes=sl, coating=N, substrate=1.37 + 7.62j)
     film = bare.replace(coating_films=ABSORBING)
     jb, jf = bare.jones(ti, ti, 0.0), film.jones(ti, ti, 0.0)
-    (ts_in, tp_in), (ts_out, tp_out) = film_transmission(np.cos(ti), ABSORBING.on(N))
+    (ts_in, tp_in), (ts_out, tp_out) = film_transmission(np.cos(ti), np.cos(ti), ABSORBING.on(N))
     _, _, ts, tp = models.fresnel_coefficients(np.cos(ti), 1.0, N)
     want = (jb[:, 0, 0] / jb[:, 1, 1]) * (ts_in * ts_out / ts**2) / (tp_in * tp_out / tp**2)
     got = jf[:, 0, 0] / jf[:, 1, 1]
