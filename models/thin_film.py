@@ -297,6 +297,16 @@ class Films(Declared):
         return self.replace(wavelength_nm=wavelength_nm)
 
 
+class FilmedCoating:
+    """Mixin of the models with ``coating_films`` (:class:`Films` or ``None``) on their real
+    ``coating`` index: :attr:`_top_stack`, the one place the films are put on the coating."""
+
+    @cached_property
+    def _top_stack(self):
+        """``coating_films`` on the coating index (a :class:`FilmStack`), or ``None``."""
+        return None if self.coating_films is None else self.coating_films.on(self.coating)
+
+
 def check_films(name, value):
     """The ``check`` of a ``coating_films`` parameter (:func:`models.params.param`): ``None``
     (no films: the bare interface) or a :class:`Films`, which validated itself when built."""
