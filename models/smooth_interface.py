@@ -160,8 +160,8 @@ def film_transmission(cos_in, cos_out, stack: FilmStack):
     the coating's index, under the ambient 1).  Each crossing is computed at its own cosine
     only: the entrance from ``t_01``, the exit from ``t_10`` (F4: not from ``t_01``)."""
     c = np.asarray(cos_out, dtype=float)
-    ts, tp = stack.transmission_down(cos_in, 1.0)
-    us, up = stack.transmission_up(c, 1.0)
+    ts, tp = stack.transmission_down(cos_in)
+    us, up = stack.transmission_up(c)
     n = stack.indices[1].real
     kz_s = n * coating_cos(c, n)
     # kz_0 / kz_s; kz_s = 0 only for n = 1 at grazing, where the ray carries no flux
@@ -202,7 +202,7 @@ def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> floa
     giving the last two estimates' difference.
     """
     n = stack.indices[1].real
-    up = stack.upward(1.0)
+    up = stack.upward()
     x, w = np.polynomial.legendre.leggauss(16)
 
     def estimate(panels):
