@@ -41,13 +41,20 @@ def _index(rng, low, high, absorbing):
     return complex(rng.uniform(low, high), rng.uniform(0.0, 3.0) if absorbing else 0.0)
 
 
-def random_case(rng):
-    """``(n0, films [(index, d_nm)], substrate, wavelength_nm, theta0)``."""
-    n0 = float(rng.choice([1.0, 1.5]))
+def _films(rng):
+    """1-4 films ``[(index, d_nm)]``: indices 1.2-3, 30 % absorbing (k up to 3), thicknesses
+    0-500 nm, 10 % exactly 0."""
     films = []
     for _ in range(int(rng.integers(1, 5))):
         d = 0.0 if rng.random() < 0.1 else float(rng.uniform(0.0, 500.0))
         films.append((_index(rng, 1.2, 3.0, rng.random() < 0.3), d))
+    return films
+
+
+def random_case(rng):
+    """``(n0, films [(index, d_nm)], substrate, wavelength_nm, theta0)``."""
+    n0 = float(rng.choice([1.0, 1.5]))
+    films = _films(rng)
     kind = rng.random()
     if kind < 0.3:  # metal
         sub = _index(rng, 0.1, 3.0, True)
@@ -60,13 +67,9 @@ def random_case(rng):
 
 
 def coating_case(rng):
-    """``(films, coating, wavelength_nm, theta0)``: films on a real coating index, crossed
-    from the ambient at ``theta0`` (the draws of ``tests/test_coating_films.py``'s stacks)."""
-    films = []
-    for _ in range(int(rng.integers(1, 5))):
-        d = 0.0 if rng.random() < 0.1 else float(rng.uniform(0.0, 500.0))
-        k = rng.uniform(0.0, 2.0) if rng.random() < 0.3 else 0.0
-        films.append((complex(rng.uniform(1.1, 3.0), k), d))
+    """``(films, coating, wavelength_nm, theta0)``: :func:`_films` on a real coating index
+    1-2.5, crossed from the ambient at ``theta0``."""
+    films = _films(rng)
     n = float(rng.uniform(1.0, 2.5))
     lam = float(rng.uniform(380.0, 780.0))
     return films, n, lam, float(rng.uniform(0.0, math.radians(89.0)))
