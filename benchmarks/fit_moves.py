@@ -7,6 +7,14 @@ Runs the report's full seed 003 model comparison
 once with the differential-evolution mixture (``ChainSettings.moves``), the same seed and
 step budget, and prints per fit the final ``max tau``, the steps run, whether ``N >= 50
 tau`` was reached, and each run's time.  It is why the report's comparison uses ``"de"``.
+
+The figures cited in :func:`validation.checks.fitting.comparison_settings` come from::
+
+    python benchmarks/fit_moves.py --max-steps 2000
+
+(the default budget is the report's, 12000 steps).  Measured 2026-11-24 on 2 shared cores:
+stretch 0/8 converged at 2000 steps (max tau 43.8-156.4, 491 s), "de" 5/8 (converged at
+800-1900 steps; the other three at max tau 52.2-151.7, 262 s).
 """
 
 from __future__ import annotations

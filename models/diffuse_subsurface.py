@@ -46,13 +46,13 @@ from .smooth_interface import (
     internal_hemispherical_reflectance,
     squared_modulus,
 )
-from .thin_film import Films, check_films
+from .thin_film import FilmedCoating, Films, check_films
 
 __all__ = ["DiffuseSubsurfaceBRDF"]
 
 
 @dataclass(frozen=True)
-class DiffuseSubsurfaceBRDF(Model):
+class DiffuseSubsurfaceBRDF(FilmedCoating, Model):
     """Lambertian diffuser under a smooth interface, multiple internal reflections (Eq. 27).
 
     Parameters
@@ -80,11 +80,6 @@ class DiffuseSubsurfaceBRDF(Model):
 
     depolarizing = True
     aliases = {"n": "coating"}
-
-    @cached_property
-    def _top_stack(self):
-        """``coating_films`` on the coating index (a :class:`models.FilmStack`), or ``None``."""
-        return None if self.coating_films is None else self.coating_films.on(self.coating)
 
     @cached_property
     def rbar(self):
@@ -118,7 +113,7 @@ class DiffuseSubsurfaceBRDF(Model):
             _, _, a_s, a_p = interface_amplitudes(cos_ext, self.coating)
             return a_s, a_p
         _, _, (a_s, a_p), (b_s, b_p) = film_amplitudes(cos_ext, self._top_stack)
-        return np.stack([a_s[0], b_s[1]]), np.stack([a_p[0], b_p[1]])
+        return np.stack([a_s, b_s]), np.stack([a_p, b_p])
 
     def _mueller16(self, ti, tr, pr):
         (asi, asr), (api, apr) = self._amps(ti, tr)

@@ -146,9 +146,12 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none", top=None):
     inv_g = 1.0 / g
     h_dots = (si * sp, cr * cp * si + sr * ci, sr * sp * inv_g, (ci * sr * cp + si * cr) * inv_g)
     d = (cp, -sp * ci, -cr * sp, sr * si - cr * cp * ci)  # e_a . e_b for ss, ps, sp, pp
-    if top is None:
-        return _jones_elements(rs, K, np.sqrt(S), h_dots, d, cos_ext, n)
-    return _through_films(_jones_elements(rs, K, np.sqrt(S), h_dots, d, cos_ext, 1.0), cos_ext, top)
+    if top is not None:  # the films' complex crossing amplitudes replace Eq. 14-15's
+        return _through_films(_jones_elements(rs, K, np.sqrt(S), h_dots, d, None), cos_ext, top)
+    # Eq. 14-18: t(theta; 1, n) of both passes; an exposed surface (n = 1) has none (t = 1,
+    # and coating_transmission would give 0/0 at grazing)
+    crossing = None if n == 1.0 else coating_transmission(cos_ext, n)
+    return _jones_elements(rs, K, np.sqrt(S), h_dots, d, crossing)
 
 
 def _through_films(parts, cos_ext, top):
@@ -156,8 +159,7 @@ def _through_films(parts, cos_ext, top):
     films on the coating, ``t_out,a(theta_r) t_in,b(theta_i)`` for element ``ab``
     (:func:`models.smooth_interface.film_transmission`, F1-F2): complex products, so the
     relative s/p phase of the films' transmission reaches the Mueller matrix."""
-    (ts_in, tp_in), (ts_out, tp_out) = film_transmission(cos_ext, top)  # rows: incidence, scattering
-    tsi, tpi, tsr, tpr = ts_in[0], tp_in[0], ts_out[1], tp_out[1]
+    (tsi, tpi), (tsr, tpr) = film_transmission(cos_ext[0], cos_ext[1], top)
     out = []
     for (re, im), f in zip(parts, (tsr * tsi, tsr * tpi, tpr * tsi, tpr * tpi), strict=True):
         z = (re + 1j * im) * f
@@ -165,10 +167,11 @@ def _through_films(parts, cos_ext, top):
     return tuple(out)
 
 
-def _jones_elements(rs, K, root, h_dots, d, cos_ext, n):
+def _jones_elements(rs, K, root, h_dots, d, crossing):
     """``q_ab = r_s D_ab + (K - 2 r_s) (e_a.h)(e_b.h)/|h|^2`` (module docstring) as
-    ``(re, im)`` pairs scaled by ``root``, with the coating's transmission factors
-    (none for ``n = 1``)."""
+    ``(re, im)`` pairs scaled by ``root``, times the coating's real transmission factors
+    ``crossing = ((t_s,in, t_s,out), (t_p,in, t_p,out))``
+    (:func:`models.fresnel.coating_transmission`), or without any for ``crossing=None``."""
     r_re = rs.real * root
     r_im = rs.imag * root
     k_re = K.real * root
@@ -177,9 +180,9 @@ def _jones_elements(rs, K, root, h_dots, d, cos_ext, n):
     k_im -= 2.0 * r_im
     ho_s, ho_p, hi_s, hi_p = h_dots
     d_ss, d_ps, d_sp, d_pp = d
-    if n != 1.0:
-        # Eq. 14-18: t(theta_r; 1, n) on the way out, t(theta_i; 1, n) on the way in.
-        (tsi, tsr), (tpi, tpr) = coating_transmission(cos_ext, n)
+    if crossing is not None:
+        # t(theta_r; 1, n) on the way out, t(theta_i; 1, n) on the way in
+        (tsi, tsr), (tpi, tpr) = crossing
         ho_s *= tsr
         ho_p *= tpr
         hi_s *= tsi

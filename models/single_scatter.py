@@ -40,7 +40,6 @@ transmittances over ``n`` (F3).  Directions, the phase function and the depth in
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
@@ -49,13 +48,13 @@ from .params import param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
 from .smooth_interface import depolarized_between, film_amplitudes, interface_amplitudes, squared_modulus
-from .thin_film import Films, check_films
+from .thin_film import FilmedCoating, Films, check_films
 
 __all__ = ["SingleScatterBRDF"]
 
 
 @dataclass(frozen=True)
-class SingleScatterBRDF(Model):
+class SingleScatterBRDF(FilmedCoating, Model):
     """Single scattering by a volume diffuser beneath a smooth interface (seed 003 Eq. 20).
 
     SCATMECH: ``First_Diffuse_BRDF_Model`` (depolarizing phase function only).
@@ -85,11 +84,6 @@ class SingleScatterBRDF(Model):
 
     aliases = {"n": "coating"}
 
-    @cached_property
-    def _top_stack(self):
-        """``coating_films`` on the coating index (a :class:`models.FilmStack`), or ``None``."""
-        return None if self.coating_films is None else self.coating_films.on(self.coating)
-
     def _validate(self):
         if not isinstance(self.phase, HenyeyGreenstein):
             raise ValueError(f"phase must be a models.HenyeyGreenstein; got {self.phase!r}")
@@ -105,8 +99,8 @@ class SingleScatterBRDF(Model):
         if self._top_stack is None:
             (si, sr), (ci, cr), (asi, asr), (api, apr) = interface_amplitudes(cos_ext, self.coating)
         else:
-            (si, sr), (ci, cr), (a_s, a_p), (b_s, b_p) = film_amplitudes(cos_ext, self._top_stack)
-            asi, api, asr, apr = a_s[0], a_p[0], b_s[1], b_p[1]  # in at theta_i, out at theta_r
+            # in at theta_i, out at theta_r
+            (si, sr), (ci, cr), (asi, api), (asr, apr) = film_amplitudes(cos_ext, self._top_stack)
         cp, sp = np.cos(pr), np.sin(pr)
         cos_scat = si * sr * cp - ci * cr  # k_i' . k_r'
         # Eq. 19-20: p4 / cos(tr) with the solid-angle factor, cos'/cos carried by the amplitudes.

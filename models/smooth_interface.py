@@ -20,9 +20,9 @@ models; :mod:`models.thin_film`).  The films change neither direction (the Snell
 change the amplitudes of the two crossings, which become complex:
 
 * entrance (F1): ``t_in = t_01(theta)``, the stack's transmission from the ambient into the
-  coating (:meth:`models.FilmStack.transmission`, down);
+  coating (:meth:`models.FilmStack.transmission_down`);
 * exit (F2): the ray leaves the coating at ``theta'`` and emerges at ``theta`` with the
-  stack's upward amplitude ``t_10``.  Seed 000 Eq. 14-15 and seed 003 Eq. 11, 25 write the
+  stack's upward amplitude ``t_10`` (:meth:`models.FilmStack.transmission_up`).  Seed 000 Eq. 14-15 and seed 003 Eq. 11, 25 write the
   exit with ``t(theta; 1, n)``, which for one interface is ``t_10 kz_0 / kz_s`` (``kz_0 =
   cos theta``, ``kz_s = n cos theta'``): the Fresnel exit amplitude with the ratio of the
   normal wavevectors that the radiance bookkeeping (``n^2`` and the ``cos'/cos`` of the
@@ -153,13 +153,15 @@ def _rbar(n: float) -> float:
     return 1.0 - (1.0 - val) / (n * n)
 
 
-def film_transmission(cos_ext, stack: FilmStack):
+def film_transmission(cos_in, cos_out, stack: FilmStack):
     """``((t_s, t_p) in, (t_s, t_p) out)``: the complex amplitudes (F1)-(F2) (module docstring)
-    that replace ``t(theta; 1, n)`` for a ray entering, and one leaving, at the external
-    cosine ``cos_ext`` through the films of ``stack`` (a :class:`models.FilmStack` on the
-    coating's index, under the ambient 1)."""
-    c = np.asarray(cos_ext, dtype=float)
-    (ts, tp), (us, up) = stack.transmission(c, 1.0)
+    that replace ``t(theta; 1, n)`` for a ray entering at the external cosine ``cos_in``, and
+    one leaving at ``cos_out``, through the films of ``stack`` (a :class:`models.FilmStack` on
+    the coating's index, under the ambient 1).  Each crossing is computed at its own cosine
+    only: the entrance from ``t_01``, the exit from ``t_10`` (F4: not from ``t_01``)."""
+    c = np.asarray(cos_out, dtype=float)
+    ts, tp = stack.transmission_down(cos_in)
+    us, up = stack.transmission_up(c)
     n = stack.indices[1].real
     kz_s = n * coating_cos(c, n)
     # kz_0 / kz_s; kz_s = 0 only for n = 1 at grazing, where the ray carries no flux
@@ -169,7 +171,9 @@ def film_transmission(cos_ext, stack: FilmStack):
 
 def film_amplitudes(cos_ext, stack: FilmStack):
     """``(sin_int, cos_int, (a_s, a_p) in, (a_s, a_p) out)``: :func:`interface_amplitudes` with
-    films, ``a = t sqrt(c'/c)`` of each crossing of :func:`film_transmission` (complex)."""
+    films, ``a = t sqrt(c'/c)`` of each crossing of :func:`film_transmission` (complex).
+    ``cos_ext`` stacks the incidence's cosines (row 0) and the exit's (row 1); ``sin_int``
+    and ``cos_int`` keep both rows, the entrance amplitudes are row 0's, the exit's row 1's."""
     c = np.asarray(cos_ext, dtype=float)
     c = np.where(c < 1e-15, 0.0, c)  # exactly grazing, as interface_amplitudes
     n = stack.indices[1].real
@@ -177,8 +181,8 @@ def film_amplitudes(cos_ext, stack: FilmStack):
     c_int = coating_cos(c, n)
     # sqrt(c'/c): t_in and the exit's kz_0 / kz_s vanish like c, so a -> 0 at grazing
     g = np.where(c > 0.0, np.sqrt(c_int / np.where(c > 0.0, c, 1.0)), 0.0)
-    (ts, tp), (us, up) = film_transmission(c, stack)
-    return s_int, c_int, (ts * g, tp * g), (us * g, up * g)
+    (ts, tp), (us, up) = film_transmission(c[0], c[1], stack)
+    return s_int, c_int, (ts * g[0], tp * g[0]), (us * g[1], up * g[1])
 
 
 def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> float:
@@ -198,7 +202,7 @@ def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> floa
     giving the last two estimates' difference.
     """
     n = stack.indices[1].real
-    up = stack.upward(1.0)
+    up = stack.upward()
     x, w = np.polynomial.legendre.leggauss(16)
 
     def estimate(panels):

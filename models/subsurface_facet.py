@@ -25,19 +25,18 @@ compiled kernel included.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 from .facet import _FacetModel, _index_or_stack
 from .params import param
 from .shadowing import SHADOWING
 from .slopes import ExponentialSlopes, SlopeDistribution
-from .thin_film import Films, check_films
+from .thin_film import FilmedCoating, Films, check_films
 
 __all__ = ["SubsurfaceFacetBRDF"]
 
 
 @dataclass(frozen=True)
-class SubsurfaceFacetBRDF(_FacetModel):
+class SubsurfaceFacetBRDF(FilmedCoating, _FacetModel):
     """Flakes or a rough interface beneath a smooth transparent coating (seed 000).
 
     A ray refracts into the coating (Eq. 2-4, 9-10), reflects from the facet
@@ -89,8 +88,3 @@ class SubsurfaceFacetBRDF(_FacetModel):
 
     def _top(self):
         return self._top_stack
-
-    @cached_property
-    def _top_stack(self):
-        """``coating_films`` on the coating index (a :class:`models.FilmStack`), or ``None``."""
-        return None if self.coating_films is None else self.coating_films.on(self.coating)

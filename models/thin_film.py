@@ -34,8 +34,8 @@ Dispersion: every index (films and substrate) may be a number or a callable
 of the wavelength in nm returning ``n + ik`` (e.g. :class:`TabulatedIndex`);
 :meth:`FilmStack.at` gives the same stack at another wavelength.
 
-Transmission both ways (:meth:`FilmStack.transmission`).  Between a real top medium
-``n_0`` (the ambient) and a real substrate ``n_s >= n_0`` (a coating), light crosses the
+Transmission both ways (:meth:`FilmStack.transmission`).  Between the ambient ``n_0 = 1``
+and a real substrate ``n_s >= 1`` (a coating), light crosses the
 films down, ``t_01`` (the recursion above), and up, ``t_10``: the same recursion on the
 reversed stack, incident from ``n_s``, at the same Snell invariant ``n_0 sin theta_0``.
 The stack is reciprocal (isotropic films, absorbing or not: Lorentz reciprocity), so in
@@ -206,41 +206,56 @@ class FilmStack(Declared):
         tp2 = (np.conj(sub) * kz / sub).real * np.abs(tp) ** 2 * inv
         return np.abs(rs) ** 2, np.abs(rp) ** 2, ts2, tp2
 
-    def transmission(self, cos_top, n_top=1.0):
+    def transmission(self, cos_top):
         """``((t_s, t_p) down, (t_s, t_p) up)``: field transmission amplitudes through the films
-        between the real ``n_top`` and this stack's substrate (module docstring, ``t_01`` and
-        ``t_10``).
+        between the ambient (index 1) and this stack's substrate (module docstring, ``t_01``
+        and ``t_10``), both at ``cos_top``: :meth:`transmission_down` and :meth:`transmission_up`."""
+        return self.transmission_down(cos_top), self.transmission_up(cos_top)
 
-        ``cos_top`` is the cosine in ``n_top`` of both rays: the one arriving from above, and
-        the one leaving the substrate upwards that emerges there.  The substrate must be real
-        and ``>= n_top`` (a coating under the ambient), so that every direction above has a
-        propagating partner below.  The upward amplitudes come from the same recursion as
-        :meth:`coefficients` (not a second transfer-matrix code) run on the reversed layers
-        from the substrate, with every layer's ``kz`` computed from ``cos_top`` as the downward
-        ones are: ``kz_0 = n_top cos_top`` exactly.  (From the substrate's cosine,
-        ``kz_0 = sqrt(n_s^2 cos^2 theta_s - n_s^2 + n_0^2)`` cancels near grazing exit: at
-        ``theta_0 = pi/2 - 1e-9`` under ``n_s = 1.5`` it came out 0 instead of 1e-9, and the
-        exit amplitudes erred by 2e-9 relative, a reciprocity error the stability sweep
-        flagged.)
+    def transmission_down(self, cos_top):
+        """``(t_s, t_p)``: ``t_01`` of a ray arriving from the ambient (index 1) at the cosine
+        ``cos_top`` and crossing the films into the substrate (as :meth:`transmission_up`
+        requires, a real index ``>= 1``)."""
+        self._check_coating()
+        _, _, ts, tp = self.coefficients(np.asarray(cos_top, dtype=float))
+        return ts, tp
+
+    def transmission_up(self, cos_top):
+        """``(t_s, t_p)``: ``t_10`` of a ray leaving the substrate upwards that emerges in the
+        ambient (index 1) at the cosine ``cos_top``.
+
+        The substrate must be real and ``>= 1`` (a coating under the ambient), so that every
+        direction above has a propagating partner below.  The amplitudes come from the same
+        recursion as :meth:`coefficients` (not a second transfer-matrix code) run on the
+        reversed layers from the substrate, with every layer's ``kz`` computed from
+        ``cos_top`` as the downward ones are: ``kz_0 = cos_top`` exactly.  (From the
+        substrate's cosine, ``kz_0 = sqrt(n_s^2 cos^2 theta_s - n_s^2 + 1)`` cancels near
+        grazing exit: at ``theta_0 = pi/2 - 1e-9`` under ``n_s = 1.5`` it came out 0 instead
+        of 1e-9, and the exit amplitudes erred by 2e-9 relative, a reciprocity error the
+        stability sweep flagged.)
         """
-        n0 = check_real("n_top", n_top, 0.0, low_open=True)
+        self._check_coating()
         films, sub = self.indices
-        if sub == math.inf or sub.imag != 0 or sub.real < n0:
-            raise ValueError(
-                f"substrate must be a real index >= n_top ({n0:g}) for transmission both ways; got {sub!r}"
-            )
         c = np.asarray(cos_top, dtype=float)
-        _, _, ts, tp = self.coefficients(c, n0)
-        kz = [n0 * _w(c, sub / n0)] + [n0 * _w(c, n / n0) for n in films[::-1]]
+        kz = [_w(c, sub)] + [_w(c, n) for n in films[::-1]]
         ns = [sub] + list(films[::-1])
-        r, t = (list(x) for x in _interface(kz[-1], n0 * c + 0j, ns[-1], complex(n0)))
+        r, t = (list(x) for x in _interface(kz[-1], c + 0j, ns[-1], 1.0 + 0j))
         _, _, us, up = _rouard(kz, ns, [d for _, d in self.layers[::-1]], self.wavelength_nm, r, t)
-        return (ts, tp), (us, up)
+        return us, up
 
-    def upward(self, n_top=1.0):
-        """The stack as light leaving the substrate meets it: the films in reverse order on
-        ``n_top``; its :meth:`coefficients` take the substrate's (real) index as ``n_incident``."""
-        return FilmStack(layers=self.layers[::-1], substrate=n_top, wavelength_nm=self.wavelength_nm)
+    def _check_coating(self):
+        """Transmission both ways needs a real substrate index ``>= 1`` (the ambient's)."""
+        sub = self.indices[1]
+        if sub == math.inf or sub.imag != 0 or sub.real < 1.0:
+            raise ValueError(
+                f"substrate must be a real index >= 1 (the ambient's) for transmission both ways; got {sub!r}"
+            )
+
+    def upward(self):
+        """The stack as light leaving the substrate meets it: the films in reverse order on the
+        ambient (index 1); its :meth:`coefficients` take the substrate's (real) index as
+        ``n_incident``."""
+        return FilmStack(layers=self.layers[::-1], substrate=1.0, wavelength_nm=self.wavelength_nm)
 
 
 @dataclass(frozen=True)
@@ -276,9 +291,15 @@ class Films(Declared):
         """The :class:`FilmStack` of these films on ``substrate``."""
         return FilmStack(layers=self.layers, substrate=substrate, wavelength_nm=self.wavelength_nm)
 
-    def at(self, wavelength_nm):
-        """The same films at another vacuum wavelength (nm)."""
-        return self.replace(wavelength_nm=wavelength_nm)
+
+class FilmedCoating:
+    """Mixin of the models with ``coating_films`` (:class:`Films` or ``None``) on their real
+    ``coating`` index: :attr:`_top_stack`, the one place the films are put on the coating."""
+
+    @cached_property
+    def _top_stack(self):
+        """``coating_films`` on the coating index (a :class:`FilmStack`), or ``None``."""
+        return None if self.coating_films is None else self.coating_films.on(self.coating)
 
 
 def check_films(name, value):

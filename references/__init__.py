@@ -174,7 +174,7 @@ def scatmech_flake_measurement_path() -> str:
 
 
 # Peer references (Mitsuba 3, tmm): committed evaluations the tests read; the peers are never imported here
-__all__ += ["mitsuba_roughconductor", "tmm_reference", "peer_timings"]
+__all__ += ["mitsuba_roughconductor", "tmm_reference", "tmm_both_ways", "peer_timings"]
 
 
 def peer_timings() -> dict:
@@ -208,20 +208,38 @@ def mitsuba_roughconductor() -> dict:
     return out
 
 
+def _tmm_case(r):
+    films = []
+    for part in r["layers"].split("|"):
+        n, k, d = (float(x) for x in part.split(";"))
+        films.append((complex(n, k), d))
+    case = {"n0": float(r["n0"]), "films": films, "wavelength_nm": float(r["wavelength_nm"])}
+    case["substrate"] = complex(float(r["substrate_n"]), float(r["substrate_k"]))
+    case["theta0"] = float(r["theta0"])
+    for c in ("rs", "rp", "ts", "tp"):
+        case[c] = complex(float(r[f"{c}_re"]), float(r[f"{c}_im"]))
+    return case
+
+
 def tmm_reference() -> list[dict]:
-    """``tmm`` thin-film coefficients (``references/scripts/make_tmm_reference.py``): one dict
-    per case with ``n0``, ``films`` (list of ``(index, thickness_nm)``), ``substrate``,
-    ``wavelength_nm``, ``theta0`` and complex ``rs, rp, ts, tp``."""
-    out = []
-    for r in read_csv("tmm_reference.csv"):
-        films = []
-        for part in r["layers"].split("|"):
-            n, k, d = (float(x) for x in part.split(";"))
-            films.append((complex(n, k), d))
-        case = {"n0": float(r["n0"]), "films": films, "wavelength_nm": float(r["wavelength_nm"])}
-        case["substrate"] = complex(float(r["substrate_n"]), float(r["substrate_k"]))
-        case["theta0"] = float(r["theta0"])
-        for c in ("rs", "rp", "ts", "tp"):
-            case[c] = complex(float(r[f"{c}_re"]), float(r[f"{c}_im"]))
-        out.append(case)
-    return out
+    """``tmm`` thin-film coefficients (``references/scripts/make_tmm_reference.py``, its
+    "random" rows): one dict per case with ``n0``, ``films`` (list of ``(index,
+    thickness_nm)``), ``substrate``, ``wavelength_nm``, ``theta0`` and complex ``rs, rp, ts, tp``."""
+    return [_tmm_case(r) for r in read_csv("tmm_reference.csv") if r["role"] == "random"]
+
+
+def tmm_both_ways() -> list[tuple[dict, dict]]:
+    """``tmm``'s films on a coating crossed both ways (the same file's "down" and "up" rows):
+    ``(down, up)`` pairs of :func:`tmm_reference`'s dicts, each with tmm's power
+    transmittances ``T_s``, ``T_p`` besides.  ``down``: from the ambient (``n0 = 1``) onto the
+    coating (``substrate``); ``up``: from the coating through the films reversed into the
+    ambient, at the refracted angle."""
+    rows = [r for r in read_csv("tmm_reference.csv") if r["role"] != "random"]
+    cases = []
+    for r in rows:
+        case = _tmm_case(r)
+        case["T_s"], case["T_p"] = float(r["T_s"]), float(r["T_p"])
+        cases.append(case)
+    if [r["role"] for r in rows] != ["down", "up"] * (len(rows) // 2):
+        raise ValueError("tmm_reference.csv: each 'down' row must be followed by its 'up' row")
+    return list(zip(cases[::2], cases[1::2], strict=True))

@@ -25,6 +25,7 @@ from validation.checks.conformance_scatmech import (
     matching_cases,
 )
 from validation.checks.registry import CheckContext
+from validation.checks.seed000 import scatmech_facet_model
 from validation.testing import (
     Contributed,
     check_model,
@@ -273,18 +274,10 @@ def test_scatmech_residual_per_unit_exponent():
         R = ref["mueller"][i]
         if abs(R[0, 0]) < SCATMECH_FLOOR:
             continue
-        cls = models.ExponentialSlopes if ref["sdf"][i] == "Exponential" else models.GaussianSlopes
-        slopes = cls(sigma=float(ref["sigma"][i]))
-        sub = complex(ref["substrate_n"][i], ref["substrate_k"][i])
-        n = 1.0 if ref["model"][i] == "facet" else float(ref["coating"][i])
-        m = (
-            models.FacetBRDF(slopes=slopes, substrate=sub)
-            if n == 1.0
-            else models.SubsurfaceFacetBRDF(slopes=slopes, coating=n, substrate=sub)
-        )
+        m, n = scatmech_facet_model(ref, i)  # the models check_scatmech_facet compares
         g = [np.array([ref[k][i]]) for k in ("theta_i", "theta_r", "phi_r")]
         zx, zy = models.facet.facet_slopes(*g, n)
-        x = -math.log(float(slopes.p3(zx, zy)[0] / slopes.p3(np.zeros(1), np.zeros(1))[0]))
+        x = -math.log(float(m.slopes.p3(zx, zy)[0] / m.slopes.p3(np.zeros(1), np.zeros(1))[0]))
         err = float(np.max(np.abs(m.mueller(*g)[0] - R)) / abs(R[0, 0]))
         worst, cases = max(worst, err / max(1.0, x)), cases + 1
     assert cases > 500

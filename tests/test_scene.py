@@ -3,6 +3,7 @@
 import csv
 import math
 import os
+import re
 
 import numpy as np
 import pytest
@@ -386,3 +387,29 @@ def test_distributions_table_keeps_its_form():
         "ggx",
         "anisotropic-ggx",
     }
+
+
+@pytest.mark.parametrize("rough", [True, False], ids=["rough-top", "smooth-top"])
+@pytest.mark.parametrize("interface", ["rough", "smooth"])
+def test_monte_carlo_volume_is_one_rule(rough, interface):
+    """The volume is the Monte Carlo model exactly where a [coating.roughness] meets
+    ``interface = 'rough'`` (models.scene.assembly.monte_carlo_volume): the assembly builds
+    RoughDiffuseBRDF there and only there, ``pairs`` is accepted there and only there, and
+    [coating.film] is refused there and only there."""
+    want = rough and interface == "rough"
+    text = (
+        BASE.replace("theta_i_deg = 30\n", "theta_i_deg = 30\nwavelength_nm = 550.0\n")
+        + "[coating]\nindex = 1.5\n"
+        + ("[coating.roughness]\ndistribution = 'gaussian'\nsigma = 0.3\n" if rough else "")
+        + f"[volume]\nrho = 0.5\ninterface = '{interface}'\n"
+    )
+    kinds = [type(m.model) for m in scene.loads(text, "v.toml").mechanisms()]
+    assert (models.RoughDiffuseBRDF in kinds) is want
+    film = "[coating.film]\nlayers = [{index = 1.2247, thickness_nm = 112.3}]\n"
+    for extra, key in (("pairs = 100\n", "[volume] pairs"), (film, "[coating.film]")):
+        refused = key == "[volume] pairs" and not want or key == "[coating.film]" and want
+        if refused:
+            with pytest.raises(scene.SceneError, match=re.escape(f"v.toml: {key}")):
+                scene.loads(text + extra, "v.toml")
+        else:
+            assert scene.loads(text + extra, "v.toml").mechanisms()

@@ -7,7 +7,13 @@ import pytest
 
 import models
 from validation.checks import seed003 as c3
-from validation.checks.fig1 import effective_index, peak_angle
+from validation.checks.fig1 import (
+    EFFECTIVE_INDEX_DEG,
+    effective_index,
+    fit_effective_index,
+    peak_angle,
+    sin_mean_angles,
+)
 from validation.numerics.integrate import integrated_reflectance
 
 
@@ -88,6 +94,20 @@ def test_fig1_effective_index():
     n_mid, _ = effective_index(0.3)
     n_wide, _ = effective_index(1.0)
     assert n_narrow > n_mid > n_wide and n_wide < 1.2
+
+
+def test_effective_index_takes_one_form():
+    """effective_index computes its own sines from sigma (no s_out to disagree with them);
+    fit_effective_index fits given sines, one per incidence, and refuses any other count."""
+    assert effective_index(0.3) == fit_effective_index(EFFECTIVE_INDEX_DEG, sin_mean_angles(0.3))
+    with pytest.raises(TypeError):
+        effective_index(0.3, s_out=sin_mean_angles(0.3))  # the old two-form call
+    deg = np.array([0.0, 20.0, 40.0, 70.0])
+    n_eff, res = fit_effective_index(deg, np.sin(np.radians(deg)) / 1.3)  # exactly Snell, n = 1.3
+    assert abs(n_eff - 1.3) <= 1e-15 and res <= 1e-16
+    for bad in (np.zeros(3), np.zeros(5), np.zeros((4, 1))):
+        with pytest.raises(ValueError, match=r"s_out must hold one value per theta_i_deg \(shape \(4,\)\)"):
+            fit_effective_index(deg, bad)
 
 
 @pytest.mark.parametrize(

@@ -29,6 +29,7 @@ __all__ = [
     "facet_mechanisms",
     "cook_torrance_mechanisms",
     "maxwell_beard_mechanisms",
+    "monte_carlo_volume",
 ]
 
 
@@ -39,6 +40,18 @@ class Mechanism:
     name: str
     model: Model
     why: str
+
+
+def monte_carlo_volume(coating: dict | None, volume: dict | None) -> bool:
+    """Whether a scene's ``[volume]`` is seed 003 Sec. 2.5's Monte Carlo model under the rough
+    coating (a ``[coating.roughness]`` with ``[volume] interface = 'rough'``): the one rule the
+    schema's checks and the assembly both apply."""
+    return (
+        volume is not None
+        and coating is not None
+        and coating.get("roughness") is not None
+        and volume["interface"] == "rough"
+    )
 
 
 def mechanisms(substrate: dict | None, coating: dict | None, volume: dict | None) -> list[Mechanism]:
@@ -59,7 +72,7 @@ def mechanisms(substrate: dict | None, coating: dict | None, volume: dict | None
             )
         )
     if volume is not None:
-        out = _volume_mechanisms(out, volume, coat_n, rough_top, top)
+        out = _volume_mechanisms(out, volume, coat_n, rough_top, top, monte_carlo_volume(coating, volume))
     return out
 
 
@@ -120,10 +133,11 @@ def maxwell_beard_mechanisms(sub: dict, coat_n) -> list[Mechanism]:
     return [Mechanism("Maxwell-Beard", model, why)]
 
 
-def _volume_mechanisms(out, v, n, rough_top, top):
-    """Seed 003: volume scattering in the binder (index = the coating's)."""
+def _volume_mechanisms(out, v, n, rough_top, top, monte_carlo):
+    """Seed 003: volume scattering in the binder (index = the coating's); ``monte_carlo``:
+    :func:`monte_carlo_volume`."""
     phase = HenyeyGreenstein(g=v["g"], polarized=v["polarized"])
-    if rough_top is not None and v["interface"] == "rough":
+    if monte_carlo:
         # The Monte Carlo model carries the direct reflection by the rough surface
         # (surface=True), so the separate rough-surface facet term is replaced.
         out = [m for m in out if m.name != "rough coating surface"]

@@ -19,6 +19,7 @@ from ..point_source import PointSourceBRDF
 from ..polarization import stokes
 from ..subsurface_facet import SubsurfaceFacetBRDF
 from ..thin_film import Films, FilmStack
+from .assembly import monte_carlo_volume
 from .table import SUBSTRATE_MODELS, TABLE, VOLUME, VOLUME_DEFAULTS, KeyProblem, build
 
 __all__ = [
@@ -410,7 +411,7 @@ def _coating_films_apply(path, out):
             f"not with [substrate] model = {sub['model']!r}: its varnish model takes no films "
             "(films on the coating go with model = 'facet' or a [volume])",
         )
-    if vol is not None and vol["interface"] == "rough" and coating.get("roughness") is not None:
+    if monte_carlo_volume(coating, vol):
         raise _err(
             path,
             "[coating.film]",
@@ -462,7 +463,7 @@ def _volume(path, v, coating):
     out["interface"] = interface
     if out["rho"] == 0 and not out["single"]:
         raise _err(path, "[volume]", "declares no scattering: set rho > 0 or single = true")
-    monte_carlo = coating.get("roughness") is not None and interface == "rough"
+    monte_carlo = monte_carlo_volume(coating, out)
     if monte_carlo and coating.get("shadowing", "none") != "none":
         raise _err(
             path,

@@ -23,7 +23,7 @@ import numpy as np
 
 import models
 
-__all__ = ["SIGMAS", "peak_angle", "mean_transmitted_angle", "effective_index", "fig1"]
+__all__ = ["SIGMAS", "peak_angle", "mean_transmitted_angle", "effective_index", "fit_effective_index", "fig1"]
 
 SIGMAS = (0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0)
 N_INDEX = 1.5
@@ -78,11 +78,22 @@ def sin_mean_angles(sigma, n=N_INDEX, theta_i_deg=EFFECTIVE_INDEX_DEG):
     return np.array([math.sin(mean_transmitted_angle(sigma, math.radians(t), n)) for t in theta_i_deg])
 
 
-def effective_index(sigma, n=N_INDEX, theta_i_deg=EFFECTIVE_INDEX_DEG, s_out=None):
-    """``(n_eff, max |residual|)`` of ``sin(mean tt) = sin(ti)/n_eff`` (least squares through 0);
-    ``s_out``: :func:`sin_mean_angles` if already computed."""
+def effective_index(sigma, n=N_INDEX, theta_i_deg=EFFECTIVE_INDEX_DEG):
+    """``(n_eff, max |residual|)`` of ``sin(mean tt) = sin(ti)/n_eff`` (least squares through 0)
+    for the Gaussian slopes ``sigma``: :func:`fit_effective_index` of :func:`sin_mean_angles`."""
+    return fit_effective_index(theta_i_deg, sin_mean_angles(sigma, n, theta_i_deg))
+
+
+def fit_effective_index(theta_i_deg, s_out):
+    """``(n_eff, max |residual|)`` of ``s_out = sin(ti)/n_eff`` (least squares through 0):
+    ``s_out`` holds ``sin(mean theta_t)`` measured at each of ``theta_i_deg`` (as
+    :func:`sin_mean_angles` gives it), one value per incidence."""
     s_in = np.sin(np.radians(np.asarray(theta_i_deg, dtype=float)))
-    s_out = sin_mean_angles(sigma, n, theta_i_deg) if s_out is None else s_out
+    s_out = np.asarray(s_out, dtype=float)
+    if s_in.ndim != 1 or s_out.shape != s_in.shape:
+        raise ValueError(
+            f"s_out must hold one value per theta_i_deg (shape {s_in.shape}); got shape {s_out.shape}"
+        )
     slope = float(np.sum(s_in * s_out) / np.sum(s_in * s_in))
     return 1.0 / slope, float(np.max(np.abs(s_out - slope * s_in)))
 
@@ -93,7 +104,7 @@ def fig1(sigmas=SIGMAS):
     rows = []
     for s in sigmas:
         s_out = sin_mean_angles(s)
-        n_eff, res = effective_index(s, s_out=s_out)
+        n_eff, res = fit_effective_index(EFFECTIVE_INDEX_DEG, s_out)
         rows.append(
             {"sigma": s, "peak_deg": peak_angle(s), "n_eff": n_eff, "linear_residual": res, "sin_out": s_out}
         )

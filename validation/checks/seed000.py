@@ -29,7 +29,7 @@ from .conformance_scatmech import scatmech_tolerance
 from .registry import Finding, check, judge, text_section
 from .table1 import compute_table1, format_table1
 
-__all__ = ["scatmech_facet_errors", "extreme_models", "energy_samples"]
+__all__ = ["scatmech_facet_model", "scatmech_facet_errors", "extreme_models", "energy_samples"]
 
 
 # ----------------------------------------------------------------------------- Fresnel
@@ -90,19 +90,27 @@ def check_slope_conversions(ctx):
 
 
 # ----------------------------------------------------------------------------- SCATMECH
+def scatmech_facet_model(ref, i):
+    """``(model, coating)``: scatterbench's counterpart of case ``i`` of the committed SCATMECH
+    facet references ``ref`` (:func:`references.scatmech_facet`) and the coating index it
+    reflects under: :class:`models.FacetBRDF` (coating 1) for SCATMECH's
+    ``Facet_BRDF_Model``, :class:`models.SubsurfaceFacetBRDF` with the case's coating for
+    ``Subsurface_Facet_BRDF_Model`` (an overcoat of 1 included)."""
+    cls = models.ExponentialSlopes if ref["sdf"][i] == "Exponential" else models.GaussianSlopes
+    slopes = cls(sigma=float(ref["sigma"][i]))
+    sub = complex(ref["substrate_n"][i], ref["substrate_k"][i])
+    if ref["model"][i] == "facet":
+        return models.FacetBRDF(slopes=slopes, substrate=sub), 1.0
+    n = float(ref["coating"][i])
+    return models.SubsurfaceFacetBRDF(slopes=slopes, coating=n, substrate=sub), n
+
+
 def scatmech_facet_errors():
     """Per-case max ``|M - M_scatmech| / M00`` over the committed references, by model."""
     ref = references.scatmech_facet()
     errs = {"facet": [], "subsurface": []}
     for i in range(len(ref["model"])):
-        sdf = ref["sdf"][i]
-        cls = models.ExponentialSlopes if sdf == "Exponential" else models.GaussianSlopes
-        slopes = cls(sigma=float(ref["sigma"][i]))
-        sub = complex(ref["substrate_n"][i], ref["substrate_k"][i])
-        if ref["model"][i] == "facet":
-            m = models.FacetBRDF(slopes=slopes, substrate=sub)
-        else:
-            m = models.SubsurfaceFacetBRDF(slopes=slopes, coating=float(ref["coating"][i]), substrate=sub)
+        m, _ = scatmech_facet_model(ref, i)
         M = m.mueller(ref["theta_i"][i], ref["theta_r"][i], ref["phi_r"][i])
         R = ref["mueller"][i]
         scale = max(abs(R[0, 0]), 1e-300)

@@ -59,6 +59,11 @@ __all__ = [
 
 ACCEPTED_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accepted_findings.toml")
 
+# Films on the coating's top surface (coating_films): a zero-thickness film, a quarter-wave
+# anti-reflection film on the default coating 1.5, a thick one and an absorbing pair.
+_AR = math.sqrt(1.5)
+_ABSORBING_FILMS = models.Films(layers=((1.8 + 0.3j, 120.0), (2.4, 60.0)), wavelength_nm=550.0)
+
 # Edge values by parameter name, for the names the models use; other parameters
 # fall back to their declared bounds.
 _NAMED_EDGES = {
@@ -98,7 +103,17 @@ _NAMED_EDGES = {
     "rho_v": (0.0, 1.0 / math.pi),
     "tau": (1e-4, 2.0),
     "omega": (1e-4, 2.0),
+    "coating_films": (
+        models.Films(layers=((2.0, 0.0),), wavelength_nm=550.0),
+        models.Films(layers=((_AR, 550.0 / (4 * _AR)),), wavelength_nm=550.0),
+        models.Films(layers=((2.6, 1e5),), wavelength_nm=550.0),
+        _ABSORBING_FILMS,
+    ),
 }
+
+# (parameter, edge value) -> parameters swept to their edges once more with that edge set:
+# the coating's edges (1, 1 + 1e-9, 3) under the absorbing films.
+_SWEPT_AT = {("coating_films", _ABSORBING_FILMS): ("coating",)}
 
 # Classes whose defaults cannot be built alone (wrappers): a representative instance.
 _BASES = {
@@ -135,24 +150,6 @@ def _issue15_bases(name):
         ),
     )
     return out + [(cls(substrate=f, shadowing=sh), ()) for f in films for sh in ("none", "smith")]
-
-
-def _coating_film_bases(name):
-    """Films on the coating's top surface (``coating_films``) of the models that take them, as
-    ``(instance, swept parameters)``: a zero-thickness film, a quarter-wave anti-reflection
-    film, a thick one and an absorbing pair as they are, and the absorbing pair with the
-    coating swept to its edges (1, 1 + 1e-9, 3)."""
-    if name not in ("SubsurfaceFacetBRDF", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF"):
-        return []
-    cls = getattr(models, name)
-    ar = math.sqrt(1.5)
-    absorbing = models.Films(layers=((1.8 + 0.3j, 120.0), (2.4, 60.0)), wavelength_nm=550.0)
-    films = (
-        models.Films(layers=((2.0, 0.0),), wavelength_nm=550.0),
-        models.Films(layers=((ar, 550.0 / (4 * ar)),), wavelength_nm=550.0),
-        models.Films(layers=((2.6, 1e5),), wavelength_nm=550.0),
-    )
-    return [(cls(coating_films=f), ()) for f in films] + [(cls(coating_films=absorbing), ("coating",))]
 
 
 _INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
@@ -242,9 +239,19 @@ def edge_instances(cls):
         if inst not in out:
             out.append(inst)
     if not isinstance(cls, models.Model):
-        for extra, names in _issue15_bases(cls.__name__) + _coating_film_bases(cls.__name__):
+        for extra, names in _issue15_bases(cls.__name__) + _swept_at(base):
             out += [inst for inst in _one_at_a_time(extra, names) if inst not in out]
     return out
+
+
+def _swept_at(base):
+    """``(instance, swept parameters)`` of :data:`_SWEPT_AT` for the parameters ``base`` has."""
+    have = {info.name for info in type(base).parameters()}
+    return [
+        (dataclasses.replace(base, **{name: value}), names)
+        for (name, value), names in _SWEPT_AT.items()
+        if name in have
+    ]
 
 
 def _real_indices(obj, out=None):
