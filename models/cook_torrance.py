@@ -245,7 +245,14 @@ class _CookTorranceBase(Model):
 
     def _cook_spec(self, variant, coating):
         """The Cook-Torrance kernel (every shadowing option: :data:`models.kernel_specs.COOK_SHADOWING`)."""
-        rows = [coating, *kernel_specs.index_rows(self.substrate), *self._m_rows()]
+        m_rows = self._m_rows()
+        rows = [
+            coating,
+            *kernel_specs.index_rows(self.substrate),
+            *m_rows,
+            np.cos(m_rows[2]),
+            np.sin(m_rows[2]),
+        ]
         options = (variant, int(self.convention == "corrected"), kernel_specs.COOK_SHADOWING[self.shadowing])
         return "cook", rows, options
 

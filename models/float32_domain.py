@@ -140,6 +140,9 @@ LOBE_SLOPE = {
 #: parameter rows that are angles: the float32 rows take them reduced to (-pi, pi] in float64
 #: (:class:`models.kernels.Compiled`), so any finite value is exact enough
 ANGLE_ROWS = ("rotation", "stroke_angle")
+#: rows holding an angle's cosine or sine: in [-1, 1], where rounding to float32 (to zero
+#: below 1.2e-38) is the angle's own rounding
+TRIG_ROWS = ("stroke_cos", "stroke_sin")
 #: kernels that compute sines as sqrt(1 - cos^2)
 _SINES_FROM_COSINES = ("facet", "maxwell", "cook", "single")
 
@@ -247,7 +250,7 @@ def condition(code, rows, iopt):
 def _unrepresentable(rows):
     """The first parameter row float32 cannot carry (a sentence), or ``None``."""
     for name, v in rows.items():
-        if name in ANGLE_ROWS:
+        if name in ANGLE_ROWS or name in TRIG_ROWS:
             continue
         a = np.abs(v)
         exact_inf = (a == math.inf) & name.startswith("substrate")

@@ -14,7 +14,13 @@ import models
 from models.kernels import Compiled, drive, vector
 from models.kernels.vector_math import REDUCED_MAX, exp_neg, sincos, sqrt
 
-VECTORIZED = [m for m in CONFIGS if Compiled(m, *m._kernel_spec()).vectorized]
+#: test_kernels' configurations, and Cook-Torrance under strokes (its azimuth's cosine and
+#: sine are parameter rows)
+STROKES = [
+    models.CookTorranceBRDF(slopes=models.StrokeSlopes(0.05, 0.2, 0.7), substrate=1.37 + 7.62j, shadowing=sh)
+    for sh in ("none", "blinn")
+] + [models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.3, 0.1, -2.0), convention="corrected")]
+VECTORIZED = [m for m in CONFIGS + STROKES if Compiled(m, *m._kernel_spec()).vectorized]
 #: azimuths beyond the polynomial's range (the C library's there), and at its edge
 FAR = np.array([REDUCED_MAX, -REDUCED_MAX, 3.0e6, -1.0e7, 1.0e300])
 
@@ -37,10 +43,12 @@ def _both(kernel, ti, tr, pr):
 
 def test_the_vectorized_models_are_the_ones_meant():
     names = {type(m).__name__ for m in VECTORIZED}
-    assert names == {"FacetBRDF", "SubsurfaceFacetBRDF", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF"}
-    kinds = {type(m.slopes).__name__ for m in VECTORIZED if hasattr(m, "slopes")}
-    assert kinds == {"ExponentialSlopes", "GaussianSlopes", "GGXSlopes"}
-    assert all(m.shadowing == "none" for m in VECTORIZED if hasattr(m, "shadowing"))
+    cook = {"CookTorranceBRDF", "VarnishedCookTorranceBRDF"}
+    assert names == {"FacetBRDF", "SubsurfaceFacetBRDF", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF"} | cook
+    facets = [m for m in VECTORIZED if type(m).__name__.endswith("FacetBRDF")]
+    assert {type(m.slopes).__name__ for m in facets} == {"ExponentialSlopes", "GaussianSlopes", "GGXSlopes"}
+    assert all(m.shadowing == "none" for m in facets)
+    assert {m.shadowing for m in VECTORIZED if type(m).__name__ in cook} == {"none", "blinn"}
 
 
 @pytest.mark.parametrize("model", VECTORIZED, ids=lambda m: type(m).__name__)
@@ -78,7 +86,8 @@ def test_models_take_the_vector_loop_and_agree_with_numpy():
 
 
 @pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="x86 instruction names")
-def test_the_lanes_compile_to_simd_instructions():
+@pytest.mark.parametrize("which", ["facet", "varnished cook"])
+def test_the_lanes_compile_to_simd_instructions(which):
     """The loop's square roots are packed (``sqrtpd``: two or more float64 per instruction);
     a scalar loop has only ``sqrtsd``.  Fails when a change puts a call or an exception back
     in a kernel the vector path takes."""

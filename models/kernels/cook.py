@@ -14,6 +14,9 @@ from .vector_math import sqrt
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
+#: and the stroke azimuth's cosine and sine, taken once per model (no C library call per
+#: geometry: :mod:`models.kernels.vector` runs the loop on SIMD lanes)
+COOK_ROWS += ("stroke_cos", "stroke_sin")
 
 
 @njit(cache=True, error_model="numpy")
@@ -46,8 +49,8 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     hz2 = hz * hz
     g = hx * hx + hy * hy + hz2
     q = g / hz2
-    # the strokes' azimuth matters only for unequal m (stroke_d); two trig calls saved otherwise
-    ca, sa = (T(1.0), T(0.0)) if p[3] == p[4] else (math.cos(p[5]), math.sin(p[5]))
+    # the strokes' azimuth matters only for unequal m (stroke_d, as the numpy path's)
+    ca, sa = (T(1.0), T(0.0)) if p[3] == p[4] else (p[6], p[7])
     val = stroke_d(hx, hy, hz2, p[3], p[4], ca, sa) * (q * q)
     val *= fresnel_average(T(0.5) * sqrt(g), mr, mi, mr == T(math.inf))
     if shadowing == 1:

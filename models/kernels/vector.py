@@ -18,8 +18,7 @@ block of :data:`VBLOCK` geometries:
 
 The kernels are the same functions as the scalar loop's, so both give the same bits
 (``tests/test_kernels.py``).  :func:`vectorized` says which models and options take this
-path; the others (FacetBTDF, Cook-Torrance, Maxwell-Beard, Smith shadowing, anisotropic
-slopes) keep C
+path; the others (FacetBTDF, Maxwell-Beard, Smith shadowing, anisotropic slopes) keep C
 library calls that leave any loop scalar, and :class:`models.kernels.Compiled` runs them
 through :mod:`~models.kernels.drive`.
 """
@@ -31,9 +30,10 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..kernel_specs import EXPONENTIAL, GAUSSIAN, GGX
+from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX
 from .common import NO_SHADOWING
-from .drive import BLOCK, DIFFUSE, FACET, PARAM_ROWS, SINGLE, options
+from .cook import cook
+from .drive import BLOCK, COOK, DIFFUSE, FACET, PARAM_ROWS, SINGLE, options
 from .facet import facet
 from .vector_math import REDUCED_MAX, sincos
 from .volume import diffuse, single
@@ -48,12 +48,15 @@ _ROWS = _PRM + PARAM_ROWS
 #: through the C library's cosine; the unit one is left to the scalar loop: each kind costs
 #: about 2 s of compilation)
 FACET_KINDS = (EXPONENTIAL, GAUSSIAN, GGX)
+BLINN, NO_COOK_SHADOWING = COOK_SHADOWING["blinn"], COOK_SHADOWING["none"]
 
 
 def vectorized(code, iopt) -> bool:
     """Whether kernel ``code`` with options ``iopt`` takes the vector path (float64)."""
     if code == FACET:
         return iopt[1] == NO_SHADOWING and iopt[0] in FACET_KINDS
+    if code == COOK:
+        return iopt[2] != COOK_SHADOWING["smith"]
     return code in (SINGLE, DIFFUSE)
 
 
@@ -113,8 +116,12 @@ def lanes(code, sc, m, o):
             _loop(single, sc, m, (0, 0, 0))
         else:
             _loop(single, sc, m, (1, 0, 0))
-    else:
+    elif code == DIFFUSE:
         _loop(diffuse, sc, m, (0, 0, 0))
+    elif o[2] == BLINN:
+        _loop(cook, sc, m, (o[0], o[1], BLINN))
+    else:
+        _loop(cook, sc, m, (o[0], o[1], NO_COOK_SHADOWING))
 
 
 @njit(cache=True, error_model="numpy")
