@@ -55,8 +55,8 @@ def vectorized(code, iopt) -> bool:
     """Whether kernel ``code`` with options ``iopt`` takes the vector path (float64)."""
     if code == FACET:
         return iopt[1] == NO_SHADOWING and iopt[0] in FACET_KINDS
-    if code == COOK:
-        return iopt[2] != COOK_SHADOWING["smith"]
+    if code == COOK:  # the varnished form: LLVM's cost model keeps its loop scalar
+        return iopt[0] == 0 and iopt[2] != COOK_SHADOWING["smith"]
     return code in (SINGLE, DIFFUSE)
 
 
@@ -119,9 +119,9 @@ def lanes(code, sc, m, o):
     elif code == DIFFUSE:
         _loop(diffuse, sc, m, (0, 0, 0))
     elif o[2] == BLINN:
-        _loop(cook, sc, m, (o[0], o[1], BLINN))
+        _loop(cook, sc, m, (0, o[1], BLINN))
     else:
-        _loop(cook, sc, m, (o[0], o[1], NO_COOK_SHADOWING))
+        _loop(cook, sc, m, (0, o[1], NO_COOK_SHADOWING))
 
 
 @njit(cache=True, error_model="numpy")
