@@ -46,6 +46,9 @@ __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 #: ``fit`` command of ``benchmarks/fit_speed.py``, best of three runs each, 2 cores); small
 #: calls (<= 100 geometries) stay serial
 PARALLEL_MIN = 1024
+#: geometries from which a small call of a vectorized model takes :mod:`~models.kernels.vector`
+#: (below: the scalar loop, which needs no scratch)
+VECTOR_MIN = 16
 _HALF_PI = 0.5 * math.pi
 _FLOAT64 = np.dtype(np.float64)
 _DTYPES = {"float64": _FLOAT64, "float32": np.dtype(np.float32)}
@@ -196,7 +199,8 @@ class Compiled:
         elif not out.flags.c_contiguous:
             return None
         if dtype is _FLOAT64 and n < PARALLEL_MIN:
-            if not drive.run_checked(self.code, ti, tr, pr, self.prm["float64"], self.iopt, out):
+            loops = vector if self.vectorized and n >= VECTOR_MIN else drive
+            if not loops.run_checked(self.code, ti, tr, pr, self.prm["float64"], self.iopt, out):
                 return None
         else:
             if not drive.angles_ok(ti, tr, pr):

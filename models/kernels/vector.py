@@ -33,7 +33,7 @@ from numba import njit, prange
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX
 from .common import NO_SHADOWING
 from .cook import cook
-from .drive import BLOCK, COOK, DIFFUSE, FACET, PARAM_ROWS, SINGLE, options
+from .drive import BLOCK, COOK, DIFFUSE, FACET, PARAM_ROWS, SINGLE, angles_ok, options
 from .facet import facet
 from .vector_math import REDUCED_MAX, sincos
 from .volume import diffuse, single
@@ -164,6 +164,15 @@ def run(code, ti, tr, pr, prm, iopt, out, start):
     """:func:`models.kernels.drive.run` (same arguments, float64) on SIMD lanes."""
     n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
     run_range(code, ti, tr, pr, prm, iopt, out, start, 0, n)
+
+
+@njit(cache=True, error_model="numpy")
+def run_checked(code, ti, tr, pr, prm, iopt, out):
+    """:func:`models.kernels.drive.run_checked` (same arguments, float64) on SIMD lanes."""
+    if not angles_ok(ti, tr, pr):
+        return False
+    run(code, ti, tr, pr, prm, iopt, out, 0)
+    return True
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
