@@ -3,6 +3,9 @@
 instructions, and the polynomials within 2 ulp of the C library."""
 
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -84,44 +87,35 @@ def test_models_take_the_vector_loop_and_agree_with_numpy():
     assert _relative(mk, mn) <= TOL
 
 
-@pytest.mark.parametrize("which", ["facet", "cook"])
-def test_the_lanes_are_vectorized_loops(which):
-    """LLVM's loop vectorizer took the loop (its ``vector.body`` block is in the optimized IR,
-    working on ``<N x double>`` values); a scalar loop has neither.  Fails when a change puts
-    a call or an exception back in a kernel the vector path takes."""
-    from models.kernel_specs import EXPONENTIAL
-    from models.kernels.cook import cook
-    from models.kernels.facet import facet
-
-    # not cached: a cached function keeps no IR to inspect
-    if which == "facet":
-
-        @njit(error_model="numpy")
-        def lanes(sc, m):
-            vector._loop(facet, sc, m, (EXPONENTIAL, 0, 0))
-    else:
-
-        @njit(error_model="numpy")
-        def lanes(sc, m):
-            vector._loop(cook, sc, m, (0, 1, vector.BLINN))
-
-    lanes(np.zeros(vector._ROWS * vector.VBLOCK), 8)
-    ir = "".join(lanes.inspect_llvm().values())
-    assert "vector.body" in ir and " x double>" in ir
+_PROBE = """
+import re
+import numpy as np, models
+from models.kernels import Compiled, drive, vector
+for m in (models.FacetBRDF(), models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
+    Compiled(m, *m._kernel_spec()).run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
+drive.run(0, np.zeros(4), np.zeros(4), np.zeros(4), np.ones((drive.PARAM_ROWS, 1)),
+          np.zeros(3, dtype=np.int64), np.empty((16, 4)), 0)
+for name, fn in (("lanes", vector.lanes), ("scalar", drive.run_range)):
+    ir = "".join(fn.inspect_llvm().values())
+    print(name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
+"""
 
 
-def test_a_scalar_loop_is_told_apart():
-    """The check above on the scalar loop of :mod:`~models.kernels.drive` (which the
-    vectorizer leaves alone) finds no vector loop."""
-    from models.kernels.facet import facet
-
-    @njit(error_model="numpy")
-    def serial(x, prm, out):
-        drive._serial(facet, x, x, x, prm, (0, 0, 0), out, 0, 0, x.shape[0])
-
-    x = np.linspace(0.0, 1.0, 8)
-    serial(x, np.ones((drive.PARAM_ROWS, 1)), np.empty((16, 8)))
-    assert "vector.body" not in "".join(serial.inspect_llvm().values())
+def test_the_lanes_are_vectorized_loops(tmp_path):
+    """In a process with an empty kernel cache (a function loaded from the cache keeps no IR,
+    and LLVM cannot inline it): :func:`models.kernels.vector.lanes` holds LLVM's vectorized
+    loops (their ``vector.body`` blocks, on ``<N x double>`` values), one per facet slope
+    kind, single scattering, diffuse and Cook-Torrance loop that compiled; the scalar loop
+    of :mod:`~models.kernels.drive` has none.  Fails when a change puts a call or an
+    exception back in a kernel the vector path takes."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
+    counts = {ln.split()[0]: tuple(int(x) for x in ln.split()[1:]) for ln in res.stdout.splitlines()}
+    # lanes is one compiled function holding every specialization: 3 facet slope kinds,
+    # 2 single scattering, 1 diffuse, 2 Cook-Torrance (blinn, none): a vector.body each
+    # (labels vector.body.i, vector.body.i5, ... once inlined)
+    assert counts["lanes"][0] >= 8 and counts["lanes"][1] > 0
+    assert counts["scalar"][0] == 0
 
 
 @njit
