@@ -25,7 +25,10 @@ recursion):
     e = exp(2 i beta),  beta = 2 pi d kz / lambda  (the film's phase thickness).
 
 A zero-thickness film therefore changes nothing (``(r01 + r12)/(1 + r01 r12) =
-r02`` for both polarizations, phases included) and a stack without films is
+r02`` for both polarizations, phases included), so the recursion leaves such films
+out: summed, they are 0/0 at exact grazing between media of one index, where
+``1 + r01 r12 = 0``.  Likewise two media of one index meet in no interface
+(``r = 0``, ``t = 1``, set exactly).  A stack without films of positive thickness is
 the bare interface, evaluated by :func:`models.fresnel.fresnel_coefficients`
 itself.  A perfect-conductor substrate (``math.inf``) has ``r_s = -1``,
 ``r_p = +1``, ``t = 0`` at the last interface.
@@ -158,6 +161,16 @@ class FilmStack(Declared):
             "substrate", self.substrate, self.wavelength_nm
         )
 
+    @cached_property
+    def _thick(self):
+        """``(indices, thicknesses)`` of the films of positive thickness, the ones the
+        recursion sums: a zero-thickness film changes nothing (module docstring), but summed
+        it would make the recursion 0/0 at exact grazing, where ``1 + r01 r12 = 0`` when the
+        media on both sides have the same index (or the film sits on a perfect conductor)."""
+        films = self.indices[0]
+        kept = [(n, d) for n, (_, d) in zip(films, self.layers, strict=True) if d > 0.0]
+        return tuple(n for n, _ in kept), tuple(d for _, d in kept)
+
     def at(self, wavelength_nm):
         """The same stack at another vacuum wavelength (nm)."""
         return self.replace(wavelength_nm=wavelength_nm)
@@ -165,14 +178,14 @@ class FilmStack(Declared):
     def coefficients(self, cos_i, n_incident=1.0):
         """``(r_s, r_p, t_s, t_p)`` for light in the real ``n_incident`` at incidence cosine ``cos_i``."""
         n0 = check_real("n_incident", n_incident, 0.0, low_open=True)
-        films, sub = self.indices
+        (films, thickness), sub = self._thick, self.indices[1]
         c = np.asarray(cos_i, dtype=float)
         if not films:
             return fresnel_coefficients(c, n0, sub)
         kz = [n0 * c + 0j] + [n0 * _w(c, n / n0) for n in films]  # n_j cos(theta_j), Im >= 0
         ns = [complex(n0)] + list(films)
         r, t = _bottom(kz[-1], ns[-1], c, n0, sub)
-        return _rouard(kz, ns, [d for _, d in self.layers], self.wavelength_nm, r, t)
+        return _rouard(kz, ns, thickness, self.wavelength_nm, r, t)
 
     def reflection_rs_k(self, cos_i, n_incident):
         """``r_s`` and ``K = (r_s + r_p) / sin^2(theta)`` (:func:`models.fresnel.reflection_rs_k`).
@@ -181,7 +194,7 @@ class FilmStack(Declared):
         its rounding error there stays ~1e-16 however small ``sin``; at exactly
         normal incidence, where ``r_s + r_p = 0``, it is set to 0.
         """
-        films, sub = self.indices
+        films, sub = self._thick[0], self.indices[1]
         c = np.asarray(cos_i, dtype=float)
         if not films:
             return reflection_rs_k(c, sub if sub == math.inf else sub / n_incident)
@@ -235,12 +248,12 @@ class FilmStack(Declared):
         stability sweep flagged.)
         """
         self._check_coating()
-        films, sub = self.indices
+        (films, thickness), sub = self._thick, self.indices[1]
         c = np.asarray(cos_top, dtype=float)
         kz = [_w(c, sub)] + [_w(c, n) for n in films[::-1]]
         ns = [sub] + list(films[::-1])
         r, t = (list(x) for x in _interface(kz[-1], c + 0j, ns[-1], 1.0 + 0j))
-        _, _, us, up = _rouard(kz, ns, [d for _, d in self.layers[::-1]], self.wavelength_nm, r, t)
+        _, _, us, up = _rouard(kz, ns, thickness[::-1], self.wavelength_nm, r, t)
         return us, up
 
     def _check_coating(self):
@@ -332,7 +345,14 @@ def _rouard(kz, ns, thickness, wavelength_nm, r, t):
 
 
 def _interface(kz1, kz2, n1, n2):
-    """``((r_s, r_p), (t_s, t_p))`` of one interface (module docstring)."""
+    """``((r_s, r_p), (t_s, t_p))`` of one interface (module docstring).
+
+    Two media of one index are no interface: ``r = 0``, ``t = 1`` at every angle, set
+    exactly, since at exact grazing both ``kz`` vanish and the formulas are 0/0 (an
+    index-1 film under the ambient, e.g.)."""
+    if n1 == n2:
+        zero = np.zeros(np.broadcast(kz1, kz2).shape, dtype=complex)
+        return (zero, zero.copy()), (zero + 1.0, zero + 1.0)
     a = n2 * n2 * kz1
     b = n1 * n1 * kz2
     rs = (kz1 - kz2) / (kz1 + kz2)

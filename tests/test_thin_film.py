@@ -131,12 +131,56 @@ def test_energy_on_a_perfect_conductor():
     "n0, film, sub", [(1.0, 2.5, 1.56), (1.5, 1.3 + 0.4j, 1.37 + 7.62j), (1.5, 2.0, 1.2)]
 )
 def test_zero_thickness_film_is_the_bare_interface(n0, film, sub):
-    """Both polarizations, phases included (TIR beyond 53 deg for 1.5 -> 1.2)."""
-    c = np.cos(np.linspace(0, math.pi / 2, 181))
+    """Both polarizations, phases included (TIR beyond 53 deg for 1.5 -> 1.2): the stack
+    (which leaves zero-thickness films out) and the recursion summing such a film, which
+    must give the same by the identity (r01 + r12) / (1 + r01 r12) = r02."""
+    from models.thin_film import _bottom, _rouard, _w
+
+    c = np.cos(np.linspace(0, math.pi / 2, 181))[:-1]  # the recursion is 0/0 at exact grazing
     got = FilmStack(layers=((film, 0.0),), substrate=sub, wavelength_nm=600.0).coefficients(c, n0)
+    kz = [n0 * c + 0j, n0 * _w(c, film / n0)]
+    summed = _rouard(kz, [complex(n0), film], (0.0,), 600.0, *_bottom(kz[1], film, c, n0, sub))
     want = fresnel_coefficients(c, n0, sub)
-    for g, w in zip(got, want, strict=True):
-        assert np.max(np.abs(g - w)) <= 1e-14 * max(1.0, np.max(np.abs(w)))
+    for g, s, w in zip(got, summed, want, strict=True):
+        assert np.array_equal(g, w)
+        assert np.max(np.abs(s - w)) <= 1e-14 * max(1.0, np.max(np.abs(w)))
+
+
+@pytest.mark.parametrize(
+    "layers, sub",
+    [
+        (((2.0, 0.0),), 1.0),  # zero-thickness film between two media of one index
+        (((2.0, 0.0),), math.inf),  # ... on a perfect conductor (r_p = 1 below)
+        (((1.0, 100.0),), 1.5),  # a film of the ambient's index
+        (((1.0, 100.0), (2.0, 0.0), (1.3 + 0.1j, 80.0)), 1.0),
+        (((1.5, 100.0), (1.5, 40.0)), 1.5),  # films of the substrate's index
+    ],
+)
+def test_exact_grazing_is_the_limit_not_nan(layers, sub):
+    """At cos = 0 the coefficients are finite and continue those at cos = 1e-12 (they move
+    by O(cos)); the first four stacks made the recursion 0/0 there (NaN) before
+    zero-thickness films were left out and same-index interfaces set to r = 0, t = 1 (the
+    last has same-index interfaces away from grazing).  Both ways where the substrate allows."""
+    st = FilmStack(layers=layers, substrate=sub, wavelength_nm=550.0)
+    c = np.array([0.0, 1e-12])
+    pairs = [st.coefficients(c)]
+    if sub != math.inf:
+        pairs += list(st.transmission(c))
+    with np.errstate(all="raise"):
+        for coeffs in pairs:
+            for x in coeffs:
+                assert np.all(np.isfinite(x)) and abs(x[0] - x[1]) <= 1e-9
+
+
+def test_a_filmed_coating_of_the_ambients_index_at_grazing_is_finite():
+    """The model-level case that gave NaN: ``coating=1.0`` under a zero-thickness film at
+    exact grazing incidence."""
+    films = models.Films(layers=((2.0, 0.0),), wavelength_nm=550.0)
+    m = models.DiffuseSubsurfaceBRDF(coating=1.0, coating_films=films)
+    bare = models.DiffuseSubsurfaceBRDF(coating=1.0)
+    ti = np.array([math.pi / 2, 1.0])
+    got = m.mueller(ti, 0.3, 0.0)
+    assert np.all(np.isfinite(got)) and np.array_equal(got, bare.mueller(ti, 0.3, 0.0))
 
 
 def test_empty_stack_is_fresnel_bit_for_bit():

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import references
+from models.kernels import PARALLEL_MIN
 
 from ..core import figure_block, table_block
 from ._common import default_models, is_heavy, plt
@@ -46,9 +47,13 @@ class SpeedData:
     peer_run: dict
 
 
+#: geometries per call for the Monte Carlo and wrapper models (``n`` for the closed forms)
+HEAVY_GEOMETRIES = 200
+
+
 def _throughput(n, seed):
-    """Per model, the cost of one ``mueller`` call on ``n`` random geometries (200 for the
-    Monte Carlo and wrapper models), timed by the trade-off study's :func:`time_call`."""
+    """Per model, the cost of one ``mueller`` call on ``n`` random geometries
+    (:data:`HEAVY_GEOMETRIES` for the Monte Carlo and wrapper models), timed by the trade-off study's :func:`time_call`."""
     from validation.studies.tradeoff import time_call
 
     rng = np.random.default_rng(seed)
@@ -56,7 +61,7 @@ def _throughput(n, seed):
     pr = rng.uniform(-math.pi, math.pi, n)
     rows = []
     for m in default_models():
-        k = 200 if is_heavy(m) else n  # per-geometry cost is what is compared
+        k = HEAVY_GEOMETRIES if is_heavy(m) else n  # per-geometry cost is what is compared
         _, t = time_call(functools.partial(m.mueller, ti[:k], tr[:k], pr[:k]))
         rows.append(
             {
@@ -143,9 +148,10 @@ def render(s, d: SpeedData):
             )
         )
     caption = (
-        f"throughput: one mueller call on {d.geometries} random geometries (200 for Monte Carlo and "
-        "wrapper models), this run; best batch of validation.studies.tradeoff.time_call, CPU time of "
-        "every thread of the process (the kernels run on every core from 1024 geometries) and wall time"
+        f"throughput: one mueller call on {d.geometries} random geometries ({HEAVY_GEOMETRIES} for "
+        "Monte Carlo and wrapper models), this run; best batch of validation.studies.tradeoff.time_call, "
+        "CPU time of every thread of the process (the kernels run on every core from "
+        f"{PARALLEL_MIN} geometries) and wall time"
     )
     s.blocks.append(table_block(s, "throughput", _THROUGHPUT, d.throughput_rows, caption=caption))
     run = d.peer_run
