@@ -1,4 +1,5 @@
-"""Scalar building blocks of the compiled kernels (numba, ``cache=True``).
+"""Scalar building blocks of the compiled kernels (numba; not cached themselves: the
+entries that inline them are, :mod:`models.kernels`).
 
 Every function here works on one geometry's scalars in real arithmetic, in the precision
 of its arguments: constants are written ``T(c)`` with ``T = type(x)`` so that the float32
@@ -33,7 +34,7 @@ _SQRT6 = math.sqrt(6.0)
 _INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def polar(t):
     """``(cos t, sin t)`` of a polar angle ``t`` in its precision, the sine as the numpy path
     takes it, ``sqrt(1 - cos^2)``, both computed in float64: in float32 that formula loses the
@@ -43,14 +44,14 @@ def polar(t):
     return polar_from(sincos(t)[1], t)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def polar_from(c, t):
     """:func:`polar` of ``t`` from its cosine ``c``, computed in float64."""
     T = type(t)
     return T(c), T(sqrt(1.0 - c * c))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def azimuth(p):
     """``(cos p, sin p)`` of an azimuth (float64; :func:`~models.kernels.vector_math.sincos`,
     the C library beyond its range)."""
@@ -61,7 +62,7 @@ def azimuth(p):
     return math.cos(v), math.sin(v)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def internal_sine(c_int, s_ext, n):
     """Sine of the refracted angle in a coating ``n`` of cosine ``c_int``, external sine
     ``s_ext``: float64 ``sqrt(1 - c_int^2)`` (the numpy path's); float32 ``s_ext / n`` (Snell;
@@ -72,7 +73,7 @@ def internal_sine(c_int, s_ext, n):
     return s_ext / n
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def csqrt(a, b):
     """Principal square root of ``a + ib`` (a ``+0`` imaginary part: the ``+i`` branch, TIR).
     No call (a loop that uses it vectorizes; its branches become selects there)."""
@@ -95,7 +96,7 @@ def csqrt(a, b):
     return abs(b) / (T(2.0) * t), math.copysign(t, b)
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def cdiv(a, b, c, d):
     """``(a + ib) / (c + id)`` as numpy divides complex numbers (Smith's algorithm with one
     reciprocal, ``scl = 1 / den``, and two products: bit for bit numpy's result, and one
@@ -110,7 +111,7 @@ def cdiv(a, b, c, d):
     return (a * r + b) * scl, (b * r - a) * scl
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def refraction_w(c, mr, mi):
     """``m^2`` and ``w = m cos(theta_t) = sqrt(m^2 - 1 + c^2)`` (principal branch) as
     ``(re, im)`` pairs, for cosine ``c`` and relative index ``m = mr + i mi``
@@ -122,7 +123,7 @@ def refraction_w(c, mr, mi):
     return m2r, m2i, wr, wi
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def rs_k(c, mr, mi, pec):
     """``r_s`` and ``K = (r_s + r_p) / sin^2`` at cosine ``c`` for relative index ``m = mr + i mi``
     (:func:`models.fresnel.reflection_rs_k`); ``pec``: a perfect conductor."""
@@ -141,7 +142,7 @@ def rs_k(c, mr, mi, pec):
     return rsr, rsi, kr, ki
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def coating_cos(c, n):
     """Cosine of the refracted angle in a non-absorbing coating ``n`` from the external cosine
     ``c`` (:func:`models.fresnel.coating_cos`: no cancellation near grazing)."""
@@ -149,7 +150,7 @@ def coating_cos(c, n):
     return sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def coating_t(c, n):
     """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`models.fresnel.coating_transmission`)."""
     T = type(c)
@@ -157,7 +158,7 @@ def coating_t(c, n):
     return T(2.0) * c / (c + w), T(2.0) * n * c / (n * n * c + w)
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def p3(kind, zx, zy, sx, sy, rot, cov):
     """Slope density ``P3^xy`` of ``kind`` at ``(zx, zy)``; ``sx``, ``sy`` the widths (sigma,
     alpha; ``m_parallel``, ``m_perpendicular`` for strokes), ``rot`` the axes' rotation."""
@@ -188,7 +189,7 @@ def p3(kind, zx, zy, sx, sy, rot, cov):
     return cov * (stroke_d(zx, zy, T(1.0), sx, sy, c, s) / pi)
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     """``exp(-tan^2 alpha / m(beta)^2) / m(beta)^2`` for a bisector ``h`` (seed 001 Eq. 8, 19;
     :func:`models.stroke_slopes.stroke_d`); ``c``, ``s``: cosine and sine of the strokes' azimuth."""
@@ -206,7 +207,7 @@ def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     return exp_neg(q / hz2) * inv_m2
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def lam_unit(kind, mu):
     """Smith ``Lambda`` of the unit-width Gaussian or GGX family at ``mu = |cot theta|``."""
     T = type(mu)
@@ -221,7 +222,7 @@ def lam_unit(kind, mu):
     return T(0.5) * x * x / (T(1.0) + sqrt(T(1.0) + x * x))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
     """Smith ``Lambda`` (:func:`models.shadowing.smith_lambda`) of the Gaussian and GGX
     families, isotropic or elliptical, for a direction (cosine, sine, azimuth)."""
@@ -237,7 +238,7 @@ def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
     return lam_unit(kind, mu / alpha)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def smith_g(shadowing, kind, di, dio, sx, sy, rot):
     """Shadowing-masking ``G`` for directions ``di``, ``dio`` = ``(cos, sin, cos phi, sin phi)``
     (no back-facing test: both see the facet from its front)."""
@@ -249,7 +250,7 @@ def smith_g(shadowing, kind, di, dio, sx, sy, rot):
     return T(1.0) / (T(1.0) + (li + lo))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     """The 16 Mueller elements (row-major) of a Jones matrix (Bohren & Huffman, as
     :func:`models.polarization.mueller16_from_jones`)."""
@@ -277,14 +278,14 @@ def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     )  # fmt: skip
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def diag16(m00):
     """A depolarizer ``diag(m00, 0, 0, 0)`` (the scalar models)."""
     z = type(m00)(0.0)
     return (m00, z, z, z, z, z, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def scaled16(m, f):
     """The 16 elements ``m`` times ``f``."""
     return (

@@ -19,7 +19,7 @@ COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpend
 COOK_ROWS += ("stroke_cos", "stroke_sin")
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def fresnel_average(c, mr, mi, pec):
     """Natural-light reflectance ``(|r_s|^2 + |r_p|^2) / 2`` at cosine ``c`` for relative index
     ``mr + i mi`` (:func:`models.cook_torrance.fresnel_average`)."""
@@ -35,7 +35,7 @@ def fresnel_average(c, mr, mi, pec):
     return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
     and sines ``si``, ``sr``;
@@ -62,7 +62,7 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     return val
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def cook(geo, p, o):
     """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
     convention, ``o[2]``: the shadowing (:data:`models.kernel_specs.COOK_SHADOWING`)."""

@@ -41,7 +41,7 @@ OPTIONS = 3
 assert PARAM_ROWS == 11, "params() reads 11 rows"
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def element(code, g, p, o):
     """The 16 Mueller elements of one geometry ``g`` (:func:`geometry`) of model ``code``;
     ``p``, ``o``: its parameters and options as tuples (no array enters the inlined kernels:
@@ -59,7 +59,7 @@ def element(code, g, p, o):
     return maxwell(g, p, o)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def geometry(ti, tr, pr):
     """``(theta_i, theta_r, phi_r, cos phi_r, sin phi_r)`` in the angles' precision."""
     T = type(pr)
@@ -67,20 +67,20 @@ def geometry(ti, tr, pr):
     return ti, tr, pr, T(c), T(s)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def params(prm, j):
     """Column ``j`` of the parameter rows as a tuple."""
     return (prm[0, j], prm[1, j], prm[2, j], prm[3, j], prm[4, j], prm[5, j],
             prm[6, j], prm[7, j], prm[8, j], prm[9, j], prm[10, j])  # fmt: skip
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def options(iopt):
     """The options as a tuple."""
     return (iopt[0], iopt[1], iopt[2])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def store(out, i, m):
     """The elements ``m`` into ``out[:, i]`` (only ``M00`` when ``out`` has one row)."""
     out[0, i] = m[0]
@@ -96,7 +96,7 @@ def store(out, i, m):
 BLOCK = 1024
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi):
     """:func:`run_range`'s loop for one kernel (compiled once per kernel: a loop that
     dispatches on the model per geometry holds every kernel's code and runs slower)."""
@@ -106,7 +106,7 @@ def _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi):
         store(out, start + i, kernel(g, params(prm, i * p), o))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
     """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``, serially."""
     o = options(iopt)

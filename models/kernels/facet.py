@@ -16,7 +16,7 @@ from .vector_math import sqrt
 FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def facet_jones(g, p, o):
     """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
     Mueller matrix is the BRDF (:func:`models.facet.facet_jones`); ``g``: the geometry
@@ -24,7 +24,7 @@ def facet_jones(g, p, o):
     return facet_jones_at(g, polar(g[0]), polar(g[1]), p, o)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def facet_jones_at(g, pol_i, pol_r, p, o):
     """:func:`facet_jones` given the polar angles' ``(cos, sin)`` (:func:`~models.kernels.common.polar`)."""
     ti, tr, _, cp, sp = g
@@ -80,7 +80,7 @@ def facet_jones_at(g, pol_i, pol_r, p, o):
     )
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def facet(geo, p, o):
     """:class:`models.FacetBRDF` and :class:`models.SubsurfaceFacetBRDF` at one geometry."""
     a, b, c, d, e, f, g, h = facet_jones(geo, p, o)
@@ -91,17 +91,17 @@ def facet(geo, p, o):
 BTDF_ROWS = ("substrate", "sx", "sy", "rotation", "coverage")
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def dot3(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def cross3(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def transmission_factors(c, mr):
     """``t_s`` and ``(t_p - t_s) / sin^2`` of refraction at local cosine ``c`` into relative
     index ``mr`` (zero beyond the critical angle), as :func:`models.facet_btdf.facet_transmission_jones`."""
@@ -122,7 +122,7 @@ def transmission_factors(c, mr):
     return ts, delta * (T(1.0) / (w + mr * c))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     """Real Jones elements ``(ss, ps, sp, pp)`` of refraction through facet ``m`` and the local
     cosines ``(cos iota_in, cos iota_out)`` (the dyadic of seed 003 Eq. 40, Rodrigues' rotation)."""
@@ -144,14 +144,14 @@ def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     return ss, ps, sp, pp, c, c_out
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def _btdf_element(ea, eb, v, a_in, a_out, cg, inv1, ts, delta):
     """One element of :func:`btdf_jones`: out-basis vector ``ea``, in-basis vector ``eb``."""
     rot = cg * dot3(ea, eb) + dot3(ea, cross3(v, eb)) + dot3(ea, v) * dot3(v, eb) * inv1
     return ts * rot + delta * dot3(ea, a_out) * dot3(a_in, eb)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def btdf(g, p, o):
     """:class:`models.FacetBTDF` (``convention="paper"``) at one geometry."""
     ti, tt, pt, _, _ = g

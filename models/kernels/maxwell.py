@@ -17,7 +17,7 @@ from .vector_math import sqrt
 MAXWELL_ROWS = FACET_ROWS + ("rho_d", "rho_v", "tau", "omega")
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def shadow(si, ci, sr, cr, cp, tau, omega):
     """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`models.maxwell_beard.maxwell_beard_shadow`)
     from the angles' sines and cosines."""
@@ -35,7 +35,7 @@ def shadow(si, ci, sr, cr, cp, tau, omega):
     return (T(1.0) + x * e) / (T(1.0) + x)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def maxwell(geo, p, o):
     """Maxwell-Beard at one geometry; ``o[2]``: the facet Mueller matrix on the specular term."""
     ti, tr, pr = geo[0], geo[1], geo[2]

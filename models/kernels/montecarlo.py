@@ -32,7 +32,7 @@ _REACHED = np.array([0, 1, 2, 4, 5, 6, 8, 9, 10, 15])
 _NO_BASIS = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _ray_basis(k):
     """``(s, p)`` of ray ``k``: ``s = unit(z x k)``, ``+y`` along the z axis
     (:func:`models.facet_btdf.ray_basis`)."""
@@ -44,7 +44,7 @@ def _ray_basis(k):
     return s, cross3(k, s)
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     """The incident ray through facet ``m`` (slope x ``zx``): ``(weight, k1, basis of k1,
     Jones, flux factor)``; weight 0 where the facet is not struck or the ray does not go
@@ -62,7 +62,7 @@ def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     return w, k1, e1, (ss, ps, sp, pp), n * c_out / (c_in if c_in > 0.0 else 1.0)
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
     """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
     ``(weight, k2, basis of k2, Jones, flux factor)``, weight 0 where no such ray exists."""
@@ -79,7 +79,7 @@ def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
     return w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
     """One live pair's Mueller estimate into ``x``: the totally diffuse term and the single
     scattering (depolarizing: a scalar; polarized: the Jones chain of Eq. 4-5)."""
@@ -128,7 +128,7 @@ def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
             x[e] += m[e]
 
 
-@njit(cache=True)
+@njit
 def _walk(geo, z, m, prm, inv_scale, x, mean, m2, peak):
     """Welford's running mean and sum of squared deviations (``mean``, ``m2``) of the live
     pairs' estimates times ``inv_scale``, and their largest magnitudes (``peak``); returns
@@ -160,7 +160,7 @@ def _walk(geo, z, m, prm, inv_scale, x, mean, m2, peak):
     return live
 
 
-@njit(cache=True)
+@njit
 def _geometry(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, col):
     """Mean and standard error of one geometry into ``mean[:, col]``, ``err[:, col]``."""
     mean[:, col] = 0.0

@@ -60,18 +60,18 @@ def vectorized(code, iopt) -> bool:
     return code in (SINGLE, DIFFUSE)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def _at(sc, row, k):
     return sc[row * VBLOCK + k]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def _geometry(sc, k):
     """Geometry ``k`` of the scratch, as :func:`models.kernels.drive.geometry` gives it."""
     return _at(sc, _TI, k), _at(sc, _TR, k), _at(sc, _PR, k), _at(sc, _CP, k), _at(sc, _SP, k)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def _scratch_params(sc, k):
     """Geometry ``k``'s parameters (:func:`gather` copied them)."""
     return (_at(sc, _PRM, k), _at(sc, _PRM + 1, k), _at(sc, _PRM + 2, k), _at(sc, _PRM + 3, k),
@@ -79,7 +79,7 @@ def _scratch_params(sc, k):
             _at(sc, _PRM + 8, k), _at(sc, _PRM + 9, k), _at(sc, _PRM + 10, k))  # fmt: skip
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def _store(sc, k, m):
     """The 16 elements ``m`` into the result rows, column ``k`` (written out: a loop over a
     tuple's index compiles to a switch, which keeps the loop around it scalar)."""
@@ -90,7 +90,7 @@ def _store(sc, k, m):
     sc[o + 12 * B], sc[o + 13 * B], sc[o + 14 * B], sc[o + 15 * B] = m[12], m[13], m[14], m[15]
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def _loop(kernel, sc, m, o):
     """The loop of :func:`lanes` for one kernel and its options: compiled once per kernel,
     inlined by LLVM into :func:`lanes`, where the options are constants and fold (numba's
@@ -99,7 +99,7 @@ def _loop(kernel, sc, m, o):
         _store(sc, k, kernel(_geometry(sc, k), _scratch_params(sc, k), o))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def lanes(code, sc, m, o):
     """Geometries ``0 .. m - 1`` of the scratch through kernel ``code`` (:func:`vectorized`
     models only): one loop per kernel, slope kind and option set, each with them constant."""
@@ -124,7 +124,7 @@ def lanes(code, sc, m, o):
         _loop(cook, sc, m, (0, o[1], NO_COOK_SHADOWING))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def gather(sc, ti, tr, pr, prm, lo, m):
     """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch: angles, the azimuth's
     cosine and sine (:func:`~models.kernels.vector_math.sincos` over the block, the C
@@ -145,7 +145,7 @@ def gather(sc, ti, tr, pr, prm, lo, m):
             sc[(_PRM + r) * VBLOCK + k] = prm[r, (lo + k) * p]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")
 def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
     """Geometries ``lo .. hi - 1`` into ``out[:, start + i]``, a block at a time."""
     o = options(iopt)

@@ -75,7 +75,7 @@ def sqrt(typingctx, x):
     return x(x), codegen
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def sincos(x):
     """``(sin x, cos x)`` in float64 for ``|x| <= REDUCED_MAX`` (no branch, no call)."""
     v = np.float64(x)
@@ -91,7 +91,7 @@ def sincos(x):
     return (-sv if quad >= 2 else sv), (-cv if (quad == 1 or quad == 2) else cv)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def exp_neg(x):
     """``exp(-x)`` in the precision of ``x >= 0``, exactly zero from :data:`EXP_ZERO` on."""
     T = type(x)

@@ -16,7 +16,7 @@ SINGLE_ROWS = ("coating", "g")
 DIFFUSE_ROWS = ("coating", "scale")
 
 
-@njit(cache=True, error_model="numpy", forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def amplitudes(c, s, n):
     """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`
     for the external cosine and sine ``c``, ``s`` (:func:`models.kernels.common.polar`)."""
@@ -36,7 +36,7 @@ def amplitudes(c, s, n):
     return s_int, c_int, a_s, a_p
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def depolarized16(asi, api, asr, apr, scale):
     """:func:`models.smooth_interface.depolarized_between`'s 16 elements."""
     T = type(asi)
@@ -49,7 +49,7 @@ def depolarized16(asi, api, asr, apr, scale):
     return (s_out * s_in, s_out * d_in, z, z, d_out * s_in, d_out * d_in, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def single(geo, p, o):
     """Single scattering under a smooth interface (seed 003 Eq. 20); ``o[0]``: polarized phase."""
     ti, tr, _, cp, sp = geo
@@ -76,7 +76,7 @@ def single(geo, p, o):
     return mueller16(ss, z, ps, z, sp_, z, pp, z)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy", inline="always")
 def diffuse(geo, p, o):
     """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``p[1]``: its scale."""
     ti, tr = geo[0], geo[1]
