@@ -264,3 +264,23 @@ def test_cache_directory_is_writable_and_keyed_by_the_sources(tmp_path, monkeypa
 def test_kernel_specs_have_no_numba_import():
     assert kernel_specs.slope_rows(models.TabulatedSlopes()) is None
     assert kernel_specs.index_rows(math.inf) == [math.inf, 0.0]
+
+
+def test_one_compiled_specialization_per_entry_and_precision():
+    """Read-only angles, a small call, a scalar call and a large one reach each entry point
+    with the same argument types (no read-only array type, no ``Literal[int](0)``): each
+    other type compiled every kernel again, ~10 s on a cold cache
+    (:meth:`models.kernels.Compiled.call`, :func:`models.kernels.drive.run_one`)."""
+    from models.kernels import drive, vector
+
+    frozen = np.linspace(0.1, 1.2, 2048)
+    frozen.flags.writeable = False
+    for m in (models.FacetBRDF(), models.MaxwellBeardBRDF()):
+        m.mueller(frozen, frozen, frozen)
+        m.mueller(frozen[:100], 0.3, 0.2)
+        m.mueller(frozen[:3], 0.3, 0.2)
+        m.mueller(0.3, 0.2, 0.1)
+    for entry in (drive.run, drive.run_parallel, drive.run_checked, vector.run, vector.run_parallel):
+        for sig in entry.signatures:
+            assert "readonly" not in str(sig) and "Literal" not in str(sig), (entry, sig)
+            assert all(t.mutable for t in sig if hasattr(t, "ndim")), (entry, sig)

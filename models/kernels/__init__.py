@@ -117,6 +117,11 @@ with _caching_in(cache_dir()):
     from . import drive, montecarlo, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
+def _mutable(x):
+    """``x``, or a copy of it when it is read-only (a cached array, a user's frozen one)."""
+    return x if x.flags.writeable else x.copy()
+
+
 class Compiled:
     """A model's kernel: its code, parameter rows and options, and the calls into it.
 
@@ -163,8 +168,9 @@ class Compiled:
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
         loops = vector if precision == "float64" and self.vectorized else drive
         fn = loops.run_parallel if n >= PARALLEL_MIN else loops.run
-        # contiguous inputs: one compiled specialization (and no view of a broadcast array)
-        ti, tr, pr = (np.ascontiguousarray(x) for x in (ti, tr, pr))
+        # contiguous, writable inputs: one compiled specialization per entry and precision
+        # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
+        ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
         fn(self.code, ti, tr, pr, self.params(precision), self.iopt, out, start)
 
     def run(self, ti, tr, pr, rows):
@@ -202,7 +208,8 @@ class Compiled:
         small = evaluation.small_angles(theta_i, theta_r, phi_r, evaluation.KERNEL_CHUNK)
         if small is None:
             return None
-        shape, n, (ti, tr, pr) = small
+        shape, n, angles = small
+        ti, tr, pr = (_mutable(x) for x in angles)  # one specialization (see call)
         dtype = _DTYPES[precision]
         if out is None:
             out = np.empty((rows, n), dtype=dtype)

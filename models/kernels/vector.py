@@ -163,7 +163,9 @@ def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
 def run(code, ti, tr, pr, prm, iopt, out, start):
     """:func:`models.kernels.drive.run` (same arguments, float64) on SIMD lanes."""
     n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-    run_range(code, ti, tr, pr, prm, iopt, out, start, 0, n)
+    # np.int64(0), not 0: numba gives a literal argument a specialization of its own
+    # (Literal[int](0)), which compiled every kernel a second time
+    run_range(code, ti, tr, pr, prm, iopt, out, start, np.int64(0), n)
 
 
 @njit(cache=True, error_model="numpy")
@@ -171,7 +173,7 @@ def run_checked(code, ti, tr, pr, prm, iopt, out):
     """:func:`models.kernels.drive.run_checked` (same arguments, float64) on SIMD lanes."""
     if not angles_ok(ti, tr, pr):
         return False
-    run(code, ti, tr, pr, prm, iopt, out, 0)
+    run(code, ti, tr, pr, prm, iopt, out, np.int64(0))  # int64: see run
     return True
 
 
