@@ -50,16 +50,21 @@ class IntegralResult:
         return self.value
 
 
-def _breakpoints(center, width, lo, hi, levels=10):
+def _breakpoints(center, width, lo, hi):
+    """``lo``, ``hi``, ``center`` and ``center +- width 2^k / 4`` for k = 0, 1, ... until both
+    ends are passed: cells that grow from a quarter of the lobe's width to the domain's size
+    in a constant ratio.  (Ten doublings, as before, stopped at 128 widths, beyond which one
+    cell held the lobe's tail: a GGX lobe of alpha = 1e-4 at normal incidence has 0.7% of its
+    integral there, and the rule, sampling that cell far from the lobe, reported 5e-6 for a
+    7e-3 error.)"""
     pts = {lo, hi}
     if center is not None and lo < center < hi:
         pts.add(center)
-    if center is not None and width is not None and width > 0:
-        for k in range(levels):
-            d = width * (2.0**k) / 4.0
-            for p in (center - d, center + d):
-                if lo < p < hi:
-                    pts.add(p)
+    if center is not None and width is not None and 0 < width < math.inf:
+        d = width / 4.0
+        while center - d > lo or center + d < hi:
+            pts.update(p for p in (center - d, center + d) if lo < p < hi)
+            d *= 2.0
     return np.array(sorted(pts))
 
 
@@ -119,7 +124,7 @@ def integrated_reflectance(
     s_in = np.asarray(stokes(incident), dtype=float)
     if symmetric is None:
         symmetric = bool(getattr(model, "mirror_symmetric", False)) and s_in[2] == 0 and s_in[3] == 0
-    rects = _initial_rectangles(model.lobe(theta_i) if hasattr(model, "lobe") else None, symmetric)
+    rects = _initial_rectangles(model.lobe(theta_i) if hasattr(model, "lobe") else None, symmetric, theta_i)
     factor = 2.0 if symmetric else 1.0
     # the half-range integral is doubled, and so is its error
     got = _refine(_integrand(model, theta_i, s_in, rects), len(rects), tol / factor, max_evaluations)
@@ -178,9 +183,18 @@ def _integrand(model, theta_i, s_in, rects):
     return f
 
 
-def _initial_rectangles(lobe, symmetric):
+def _initial_rectangles(lobe, symmetric, theta_i):
     """``(R, 4)`` rectangles ``(t0, t1, phi0, phi1)``: a coarse grid, refined towards a
-    narrow lobe (``(theta_c, phi_c, width)``) so the adaptive rule cannot miss it."""
+    narrow lobe (``(theta_c, phi_c, width)``) so the adaptive rule cannot miss it.
+
+    In azimuth the lobe is taken narrower by ``cos(theta_i)``: a facet tilted across the plane
+    of incidence by ``d`` turns the specular direction by ``2 d cos(theta_i)`` (by ``2 d``
+    within the plane), so at grazing incidence the lobe is a thin sliver in azimuth (5700
+    times narrower than in polar angle at 89.99 deg).  With the polar width alone, the
+    cells there were far wider than the lobe and the rule "converged" on wrong values:
+    CookTorranceBRDF (Gaussian m = 0.01) at 89.99 deg gave 12.1557 for 12.1969 (error
+    estimate 7e-4), FacetBRDF (GGX alpha = 1e-4) 0.557 for 1.0434 (estimate 9e-4).  A width
+    too narrow costs only a few more cells."""
     phi_lo, phi_hi = (0.0, math.pi) if symmetric else (-math.pi, math.pi)
     if lobe is not None:
         tc, pc, w = lobe
@@ -188,7 +202,7 @@ def _initial_rectangles(lobe, symmetric):
         # dt = 2 sin cos dtheta: the lobe's width in t
         wt = max(2.0 * math.sin(tc) * math.cos(tc) * w, w * w)
         tb = _breakpoints(tcen, wt, 0.0, 1.0)
-        wp = w / max(math.sin(tc), w)
+        wp = w * max(math.cos(theta_i), w) / max(math.sin(tc), w)
         pb = _breakpoints(pc, wp, phi_lo, phi_hi)
     else:
         tb = np.linspace(0.0, 1.0, 5)
