@@ -465,7 +465,7 @@ class PointSourceBRDF(_Wrapper):
         sc = np.maximum(np.abs(M[0]), scale)
         res.mueller[:, rows], res.scale[rows], res.capped[rows] = M, sc, got.capped
         res.error[rows] = _ratio(got.error / W, sc)
-        res.evaluations[rows] += cubature.GM_POINTS * got.regions
+        res.evaluations[rows] += cubature.GM_POINTS * got.evaluated  # split regions included
 
     def _superpose(self, ti, tr, pr, resolution):
         """Eq. 28 (or the shift approximation) at ``resolution`` radial nodes: ``(16, n)``."""
