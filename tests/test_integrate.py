@@ -225,3 +225,17 @@ def test_near_specular_lobes_at_the_ends_are_honest(model, theta_i):
     got = integrated_reflectance(model, theta_i, tol=1e-3, max_evaluations=2_000_000)
     assert got.converged and got.error <= 1e-3
     assert abs(got.value - ref) <= got.error + ref_err
+
+
+@pytest.mark.parametrize("width", [5e-324, 1e-300, 1e-16, 1e-3])
+def test_lobe_cells_stay_bounded_for_any_width(width):
+    """Breakpoints for a lobe of any width: at most two per doubling (the cap of 64), and
+    reaching both ends of the domain whenever the width allows it (1e-16 and 1e-3 do)."""
+    from validation.numerics.integrate import MAX_DOUBLINGS, _breakpoints
+
+    pts = _breakpoints(0.3, width, 0.0, 1.0)
+    assert pts.size <= 2 * MAX_DOUBLINGS + 3 and pts[0] == 0.0 and pts[-1] == 1.0
+    assert np.all(np.diff(pts) > 0)
+    if width >= 1e-16:  # the doublings pass both ends: the outermost cells are at most half
+        # the distance from the centre to their end (ten doublings left [0.3 + 3e-14, 1])
+        assert np.max(np.diff(pts)) <= 0.35 + 1e-15

@@ -50,19 +50,27 @@ class IntegralResult:
         return self.value
 
 
+#: doublings of a lobe's breakpoints at most: from 2^-64 of the domain to its size
+MAX_DOUBLINGS = 64
+
+
 def _breakpoints(center, width, lo, hi):
     """``lo``, ``hi``, ``center`` and ``center +- width 2^k / 4`` for k = 0, 1, ... until both
     ends are passed: cells that grow from a quarter of the lobe's width to the domain's size
     in a constant ratio.  (Ten doublings, as before, stopped at 128 widths, beyond which one
     cell held the lobe's tail: a GGX lobe of alpha = 1e-4 at normal incidence has 0.7% of its
     integral there, and the rule, sampling that cell far from the lobe, reported 5e-6 for a
-    7e-3 error.)"""
+    7e-3 error.)  At most :data:`MAX_DOUBLINGS` doublings: a width below ``2^-64`` of the
+    domain (or one that underflows) leaves the outermost cells larger, rather than thousands
+    of cells per axis."""
     pts = {lo, hi}
     if center is not None and lo < center < hi:
         pts.add(center)
     if center is not None and width is not None and 0 < width < math.inf:
         d = width / 4.0
-        while center - d > lo or center + d < hi:
+        for _ in range(MAX_DOUBLINGS):
+            if not (center - d > lo or center + d < hi):
+                break
             pts.update(p for p in (center - d, center + d) if lo < p < hi)
             d *= 2.0
     return np.array(sorted(pts))
