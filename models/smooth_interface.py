@@ -22,11 +22,11 @@ change the amplitudes of the two crossings, which become complex:
 * entrance (F1): ``t_in = t_01(theta)``, the stack's transmission from the ambient into the
   coating (:meth:`models.FilmStack.transmission_down`);
 * exit (F2): the ray leaves the coating at ``theta'`` and emerges at ``theta`` with the
-  stack's upward amplitude ``t_10`` (:meth:`models.FilmStack.transmission_up`).  Seed 000 Eq. 14-15 and seed 003 Eq. 11, 25 write the
-  exit with ``t(theta; 1, n)``, which for one interface is ``t_10 kz_0 / kz_s`` (``kz_0 =
-  cos theta``, ``kz_s = n cos theta'``): the Fresnel exit amplitude with the ratio of the
-  normal wavevectors that the radiance bookkeeping (``n^2`` and the ``cos'/cos`` of the
-  refracted solid angle) puts beside it.  With films the exit factor is therefore
+  stack's upward amplitude ``t_10`` (:meth:`models.FilmStack.transmission_up`).  Seed 000
+  Eq. 14-15 and seed 003 Eq. 11, 25 write the exit with ``t(theta; 1, n)``, which for one
+  interface is ``t_10 kz_0 / kz_s`` (``kz_0 = cos theta``, ``kz_s = n cos theta'``): the
+  Fresnel exit amplitude with the ratio of the normal wavevectors that the radiance
+  bookkeeping (``n^2`` and the ``cos'/cos`` of the refracted solid angle) puts beside it.  With films the exit factor is therefore
   ``t_out = t_10 kz_0 / kz_s``, in both polarizations, complex.
 
 Flux (F3): ``n |a|^2`` with ``a = t sqrt(c'/c)`` is the transmittance of the crossing, for

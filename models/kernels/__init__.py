@@ -9,7 +9,8 @@ the cores (``prange``) from :data:`PARALLEL_MIN` geometries on, writing the elem
 likelihood evaluates all walkers of an emcee step in one call.  Float64 calls of the models
 whose kernels have no C library call left (:func:`~models.kernels.vector.vectorized`: the
 facet reflection models with exponential, Gaussian or GGX slopes and no shadowing, single
-scattering, the diffuse subsurface) run :mod:`~models.kernels.vector`'s loops instead, which
+scattering, the diffuse subsurface, the bare Cook-Torrance without Smith shadowing) run
+:mod:`~models.kernels.vector`'s loops instead, which
 compile to SIMD instructions (:mod:`~models.kernels.vector_math`: polynomial cosines, sines
 and exponentials) and give the scalar loop's bits.
 

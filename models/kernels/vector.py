@@ -17,10 +17,11 @@ block of :data:`VBLOCK` geometries:
 3. the block's result rows are copied to ``out``.
 
 The kernels are the same functions as the scalar loop's, so both give the same bits
-(``tests/test_kernels.py``).  :func:`vectorized` says which models and options take this
-path; the others (FacetBTDF, Maxwell-Beard, Smith shadowing, anisotropic slopes) keep C
-library calls that leave any loop scalar, and :class:`models.kernels.Compiled` runs them
-through :mod:`~models.kernels.drive`.
+(``tests/test_vector_kernels.py``).  :func:`vectorized` says which models and options take this
+path.  The others keep C library calls that leave any loop scalar (FacetBTDF,
+Maxwell-Beard, Smith shadowing, anisotropic slopes) or form a loop that LLVM's cost model
+declines (the varnished Cook-Torrance); :class:`models.kernels.Compiled` runs them through
+:mod:`~models.kernels.drive`.
 """
 
 from __future__ import annotations

@@ -228,9 +228,9 @@ def comparison_settings(quick):
         return dict(
             rows=40, settings=ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
         )
-    # Differential evolution: at 2000 steps the stretch move left all 8 chains short of
-    # N >= 50 tau (max tau 44-156), "de" 3 of 8 (5 converged by 800-1900 steps), measured
-    # 2026-11-24 by `python benchmarks/fit_moves.py --max-steps 2000` (it prints both).
+    # Differential evolution: at 2000 steps the stretch move converged (N >= 50 tau) 0 of the
+    # 8 chains (max tau 44-156), "de" 5 of 8 (by 800-1900 steps), measured 2026-11-24 by
+    # `python benchmarks/fit_moves.py --max-steps 2000` (it prints both).
     return dict(
         rows=None,
         settings=ChainSettings(walkers=24, seed=3, max_steps=12000, check_every=100, starts=4, moves="de"),

@@ -53,7 +53,8 @@ HEAVY_GEOMETRIES = 200
 
 def _throughput(n, seed):
     """Per model, the cost of one ``mueller`` call on ``n`` random geometries
-    (:data:`HEAVY_GEOMETRIES` for the Monte Carlo and wrapper models), timed by the trade-off study's :func:`time_call`."""
+    (:data:`HEAVY_GEOMETRIES` for the Monte Carlo and wrapper models), timed by the
+    trade-off study's :func:`time_call`."""
     from validation.studies.tradeoff import time_call
 
     rng = np.random.default_rng(seed)
