@@ -42,10 +42,12 @@ def maxwell(geo, p, o):
     T = type(ti)
     # the C library's cosines and sines, as numpy's: near retroreflection ``beta = acos(~1)``
     # in :func:`shadow` turns an ulp of them into 1e-10 of the result
-    si, ci, sr, cr = math.sin(ti), math.cos(ti), math.sin(tr), math.cos(tr)
+    # (the polar cosines in float64 once: the facet term's sines come from them, :func:`polar`)
+    ci64, cr64 = math.cos(np.float64(ti)), math.cos(np.float64(tr))
+    si, ci, sr, cr = math.sin(ti), T(ci64), math.sin(tr), T(cr64)
     cp, sp = math.cos(pr), math.sin(pr)
     so = shadow(si, ci, sr, cr, cp, p[9], p[10])
-    pol_i, pol_r = polar_from(math.cos(np.float64(ti)), ti), polar_from(math.cos(np.float64(tr)), tr)
+    pol_i, pol_r = polar_from(ci64, ti), polar_from(cr64, tr)
     a, b, c, d, e, f, g, h = facet_jones_at((ti, tr, pr, cp, sp), pol_i, pol_r, p, o)
     if o[2] == 1:
         m = scaled16(mueller16(a, b, c, d, e, f, g, h), so)

@@ -137,7 +137,9 @@ def gather(sc, ti, tr, pr, prm, lo, m):
     for k in range(m):
         s, co = sincos(_at(sc, _PR, k))
         sc[_SP * VBLOCK + k], sc[_CP * VBLOCK + k] = s, co
-    for k in range(m):  # rare: beyond the polynomial's range
+    # rare: beyond the polynomial's range, a pass of its own (common.azimuth branches to the
+    # C library per value, which would keep the sincos loop above scalar)
+    for k in range(m):
         v = _at(sc, _PR, k)
         if not abs(v) <= REDUCED_MAX:
             sc[_SP * VBLOCK + k], sc[_CP * VBLOCK + k] = math.sin(v), math.cos(v)
