@@ -42,15 +42,22 @@ __all__ = ["MaxwellBeardBRDF", "maxwell_beard_shadow"]
 
 
 def maxwell_beard_shadow(ti, tr, pr, tau, omega):
-    """Shadowing/obscuration ``SO(theta_N, beta)`` of Maxwell-Beard (flat arrays)."""
+    """Shadowing/obscuration ``SO(theta_N, beta)`` of Maxwell-Beard (flat arrays).
+
+    With ``a = (-sin ti, 0, cos ti)`` the direction to the source and ``b`` that to the
+    detector, the facet normal is along ``a + b`` and ``beta`` is half the angle between
+    ``a`` and ``b``: ``theta_N = atan2(|(a + b)_xy|, (a + b)_z)`` and
+    ``beta = atan2(|a - b|, |a + b|)``.  Both are well conditioned everywhere; ``beta`` as
+    ``arccos(sqrt((1 + a.b) / 2))`` is not near retroreflection (``beta -> 0``), where it
+    turned an ulp of the cosines into 1e-10 of ``SO``."""
     si, ci, sr, cr = np.sin(ti), np.cos(ti), np.sin(tr), np.cos(tr)
-    cp = np.cos(pr)
-    t = si * si - 2.0 * si * sr * cp + sr * sr  # |k_i,xy + k_r,xy|^2 (bisector, unnormalized)
-    den = ci + cr
-    slope = np.sqrt(np.maximum(t, 0.0)) / np.where(den > 0, den, 1.0)
-    theta_n = np.arctan(slope)
-    cos_beta = np.sqrt(np.clip(0.5 * (1.0 - si * sr * cp + ci * cr), 0.0, 1.0))
-    beta = np.arccos(np.minimum(cos_beta, 1.0))
+    cp, sp = np.cos(pr), np.sin(pr)
+    hx, hy = sr * cp - si, sr * sp  # (a + b)_xy
+    t = hx * hx + hy * hy
+    den = ci + cr  # (a + b)_z
+    theta_n = np.arctan2(np.sqrt(t), np.where(den > 0, den, 1.0))
+    dx, dz = sr * cp + si, cr - ci  # b - a
+    beta = np.arctan2(np.sqrt(dx * dx + hy * hy + dz * dz), np.sqrt(t + den * den))
     with np.errstate(over="ignore", invalid="ignore"):
         e = np.exp(-2.0 * beta / tau)  # a tiny tau: -inf, e = 0, the limit
         x = theta_n / omega

@@ -119,6 +119,31 @@ def test_combination_errors():
     np.testing.assert_allclose(s.mueller(*G), M, rtol=1e-13, atol=1e-16)
 
 
+def test_maxwell_beard_shadow_is_exact_at_retroreflection():
+    """At retroreflection the source and the detector coincide: beta = 0 and SO = 1
+    (Maxwell-Beard's obscuration vanishes).  ``np.pi`` is 1.2e-16 short of pi, so at
+    (t, t, np.pi) beta = sin(t) sin(np.pi) / 2 and theta_N = t, and SO is known to an ulp;
+    beta = arccos(sqrt((1 + a.b) / 2)) turned an ulp of that cosine into beta ~ 1e-8, SO off
+    by ~1e-6 at tau = 0.01 (it fails so).  1e-7 rad away from it the kernel holds the numpy
+    path to 1e-12 (the polynomial cosines on SIMD lanes gave 1.7e-10 there)."""
+    t = np.linspace(0.0, 1.5, 301)
+    pi = np.full(t.size, np.pi)
+    for omega in (0.01, 1.0):
+        so = models.maxwell_beard.maxwell_beard_shadow(t, t, pi, 0.01, omega)
+        x = t / omega
+        want = (1.0 + x * np.exp(-np.sin(t) * np.sin(np.pi) / 0.01)) / (1.0 + x)
+        assert np.max(np.abs(so - want)) < 1e-15
+    m = models.MaxwellBeardBRDF(slopes=models.GaussianSlopes(0.3), tau=0.01, omega=0.01, polarized=True)
+    rng = np.random.default_rng(5)
+    ti = rng.uniform(0.0, 1.5, 2000)
+    tr, pr = np.abs(ti + rng.uniform(-1e-7, 1e-7, ti.size)), np.pi + rng.uniform(-1e-7, 1e-7, ti.size)
+    with models.backend("numpy"):
+        ref = m.mueller(ti, tr, pr)
+        assert np.max(np.abs(m.mueller(t, t, pi)[..., 0, 0] - m._facet.brdf(t, t, pi))) <= 1e-14 * np.max(ref)
+    got = m.mueller(ti, tr, pr)
+    assert np.max(np.abs(got - ref)) <= 1e-12 * np.max(ref[..., 0, 0])
+
+
 def test_maxwell_beard_against_scatmech_and_terms():
     e, lit = c3.scatmech_seed003_errors("mb")
     assert len(e) == 100 and lit > 80 and e.max() < 1e-6

@@ -14,7 +14,7 @@ from test_kernels import CONFIGS, _geometries
 
 import models
 from models.kernels import Compiled, drive, vector
-from models.kernels.vector_math import REDUCED_MAX, exp_neg, sincos, sqrt
+from models.kernels.vector_math import REDUCED_MAX, atan2, exp_neg, sincos, sqrt
 
 #: test_kernels' configurations, and Cook-Torrance under strokes (its azimuth's cosine and
 #: sine are parameter rows)
@@ -46,7 +46,14 @@ def _both(kernel, ti, tr, pr):
 def test_the_vectorized_models_are_the_ones_meant():
     names = {type(m).__name__ for m in VECTORIZED}
     cook = {"CookTorranceBRDF"}  # not the varnished form: LLVM's cost model keeps it scalar
-    assert names == {"FacetBRDF", "SubsurfaceFacetBRDF", "SingleScatterBRDF", "DiffuseSubsurfaceBRDF"} | cook
+    closed = {
+        "FacetBRDF",
+        "SubsurfaceFacetBRDF",
+        "SingleScatterBRDF",
+        "DiffuseSubsurfaceBRDF",
+        "MaxwellBeardBRDF",
+    }
+    assert names == closed | cook
     facets = [m for m in VECTORIZED if type(m).__name__.endswith("FacetBRDF")]
     assert {type(m.slopes).__name__ for m in facets} == {"ExponentialSlopes", "GaussianSlopes", "GGXSlopes"}
     assert all(m.shadowing == "none" for m in facets)
@@ -125,9 +132,10 @@ def test_the_lanes_are_vectorized_loops(tmp_path):
     res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
     counts = {ln.split()[0]: tuple(int(x) for x in ln.split()[1:]) for ln in res.stdout.splitlines()}
     # lanes is one compiled function holding every specialization: 3 facet slope kinds,
-    # 2 single scattering, 1 diffuse, 2 Cook-Torrance (blinn, none): a vector.body each
-    # (labels vector.body.i, vector.body.i5, ... once inlined)
-    assert counts["lanes"][0] >= 8 and counts["lanes"][1] > 0
+    # 2 single scattering, 1 diffuse, 2 Cook-Torrance (blinn, none), 3 Maxwell-Beard slope
+    # kinds x scalar or polarized: a vector.body each (labels vector.body.i, vector.body.i5,
+    # ... once inlined)
+    assert counts["lanes"][0] >= 14 and counts["lanes"][1] > 0
     assert counts["scalar"][0] == 0
 
 
@@ -159,6 +167,31 @@ def test_sincos_and_exp_within_two_ulp(span):
     ok = x >= 0
     assert np.array_equal(r[ok], np.sqrt(x[ok]))  # IEEE: the same bits
     assert np.all(np.isnan(r[~ok]))
+
+
+@njit
+def _atan2(y, x):
+    out = np.empty_like(x)
+    for i in range(x.size):
+        out[i] = atan2(y[i], x[i])
+    return out
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-300, 1e300])
+def test_atan2_within_two_ulp(scale):
+    """Every quadrant, the reduction's seam at tan(pi/8) and the axes, from subnormal to huge
+    arguments; the C library's signs at the zeros."""
+    rng = np.random.default_rng(11)
+    y = rng.uniform(-1.0, 1.0, 200_000) * scale
+    x = rng.uniform(-1.0, 1.0, y.size) * scale
+    seam = rng.uniform(0.1, 1.0, 20_000)
+    y = np.concatenate([y, seam, seam, np.full(4, 0.5), [0.0, -0.0, 0.0, -0.0]])
+    x = np.concatenate([x, seam / math.tan(math.pi / 8) * (1 + rng.uniform(-1e-9, 1e-9, seam.size)), -seam,
+                        [0.0, -0.0, 1e-320, -1e-320], [0.0, 0.0, -0.0, -0.0]])  # fmt: skip
+    ref = np.arctan2(y, x)
+    got = _atan2(y, x)
+    assert _ulps(got[ref != 0], ref[ref != 0]) <= 2.0
+    assert np.array_equal(np.signbit(got), np.signbit(ref)) and np.array_equal(got[ref == 0], ref[ref == 0])
 
 
 def test_only_the_entry_points_are_cached():

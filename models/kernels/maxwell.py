@@ -6,49 +6,48 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from .common import diag16, mueller16, polar_from, scaled16
 from .facet import FACET_ROWS, facet_jones_at
-from .vector_math import sqrt
+from .vector_math import atan2, exp_neg, sincos, sqrt
 
 #: parameter rows: the facet kernel's, then rho_d, rho_v, tau, omega
 MAXWELL_ROWS = FACET_ROWS + ("rho_d", "rho_v", "tau", "omega")
 
 
-@njit(error_model="numpy")
-def shadow(si, ci, sr, cr, cp, tau, omega):
-    """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`models.maxwell_beard.maxwell_beard_shadow`)
-    from the angles' sines and cosines."""
+@njit(error_model="numpy", inline="always")
+def shadow(si, ci, sr, cr, cp, sp, tau, omega):
+    """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`models.maxwell_beard.maxwell_beard_shadow`,
+    whose docstring derives the two ``atan2``) from the angles' sines and cosines."""
     T = type(si)
-    t = si * si - T(2.0) * si * sr * cp + sr * sr
+    hx, hy = sr * cp - si, sr * sp
+    t = hx * hx + hy * hy
     den = ci + cr
-    slope = sqrt(max(t, T(0.0))) / (den if den > T(0.0) else T(1.0))
-    theta_n = math.atan(slope)
-    cos_beta = sqrt(min(max(T(0.5) * (T(1.0) - si * sr * cp + ci * cr), T(0.0)), T(1.0)))
-    beta = math.acos(min(cos_beta, T(1.0)))
+    theta_n = T(atan2(sqrt(t), den if den > T(0.0) else T(1.0)))
+    dx, dz = sr * cp + si, cr - ci
+    beta = T(atan2(sqrt(dx * dx + hy * hy + dz * dz), sqrt(t + den * den)))
     x = theta_n / omega
-    e = math.exp(-T(2.0) * beta / tau)
-    if math.isinf(x):  # theta_N / Omega overflowed (a tiny Omega): SO's limit
-        return e
-    return (T(1.0) + x * e) / (T(1.0) + x)
+    e = exp_neg(T(2.0) * beta / tau)
+    so = (T(1.0) + x * e) / (T(1.0) + x)
+    return e if x == T(math.inf) else so  # theta_N / Omega overflowed (a tiny Omega): SO's limit
 
 
 @njit(error_model="numpy", inline="always")
 def maxwell(geo, p, o):
-    """Maxwell-Beard at one geometry; ``o[2]``: the facet Mueller matrix on the specular term."""
-    ti, tr, pr = geo[0], geo[1], geo[2]
+    """Maxwell-Beard at one geometry; ``o[0]``: the slope kind, ``o[2]``: the facet Mueller
+    matrix on the specular term.  No C library call: a loop over it runs on SIMD lanes
+    (:mod:`models.kernels.vector`)."""
+    ti, tr, _, cp, sp = geo
     T = type(ti)
-    # the C library's cosines and sines, as numpy's: near retroreflection ``beta = acos(~1)``
-    # in :func:`shadow` turns an ulp of them into 1e-10 of the result
-    # (the polar cosines in float64 once: the facet term's sines come from them, :func:`polar`)
-    ci64, cr64 = math.cos(np.float64(ti)), math.cos(np.float64(tr))
-    si, ci, sr, cr = math.sin(ti), T(ci64), math.sin(tr), T(cr64)
-    cp, sp = math.cos(pr), math.sin(pr)
-    so = shadow(si, ci, sr, cr, cp, p[9], p[10])
-    pol_i, pol_r = polar_from(ci64, ti), polar_from(cr64, tr)
-    a, b, c, d, e, f, g, h = facet_jones_at((ti, tr, pr, cp, sp), pol_i, pol_r, p, o)
+    # the facet term takes the sines as sqrt(1 - cos^2) (:func:`polar`), the shadow the sines
+    # themselves, as the numpy path's: near normal incidence the two differ by 1e-10, which
+    # the shadow's slope near its origin made 5e-12 of a Gaussian lobe's far tail
+    (s_i, c_i), (s_r, c_r) = sincos(ti), sincos(tr)
+    pol_i, pol_r = polar_from(c_i, ti), polar_from(c_r, tr)
+    ci, cr = pol_i[0], pol_r[0]
+    so = shadow(T(s_i), ci, T(s_r), cr, cp, sp, p[9], p[10])
+    a, b, c, d, e, f, g, h = facet_jones_at(geo, pol_i, pol_r, p, o)
     if o[2] == 1:
         m = scaled16(mueller16(a, b, c, d, e, f, g, h), so)
     else:
@@ -56,6 +55,5 @@ def maxwell(geo, p, o):
     den = ci + cr
     vol = T(2.0) * p[8] / (den if den > T(0.0) else T(1.0))
     half_pi = T(0.5 * math.pi)
-    if ti >= half_pi or tr >= half_pi:
-        return m
-    return (m[0] + (p[7] + vol),) + m[1:]
+    grazing = ti >= half_pi or tr >= half_pi
+    return (m[0] + (T(0.0) if grazing else p[7] + vol),) + m[1:]

@@ -34,8 +34,9 @@ from numba import njit, prange
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX
 from .common import NO_SHADOWING
 from .cook import cook
-from .drive import BLOCK, COOK, DIFFUSE, FACET, PARAM_ROWS, SINGLE, angles_ok, options
+from .drive import BLOCK, COOK, DIFFUSE, FACET, MAXWELL, PARAM_ROWS, SINGLE, angles_ok, options
 from .facet import facet
+from .maxwell import maxwell
 from .vector_math import REDUCED_MAX, sincos
 from .volume import diffuse, single
 
@@ -58,6 +59,8 @@ def vectorized(code, iopt) -> bool:
         return iopt[1] == NO_SHADOWING and iopt[0] in FACET_KINDS
     if code == COOK:  # the varnished form: LLVM's cost model keeps its loop scalar
         return iopt[0] == 0 and iopt[2] != COOK_SHADOWING["smith"]
+    if code == MAXWELL:
+        return iopt[0] in FACET_KINDS
     return code in (SINGLE, DIFFUSE)
 
 
@@ -119,10 +122,32 @@ def lanes(code, sc, m, o):
             _loop(single, sc, m, (1, 0, 0))
     elif code == DIFFUSE:
         _loop(diffuse, sc, m, (0, 0, 0))
+    elif code == MAXWELL:
+        _maxwell_lanes(sc, m, o)
     elif o[2] == BLINN:
         _loop(cook, sc, m, (0, o[1], BLINN))
     else:
         _loop(cook, sc, m, (0, o[1], NO_COOK_SHADOWING))
+
+
+@njit(error_model="numpy", forceinline=True)
+def _maxwell_lanes(sc, m, o):
+    """:func:`lanes` for Maxwell-Beard: one loop per facet slope kind, scalar or polarized."""
+    kind, pol = o[0], o[2]
+    if kind == EXPONENTIAL:
+        if pol == 1:
+            _loop(maxwell, sc, m, (EXPONENTIAL, NO_SHADOWING, 1))
+        else:
+            _loop(maxwell, sc, m, (EXPONENTIAL, NO_SHADOWING, 0))
+    elif kind == GAUSSIAN:
+        if pol == 1:
+            _loop(maxwell, sc, m, (GAUSSIAN, NO_SHADOWING, 1))
+        else:
+            _loop(maxwell, sc, m, (GAUSSIAN, NO_SHADOWING, 0))
+    elif pol == 1:
+        _loop(maxwell, sc, m, (GGX, NO_SHADOWING, 1))
+    else:
+        _loop(maxwell, sc, m, (GGX, NO_SHADOWING, 0))
 
 
 @njit(error_model="numpy")

@@ -1,4 +1,4 @@
-"""Cosine, sine and ``exp(-x)`` in float64 without a call: code the compiler vectorizes.
+"""Cosine, sine, ``exp(-x)`` and ``atan2`` in float64 without a call: code the compiler vectorizes.
 
 A call to the C library's ``cos``, ``sin`` or ``exp`` costs about 5-10 ns per value and
 keeps any loop around it scalar: in the facet kernel those calls were a fifth of a
@@ -21,7 +21,16 @@ takes the Taylor series of ``exp r`` to ``r^13`` (the next term: 4e-18) and scal
 ``2^k`` built from its bits.  From ``x = 700`` on it is exactly zero, as the numpy path's
 :func:`models.slopes._exp_neg`.
 
-Both agree with the C library within 2 ulp (``tests/test_vector_kernels.py`` measures it).
+
+:func:`atan2` takes ``t = min(|x|, |y|) / max(|x|, |y|)`` in [0, 1] and, above
+``tan(pi/8)``, ``u = (t - 1) / (t + 1)`` (one division either way: the numerator and the
+denominator are selected), so ``|u| <= tan(pi/8)``; ``atan u = u + u^3 f(u^2)`` with ``f``
+a polynomial of degree 10 in ``u^2`` (Chebyshev fit of ``(atan u - u) / u^3`` on
+``[0, tan^2(pi/8)]`` in 50-digit arithmetic, ``scripts/fit_atan_coefficients.py``: largest
+error 3.2e-17, which enters ``atan u`` times ``u^2 <= 0.17``); the quadrant is then restored
+with ``pi/4``, ``pi/2`` and ``pi`` each in two parts.
+
+All three agree with the C library within 2 ulp (``tests/test_vector_kernels.py`` measures it).
 Float32 arguments are computed in float64 and rounded.
 """
 
@@ -49,6 +58,17 @@ _INV_LN2 = 1.4426950408889634
 E2, E3, E4, E5, E6, E7, E8, E9, E10, E11, E12, E13 = (1.0 / math.factorial(k) for k in range(2, 14))
 #: from here on ``exp(-x)`` is exactly zero (as the numpy path's)
 EXP_ZERO = 700.0
+#: ``(atan u - u) / u^3`` as a polynomial in ``z = u^2``, constant term first
+#: (``scripts/fit_atan_coefficients.py``)
+A0, A1, A2, A3, A4, A5 = (-0.3333333333333333, 0.1999999999999552, -0.14285714284666542,
+                          0.11111111015256361, -0.09090904578123903, 0.07692183190826087)  # fmt: skip
+A6, A7, A8, A9, A10 = (-0.06664511447381948, 0.0585814891280221, -0.0508544973794026,
+                       0.03923165829558719, -0.01917688711906226)  # fmt: skip
+_TAN_PI_8 = 0.41421356237309503
+#: ``pi/4``, ``pi/2``, ``pi``: the double nearest, and the rest
+_PIO4_HI, _PIO4_LO = 0.7853981633974483, 3.061616997868383e-17
+_PIO2_HI, _PIO2_LO = 1.5707963267948966, 6.123233995736766e-17
+_PI_HI, _PI_LO = 3.141592653589793, 1.2246467991473532e-16
 
 
 @intrinsic
@@ -104,3 +124,22 @@ def exp_neg(x):
     p = 1.0 + r * (1.0 + r * (E2 + r * (E3 + r * (E4 + r * (E5 + r * (E6 + r * (E7 + r * (E8 + r * p))))))))
     e = p * _from_bits((np.int64(k) + 1023) << 52)
     return T(e if v < EXP_ZERO else 0.0)
+
+
+@njit(error_model="numpy", inline="always")
+def atan2(y, x):
+    """``atan2(y, x)`` in float64 for finite ``x``, ``y`` (no branch, no call): the angle of
+    ``(x, y)`` in [-pi, pi], with the C library's signs at zeros (``atan2(+-0, -0) = +-pi``)."""
+    ay, ax = abs(np.float64(y)), abs(np.float64(x))
+    hi, lo = max(ax, ay), min(ax, ay)
+    big = lo > _TAN_PI_8 * hi
+    num = lo - hi if big else lo
+    den = lo + hi if big else hi
+    u = num / (den if den > 0.0 else 1.0)
+    z = u * u
+    p = A8 + z * (A9 + z * A10)
+    p = A0 + z * (A1 + z * (A2 + z * (A3 + z * (A4 + z * (A5 + z * (A6 + z * (A7 + z * p)))))))
+    r = (u + (u * z * p + (_PIO4_LO if big else 0.0))) + (_PIO4_HI if big else 0.0)
+    r = _PIO2_HI - (r - _PIO2_LO) if ay > ax else r
+    r = _PI_HI - (r - _PI_LO) if math.copysign(1.0, x) < 0.0 else r
+    return math.copysign(r, y)
