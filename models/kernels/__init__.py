@@ -8,11 +8,12 @@ the cores (``prange``) from :data:`PARALLEL_MIN` geometries on, writing the elem
 ``(16, N)`` result directly.  Parameters are per element (a model set) or shared, so a
 likelihood evaluates all walkers of an emcee step in one call.  Float64 calls of the models
 whose kernels have no C library call left (:func:`~models.kernels.vector.vectorized`: the
-facet reflection models with exponential, Gaussian or GGX slopes and no shadowing, single
-scattering, the diffuse subsurface, the bare Cook-Torrance without Smith shadowing) run
+facet reflection models and Maxwell-Beard with exponential, Gaussian or GGX slopes and no
+shadowing, single scattering, the diffuse subsurface, both Cook-Torrance forms without Smith
+shadowing) run
 :mod:`~models.kernels.vector`'s loops instead, which
-compile to SIMD instructions (:mod:`~models.kernels.vector_math`: polynomial cosines, sines
-and exponentials) and give the scalar loop's bits.
+compile to SIMD instructions (:mod:`~models.kernels.vector_math`: polynomial cosines, sines,
+exponentials and arctangents) and give the scalar loop's bits.
 
 The numpy implementation of every model stays the reference (``with models.backend("numpy")``);
 the tests hold the kernels to it within 1e-12 relative to ``M00``.  A model's

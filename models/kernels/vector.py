@@ -18,9 +18,8 @@ block of :data:`VBLOCK` geometries:
 
 The kernels are the same functions as the scalar loop's, so both give the same bits
 (``tests/test_vector_kernels.py``).  :func:`vectorized` says which models and options take this
-path.  The others keep C library calls that leave any loop scalar (FacetBTDF,
-Maxwell-Beard, Smith shadowing, anisotropic slopes) or form a loop that LLVM's cost model
-declines (the varnished Cook-Torrance); :class:`models.kernels.Compiled` runs them through
+path.  The others keep C library calls that leave any loop scalar (FacetBTDF, Smith
+shadowing, anisotropic slopes, unit slopes); :class:`models.kernels.Compiled` runs them through
 :mod:`~models.kernels.drive`.
 """
 
@@ -57,8 +56,8 @@ def vectorized(code, iopt) -> bool:
     """Whether kernel ``code`` with options ``iopt`` takes the vector path (float64)."""
     if code == FACET:
         return iopt[1] == NO_SHADOWING and iopt[0] in FACET_KINDS
-    if code == COOK:  # the varnished form: LLVM's cost model keeps its loop scalar
-        return iopt[0] == 0 and iopt[2] != COOK_SHADOWING["smith"]
+    if code == COOK:
+        return iopt[2] != COOK_SHADOWING["smith"]
     if code == MAXWELL:
         return iopt[0] in FACET_KINDS
     return code in (SINGLE, DIFFUSE)
@@ -124,6 +123,11 @@ def lanes(code, sc, m, o):
         _loop(diffuse, sc, m, (0, 0, 0))
     elif code == MAXWELL:
         _maxwell_lanes(sc, m, o)
+    elif o[0] == 1:
+        if o[2] == BLINN:
+            _loop(cook, sc, m, (1, o[1], BLINN))
+        else:
+            _loop(cook, sc, m, (1, o[1], NO_COOK_SHADOWING))
     elif o[2] == BLINN:
         _loop(cook, sc, m, (0, o[1], BLINN))
     else:
