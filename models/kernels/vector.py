@@ -136,22 +136,14 @@ def lanes(code, sc, m, o):
 
 @njit(error_model="numpy", forceinline=True)
 def _maxwell_lanes(sc, m, o):
-    """:func:`lanes` for Maxwell-Beard: one loop per facet slope kind, scalar or polarized."""
+    """:func:`lanes` for Maxwell-Beard: one loop per facet slope kind."""
     kind, pol = o[0], o[2]
     if kind == EXPONENTIAL:
-        if pol == 1:
-            _loop(maxwell, sc, m, (EXPONENTIAL, NO_SHADOWING, 1))
-        else:
-            _loop(maxwell, sc, m, (EXPONENTIAL, NO_SHADOWING, 0))
+        _loop(maxwell, sc, m, (EXPONENTIAL, NO_SHADOWING, pol))
     elif kind == GAUSSIAN:
-        if pol == 1:
-            _loop(maxwell, sc, m, (GAUSSIAN, NO_SHADOWING, 1))
-        else:
-            _loop(maxwell, sc, m, (GAUSSIAN, NO_SHADOWING, 0))
-    elif pol == 1:
-        _loop(maxwell, sc, m, (GGX, NO_SHADOWING, 1))
+        _loop(maxwell, sc, m, (GAUSSIAN, NO_SHADOWING, pol))
     else:
-        _loop(maxwell, sc, m, (GGX, NO_SHADOWING, 0))
+        _loop(maxwell, sc, m, (GGX, NO_SHADOWING, pol))
 
 
 @njit(error_model="numpy")
