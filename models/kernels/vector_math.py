@@ -83,6 +83,26 @@ def _from_bits(typingctx, bits):
 
 
 @intrinsic
+def _to_bits(typingctx, x):
+    """The IEEE bits of the float64 ``x`` as an int64 (a register move, vectorizable)."""
+    sig = types.int64(types.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.IntType(64))
+
+    return sig, codegen
+
+
+@njit(error_model="numpy", inline="always")
+def inverse_binade(x):
+    """``2^-e`` for the float64 ``x > 0`` of exponent ``e`` (``1 <= x 2^-e < 2`` for a normal
+    ``x``): an exact scale that brings ``x`` near 1 without a division (subnormal ``x``: the
+    scale ``2^1023``, which still lifts it above 1e-16)."""
+    e = (_to_bits(np.float64(x)) >> 52) & 0x7FF
+    return _from_bits((2046 - e) << 52)
+
+
+@intrinsic
 def sqrt(typingctx, x):
     """``math.sqrt`` as the ``llvm.sqrt`` intrinsic: numba calls the C library's ``sqrt``,
     which the vectorizer leaves alone (same IEEE result; NaN below zero, as both)."""
