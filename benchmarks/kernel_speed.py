@@ -4,7 +4,9 @@
 
 Prints, for every closed-form model: the per-geometry cost of the full float64 Mueller
 matrix from angles at ``--n`` geometries with the numpy path and with the kernels on one
-thread and on every core (best of ``--repeat``), and the ratios; the small calls (one
+thread and on every core (best of ``--repeat``), and the ratios, each call allocating its
+result and again writing into one allocated before (``out=``: the first touch of a fresh
+128 MB result, the operating system zeroing its pages, is part of the former); the small calls (one
 geometry, 100 geometries); float32 against float64 (cost, and the error as the trade-off
 study's precision knob defines it: max |M32 - M64| over every element / max M64_00); and
 the import + first-call time of a fresh process with an empty kernel cache (cold: the
@@ -57,19 +59,26 @@ def geometries(n):
 
 
 def per_geometry(n, repeat):
-    """``{model: (numpy us, one thread us, all threads us)}`` per geometry at ``n``."""
+    """``{model: (numpy us, one thread us, all threads us, one thread out= us, all out= us)}``
+    per geometry at ``n``: each call allocates its ``(16, n)`` result, whose fresh pages
+    the operating system zeroes on first touch, except in the ``out=`` columns, which
+    write into one array allocated before (``m.mueller(..., out=out)``)."""
     ti, tr, pr = geometries(n)
     out = {}
+    buf = np.empty((16, n))
     for name, make in MODELS.items():
         m = make()
         m.mueller(ti[:10], tr[:10], pr[:10])  # compiled (or loaded) before timing
         with models.backend("numpy"):
             t_np = best_of(lambda m=m: m.mueller(ti, tr, pr), max(1, repeat // 2))[0]
-        numba.set_num_threads(1)
-        t_1 = best_of(lambda m=m: m.mueller(ti, tr, pr), repeat)[0]
+        times = []
+        for threads in (1, numba.config.NUMBA_NUM_THREADS):
+            numba.set_num_threads(threads)
+            times.append(best_of(lambda m=m: m.mueller(ti, tr, pr), repeat)[0])
+            times.append(best_of(lambda m=m: m.mueller(ti, tr, pr, out=buf), repeat)[0])
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-        t_all = best_of(lambda m=m: m.mueller(ti, tr, pr), repeat)[0]
-        out[name] = tuple(1e6 * t / n for t in (t_np, t_1, t_all))
+        t_1, t_1o, t_all, t_allo = times
+        out[name] = tuple(1e6 * t / n for t in (t_np, t_1, t_all, t_1o, t_allo))
     return out
 
 
@@ -148,9 +157,16 @@ def main():
     print(
         f"load {os.getloadavg()}; {numba.config.NUMBA_NUM_THREADS} threads; {args.n} geometries, full Mueller"
     )
-    print(f"{'model':<26} {'numpy us':>9} {'1 thread':>9} {'all':>9} {'np/1thr':>8} {'1thr/all':>9}")
-    for name, (t_np, t_1, t_all) in per_geometry(args.n, args.repeat).items():
-        print(f"{name:<26} {t_np:9.4f} {t_1:9.4f} {t_all:9.4f} {t_np / t_1:7.1f}x {t_1 / t_all:8.2f}x")
+    print(f"{'':<36} fresh result{'':<28} into out=")
+    print(
+        f"{'model':<26} {'numpy us':>9} {'1 thread':>9} {'all':>9} {'np/1thr':>8} {'1thr/all':>9}"
+        f" {'1 thread':>9} {'all':>9} {'1thr/all':>9}"
+    )
+    for name, (t_np, t_1, t_all, t_1o, t_allo) in per_geometry(args.n, args.repeat).items():
+        print(
+            f"{name:<26} {t_np:9.4f} {t_1:9.4f} {t_all:9.4f} {t_np / t_1:7.1f}x {t_1 / t_all:8.2f}x"
+            f" {t_1o:9.4f} {t_allo:9.4f} {t_1o / t_allo:8.2f}x"
+        )
     for name, (t_np, t_k) in small_calls(args.repeat).items():
         print(f"small call, {name:<42} numpy {t_np:8.1f} us, kernel {t_k:6.1f} us ({t_np / t_k:.1f}x)")
     t64, t32, err = float32(args.n, args.repeat)

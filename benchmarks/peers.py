@@ -51,6 +51,7 @@ import argparse
 import datetime
 import math
 import platform
+import subprocess
 from dataclasses import asdict, dataclass, field
 from importlib import metadata
 
@@ -243,6 +244,34 @@ def _llvm_timed(mi, dr, bsdf, polarized, g):
     return m00 / np.cos(ti), (call, call_wall, geom, geom_wall)
 
 
+#: one evaluation of a JIT variant, run in a child process first (:func:`_jit_unusable`)
+_JIT_PROBE = """
+import drjit as dr, mitsuba as mi
+mi.set_variant({variant!r})
+b = mi.load_dict({{"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, "eta": 1.37, "k": 7.62}})
+si = dr.zeros(mi.SurfaceInteraction3f)
+si.sh_frame = mi.Frame3f(mi.Vector3f(0.0, 0.0, 1.0))
+si.wi = mi.Vector3f(0.0, 0.0, 1.0)
+dr.eval(b.eval(mi.BSDFContext(), si, mi.Vector3f(0.0, 0.0, 1.0)))
+"""
+
+
+def _jit_unusable(variant):
+    """``None`` when Mitsuba's JIT ``variant`` evaluates a BSDF in a child process, else why
+    not: an LLVM that Dr.Jit cannot use aborts the process inside LLVM ("Cannot select
+    fmaximum"), which no ``except`` in this one could catch."""
+    res = subprocess.run(
+        [sys.executable, "-c", _JIT_PROBE.format(variant=variant)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    if res.returncode == 0:
+        return None
+    tail = (res.stderr.strip().splitlines() or [f"exit status {res.returncode}"])[-1]
+    return f"its probe process failed ({tail[:200]}); Dr.Jit needs Debian's libllvm19 (DRJIT_LIBLLVM_PATH={LLVM})"
+
+
 def mitsuba_rows(g, loop):
     """One :class:`Row` per Mitsuba variant that runs; ``(rows, notes)``."""
     try:
@@ -254,6 +283,10 @@ def mitsuba_rows(g, loop):
     rows, notes = [], []
     for variant in ("scalar_rgb", "scalar_spectral_polarized", "llvm_ad_rgb", "llvm_ad_mono_polarized"):
         polarized = variant.endswith("polarized")
+        why = None if variant.startswith("scalar") else _jit_unusable(variant)
+        if why:
+            notes.append(f"Mitsuba {variant} skipped: {why}")
+            continue
         try:
             mi.set_variant(variant)
             dr.set_thread_count(THREADS)

@@ -126,3 +126,11 @@ def test_our_timed_calls_run_on_one_thread(peers, monkeypatch):
 def test_bad_sizes_are_refused(peers):
     with pytest.raises(SystemExit):
         peers.main(["--n", "10", "--loop", "11", "--no-save"])
+
+
+def test_a_jit_variant_that_fails_is_probed_in_a_child_process(peers):
+    """A JIT variant Dr.Jit cannot run aborts its process inside LLVM (uncatchable): the
+    probe runs it in a child, and a failure is a reason to skip, not a crash of this one."""
+    pytest.importorskip("mitsuba")
+    why = peers._jit_unusable("llvm_no_such_variant")
+    assert why is not None and "probe process failed" in why and "libllvm19" in why
