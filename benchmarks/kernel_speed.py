@@ -58,6 +58,10 @@ def geometries(n):
     return random_geometries(n, 0, max_deg=math.degrees(1.5))
 
 
+#: the kernel columns of :func:`per_geometry`
+COLUMNS = ("1 thread", "all threads", "1 thread, out=", "all threads, out=")
+
+
 def per_geometry(n, repeat):
     """``{model: (numpy us, one thread us, all threads us, one thread out= us, all out= us)}``
     per geometry at ``n``: each call allocates its ``(16, n)`` result, whose fresh pages

@@ -1,13 +1,15 @@
-"""Small calls before and after a change, measured in one run.
+"""The kernels before and after a change, measured in one run.
 
     git archive <old commit> | tar -x -C /tmp/base
-    python benchmarks/small_calls_ab.py --base /tmp/base [--rounds 3]
+    python benchmarks/kernel_ab.py --base /tmp/base [--rounds 3] [--what small|geometry]
 
-Runs this checkout's :func:`benchmarks.kernel_speed.small_calls` (every closed-form model's
-one-geometry and 100-geometry ``mueller`` calls, and the other input forms) against the
-package in ``--base`` and against this checkout's, alternating fresh processes for
-``--rounds`` rounds so that both see the same machine load, and prints the best of the
-rounds per case with the ratio.
+Runs this checkout's :func:`benchmarks.kernel_speed.small_calls` (``--what small``, the
+default: every closed-form model's one-geometry and 100-geometry ``mueller`` calls, and the
+other input forms) or :func:`benchmarks.kernel_speed.per_geometry` (``--what geometry``: 10^6
+geometries, one thread and every core, a fresh result and into ``out=``) against the package
+in ``--base`` and against this checkout's, alternating fresh processes for ``--rounds`` rounds
+so that both see the same machine load (on a shared machine figures drift by tens of percent
+over minutes), and prints the best of the rounds per case with the ratio.
 """
 
 from __future__ import annotations
@@ -27,18 +29,23 @@ spec = importlib.util.spec_from_file_location("ks", sys.argv[2])
 ks = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(ks)
 import models
-print(json.dumps({"models": models.__file__, "calls": ks.small_calls(int(sys.argv[1]))}))
+if sys.argv[3] == "small":
+    calls = ks.small_calls(int(sys.argv[1]))
+else:
+    calls = {f"{name}, {col}": (t[0], v) for name, t in ks.per_geometry(10**6, int(sys.argv[1])).items()
+             for col, v in zip(ks.COLUMNS, t[1:])}
+print(json.dumps({"models": models.__file__, "calls": calls}))
 """
 
 
-def measure(root, repeat):
+def measure(root, repeat, what):
     """``{case: (numpy us, kernel us)}`` of the package in ``root``."""
-    copy = os.path.join(root, "benchmarks", "_small_calls_ab_copy.py")
+    copy = os.path.join(root, "benchmarks", "_kernel_ab_copy.py")
     shutil.copy(os.path.join(HERE, "benchmarks", "kernel_speed.py"), copy)
     try:
         env = dict(os.environ, PYTHONPATH=root)
         r = subprocess.run(
-            [sys.executable, "-c", CHILD, str(repeat), copy],
+            [sys.executable, "-c", CHILD, str(repeat), copy, what],
             env=env,
             capture_output=True,
             text=True,
@@ -58,12 +65,13 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--base", required=True, help="a checkout of the older version")
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--what", choices=("small", "geometry"), default="small")
     args = ap.parse_args()
     best = {"before": {}, "after": {}}
     print(f"load {os.getloadavg()}")
     for _ in range(args.rounds):
         for label, root in (("before", args.base), ("after", HERE)):
-            for case, (t_np, t_k) in measure(root, 3).items():
+            for case, (t_np, t_k) in measure(root, 3, args.what).items():
                 old = best[label].get(case, (float("inf"), float("inf")))
                 best[label][case] = (min(old[0], t_np), min(old[1], t_k))
     print(f"load after: {os.getloadavg()}")
@@ -75,7 +83,7 @@ def main():
         if before is None:
             continue
         print(
-            f"{case:<48} {before[1]:10.2f} {after[1]:10.2f} {before[1] / after[1]:6.1f}x   "
+            f"{case:<48} {before[1]:10.4g} {after[1]:10.4g} {before[1] / after[1]:6.2f}x   "
             f"{before[0]:.0f} / {after[0]:.0f}"
         )
 
