@@ -12,12 +12,11 @@ cosines and sines are taken once, before it.  The sum adds the nodes in order, a
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
-from .vector_math import REDUCED_MAX, atan2, inverse_binade, sincos, sqrt
+from .common import azimuths
+from .vector_math import atan2, inverse_binade, sincos, sqrt
 
 
 @njit(error_model="numpy", inline="always")
@@ -49,15 +48,14 @@ def nodes(ti, tr, pr, a, b, cos_u, w, out):
     (``cos theta dOmega``, zero below the horizon) and the double analyzer angle's cosine
     and sine."""
     n, K = tr.shape[0], a.shape[0]
-    frame = np.empty((3, n))
-    for g in range(n):  # each nominal direction's frame (polynomials: a loop on SIMD lanes)
+    # each nominal direction's frame: cos tr, sin tr, p_r's z (as the vector form rounds it)
+    # and the azimuth's cosine and sine (polynomials: loops on SIMD lanes)
+    frame = np.empty((5, n))
+    azimuths(pr, frame[3], frame[4])
+    for g in range(n):
         st, ct = sincos(tr[g])
-        sp, cp = sincos(pr[g])
-        frame[0, g], frame[1, g], frame[2, g] = ct, st, st * cp * cp + st * sp * sp  # p_r's z
-    for g in range(n):  # rare: an azimuth beyond the polynomial's range (the C library's)
-        if not abs(pr[g]) <= REDUCED_MAX:
-            st, cp, sp = frame[1, g], math.cos(pr[g]), math.sin(pr[g])
-            frame[2, g] = st * cp * cp + st * sp * sp
+        cp, sp = frame[3, g], frame[4, g]
+        frame[0, g], frame[1, g], frame[2, g] = ct, st, st * cp * cp + st * sp * sp
     for k in range(K):
         _node(ti, pr, frame, a[k], b[k], cos_u[k], w[k], out, k * n)
 

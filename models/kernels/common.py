@@ -63,6 +63,20 @@ def azimuth(p):
 
 
 @njit(error_model="numpy", inline="always")
+def azimuths(p, c, s):
+    """:func:`azimuth` of every element of ``p`` into ``c``, ``s`` (float64 arrays of its
+    length), in two passes: the polynomial over all of them (a loop on SIMD lanes), then the
+    C library for the rare ones beyond its range (a branch to it per value, as in
+    :func:`azimuth`, would keep the first loop scalar)."""
+    for k in range(p.shape[0]):
+        s[k], c[k] = sincos(p[k])
+    for k in range(p.shape[0]):
+        v = p[k]
+        if not abs(v) <= REDUCED_MAX:
+            s[k], c[k] = math.sin(v), math.cos(v)
+
+
+@njit(error_model="numpy", inline="always")
 def internal_sine(c_int, s_ext, n):
     """Sine of the refracted angle in a coating ``n`` of cosine ``c_int``, external sine
     ``s_ext``: float64 ``sqrt(1 - c_int^2)`` (the numpy path's); float32 ``s_ext / n`` (Snell;

@@ -8,7 +8,8 @@ block of :data:`VBLOCK` geometries:
 
 1. :func:`gather` copies the block's angles and parameters into one scratch
    array and takes the azimuths' cosines and sines there with the polynomial
-   :func:`~models.kernels.vector_math.sincos` (the C library beyond its range);
+   :func:`~models.kernels.vector_math.sincos` (the C library beyond its range:
+   :func:`~models.kernels.common.azimuths`);
 2. :func:`lanes` runs the kernel over the scratch: one loop per model and slope kind, with
    the code and options constants, so that the branches left are selects; no call remains
    (the kernels use :mod:`~models.kernels.vector_math`, and ``error_model="numpy"`` lets a
@@ -25,18 +26,15 @@ shadowing, anisotropic slopes, unit slopes); :class:`models.kernels.Compiled` ru
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX
-from .common import NO_SHADOWING
+from .common import NO_SHADOWING, azimuths
 from .cook import cook
 from .drive import BLOCK, COOK, DIFFUSE, FACET, MAXWELL, PARAM_ROWS, SINGLE, angles_ok, options
 from .facet import facet
 from .maxwell import maxwell
-from .vector_math import REDUCED_MAX, sincos
 from .volume import diffuse, single
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (55 kB), stays
@@ -66,6 +64,12 @@ def vectorized(code, iopt) -> bool:
 @njit(error_model="numpy", inline="always")
 def _at(sc, row, k):
     return sc[row * VBLOCK + k]
+
+
+@njit(error_model="numpy", inline="always")
+def _row(sc, row, m):
+    """The first ``m`` columns of scratch row ``row`` (a view)."""
+    return sc[row * VBLOCK : row * VBLOCK + m]
 
 
 @njit(error_model="numpy", inline="always")
@@ -149,21 +153,13 @@ def _maxwell_lanes(sc, m, o):
 @njit(error_model="numpy")
 def gather(sc, ti, tr, pr, prm, lo, m):
     """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch: angles, the azimuth's
-    cosine and sine (:func:`~models.kernels.vector_math.sincos` over the block, the C
-    library beyond its range), and the parameters (a single model's repeated)."""
+    cosine and sine (:func:`~models.kernels.common.azimuths` over the block), and the
+    parameters (a single model's repeated)."""
     a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
     for k in range(m):
         i = lo + k
         sc[_TI * VBLOCK + k], sc[_TR * VBLOCK + k], sc[_PR * VBLOCK + k] = ti[i * a], tr[i * b], pr[i * c]
-    for k in range(m):
-        s, co = sincos(_at(sc, _PR, k))
-        sc[_SP * VBLOCK + k], sc[_CP * VBLOCK + k] = s, co
-    # rare: beyond the polynomial's range, a pass of its own (common.azimuth branches to the
-    # C library per value, which would keep the sincos loop above scalar)
-    for k in range(m):
-        v = _at(sc, _PR, k)
-        if not abs(v) <= REDUCED_MAX:
-            sc[_SP * VBLOCK + k], sc[_CP * VBLOCK + k] = math.sin(v), math.cos(v)
+    azimuths(_row(sc, _PR, m), _row(sc, _CP, m), _row(sc, _SP, m))
     for r in range(PARAM_ROWS):  # a single model's too: the loop then reads them as a set's
         for k in range(m):
             sc[(_PRM + r) * VBLOCK + k] = prm[r, (lo + k) * p]

@@ -13,8 +13,8 @@ parts, the first two of 30 significant bits, so ``k * part`` is exact for ``|k| 
 and ``r`` is exact to about an ulp of ``x`` up to :data:`REDUCED_MAX`.  On ``|r| <= pi/4``
 the series of ``sin`` to ``r^17`` and of ``cos`` to ``r^16`` leave less than 1e-17 (the
 next terms).  Beyond :data:`REDUCED_MAX` (an azimuth of 1e6 rad) the result is wrong: the
-callers use the C library there (:func:`models.kernels.common.azimuth`,
-:func:`models.kernels.vector.gather`).
+callers use the C library there (:func:`models.kernels.common.azimuth` for one value,
+:func:`models.kernels.common.azimuths` for an array).
 
 :func:`exp_neg` reduces ``-x = k ln 2 + r`` (``ln 2`` in two parts), ``|r| <= ln2 / 2``,
 takes the Taylor series of ``exp r`` to ``r^13`` (the next term: 4e-18) and scales by
