@@ -173,6 +173,21 @@ def coating_t(c, n):
 
 
 @njit(error_model="numpy", forceinline=True)
+def dielectric_transmittance(c, n):
+    """``1 - F`` for natural light at cosine ``c`` entering a non-absorbing ``n >= 1``
+    (:func:`models.kernels.cook.fresnel_average` of a real index, in real arithmetic:
+    ``w = sqrt(n^2 - 1 + c^2)`` is real, so neither the complex root nor the complex
+    divisions, whose branches a vector loop computes both of, are needed: with them LLVM's
+    cost model kept the varnished Cook-Torrance loop scalar)."""
+    T = type(c)
+    n2 = n * n
+    w = sqrt(n2 - T(1.0) + c * c)
+    rs = (c - w) / (c + w)
+    rp = (n2 * c - w) / (n2 * c + w)
+    return T(1.0) - T(0.5) * (rs * rs + rp * rp)
+
+
+@njit(error_model="numpy", forceinline=True)
 def p3(kind, zx, zy, sx, sy, rot, cov):
     """Slope density ``P3^xy`` of ``kind`` at ``(zx, zy)``; ``sx``, ``sy`` the widths (sigma,
     alpha; ``m_parallel``, ``m_perpendicular`` for strokes), ``rot`` the axes' rotation."""

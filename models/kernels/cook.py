@@ -9,7 +9,18 @@ import math
 from numba import njit
 
 from ..kernel_specs import ANISO_GAUSSIAN, GAUSSIAN
-from .common import SMITH, cdiv, coating_cos, diag16, internal_sine, polar, refraction_w, smith_g, stroke_d
+from .common import (
+    SMITH,
+    cdiv,
+    coating_cos,
+    diag16,
+    dielectric_transmittance,
+    internal_sine,
+    polar,
+    refraction_w,
+    smith_g,
+    stroke_d,
+)
 from .vector_math import sqrt
 
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
@@ -33,21 +44,6 @@ def fresnel_average(c, mr, mi, pec):
     ar, ai = m2r * c, m2i * c
     rpr, rpi = cdiv(ar - wr, ai - wi, ar + wr, ai + wi)
     return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
-
-
-@njit(error_model="numpy", forceinline=True)
-def dielectric_transmittance(c, n):
-    """``1 - F`` for natural light at cosine ``c`` entering a non-absorbing ``n >= 1``
-    (:func:`fresnel_average` of a real index, in real arithmetic: ``w = sqrt(n^2 - 1 + c^2)``
-    is real, so neither the complex root nor the complex divisions, whose branches a vector
-    loop computes both of, are needed: with them LLVM's cost model kept the varnished loop
-    scalar)."""
-    T = type(c)
-    n2 = n * n
-    w = sqrt(n2 - T(1.0) + c * c)
-    rs = (c - w) / (c + w)
-    rp = (n2 * c - w) / (n2 * c + w)
-    return T(1.0) - T(0.5) * (rs * rs + rp * rp)
 
 
 @njit(error_model="numpy", inline="always")
