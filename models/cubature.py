@@ -191,14 +191,22 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
     regions.evaluate(integrand, block)
     capped = np.zeros(n_rows, dtype=bool)
     evaluated = np.bincount(cell_row[regions.cell], minlength=n_rows)
+    # a row that stops refining keeps its figures here and its regions leave the loop: each
+    # pass then costs what its rows still refining hold (every figure is per row, summed in
+    # the regions' order, which leaving does not change: the same bits)
+    total = np.zeros((regions.val.shape[0], n_rows))
+    row_err = np.zeros(n_rows)
+    count = np.zeros(n_rows, dtype=int)
+    active = np.ones(n_rows, dtype=bool)
     while True:
         row = cell_row[regions.cell]
-        total = np.stack([np.bincount(row, weights=x, minlength=n_rows) for x in regions.val])
+        summed = np.stack([np.bincount(row, weights=x, minlength=n_rows) for x in regions.val])
+        total[:, active] = summed[:, active]
         err = norm(regions.diff, total[:, row])
-        row_err = np.bincount(row, weights=err, minlength=n_rows)
-        count = np.bincount(row, minlength=n_rows)
+        row_err[active] = np.bincount(row, weights=err, minlength=n_rows)[active]
+        count[active] = np.bincount(row, minlength=n_rows)[active]
         allowed = budget(total)
-        todo = ~(row_err <= allowed)  # a NaN error is not converged
+        todo = active & ~(row_err <= allowed)  # a NaN error is not converged
         # rows at the cap, or whose error is not finite (no split can repair it), are reported
         capped |= todo & ((count >= max_regions) | ~np.isfinite(row_err))
         todo &= ~capped
@@ -210,4 +218,6 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
         if not split.any():
             return Cubature(total, row_err, count, capped, evaluated)
         evaluated += 2 * np.bincount(row[split], minlength=n_rows)
-        regions = _refine(regions, split, integrand, block)
+        active = todo
+        keep = todo[row]
+        regions = _refine(regions.take(keep), split[keep], integrand, block)

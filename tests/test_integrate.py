@@ -159,6 +159,42 @@ def test_the_rule_is_exact_to_degree_seven():
     assert abs(value - 1.0 / 9.0) > 1e-6 and error > abs(value - 1.0 / 9.0)
 
 
+def test_rows_integrated_together_give_each_row_s_bits_alone():
+    """models.cubature.adaptive refines many rows at once, and a row that stops refining
+    leaves the loop (its figures kept): each row's value, error, region count, cap flag and
+    evaluations are those it gets integrated alone, bit for bit, whichever rows share the
+    call, finish first, stop at the cap or hold a NaN."""
+    from models import cubature
+
+    # per row: a peak of width 10^-s at (0.3, 0.6), so the rows need very different refinement
+    sharp = np.array([0.5, 1.0, 2.0, 3.0, 1.5])
+    poison = np.array([False, False, False, False, True])  # the last row's integrand is NaN
+
+    def run(rows):
+        owner = np.repeat(rows, 2)  # two cells per row: the lower and upper halves in v
+
+        def f(cell, u, v):
+            s = 10.0 ** -sharp[owner[cell]][:, None]
+            y = 0.5 * (v + (cell % 2)[:, None])
+            g = s / ((u - 0.3) ** 2 + (y - 0.6) ** 2 + s * s)
+            g = np.where(poison[owner[cell]][:, None], np.nan, g)
+            return np.stack([g, g * u]), np.full(u.shape, 0.5)
+
+        return cubature.adaptive(
+            f, np.repeat(np.arange(rows.size), 2), rows.size, norm=lambda diff, value: diff[0] + diff[1],
+            budget=lambda value: 1e-6 * np.abs(value[0]), max_regions=300,
+        )  # fmt: skip
+
+    together = run(np.arange(sharp.size))
+    assert together.capped.tolist() == [False, False, True, True, True]  # met; at the cap; NaN
+    assert len(set(together.evaluated.tolist())) >= 4  # the rows finished at different passes
+    for r in range(sharp.size):
+        alone = run(np.array([r]))
+        for f in ("value", "error", "regions", "capped", "evaluated"):
+            got, ref = getattr(together, f)[..., r], getattr(alone, f)[..., 0]
+            assert np.array_equal(got, ref, equal_nan=True), (r, f)
+
+
 @pytest.mark.parametrize("cap", [20_000, 200_000])
 def test_the_evaluation_cap_stops_refinement_and_says_so(cap):
     """A tolerance no cap allows: refinement stops near max_evaluations (the regions of the
