@@ -71,6 +71,8 @@ an :class:`AccuracyWarning` naming how many did and their estimated error;
 is rotated per node as a model set (``model.rotated(array)``, one call per block of nodes); one
 whose ``rotated`` takes a single angle (a user's model) is rotated node by node, one call per
 distinct azimuth, on the same nodes: the same quadrature, only slower.
+With the numba backend (the default) the node algebra, each point's local incidence and
+irradiance weight, runs compiled (:mod:`models.kernels.disc`, held to :meth:`_Disc.angles`).
 
 A fixed ``resolution`` (an int) is the product rule of earlier versions, unrefined and
 unestimated: Gauss-Legendre in the radius about the disc centre (``resolution`` nodes, weight
@@ -101,7 +103,7 @@ from functools import cached_property
 import numpy as np
 from scipy import signal
 
-from . import cubature
+from . import cubature, evaluation
 from .base import Model, _Wrapper, is_isotropic
 from .cubature import AccuracyWarning
 from .geometry import disc_quadrature, polar_rule
@@ -635,9 +637,31 @@ class _Disc:
 
     def values(self, rows, v, chi, w):
         """``(M, J)`` at ``(v, chi)`` with quadrature weights ``w``: the 16 Mueller elements
-        ``(16, m, P)`` and the irradiance weight ``J`` ``(m, P)`` (per row up to a constant:
-        ``rho^2 t cos^3 psi / cos^3 psi_c w`` about the centre, ``2 v rho^2 / (h (h + 1)) w``
-        about ``H``, ``h = hypot(1, k rho)``, scaled by the unit disc's)."""
+        ``(16, m, P)`` and the irradiance weight ``J`` ``(m, P)`` (:meth:`angles`)."""
+        if evaluation.current_backend() == "numba":
+            psi, Phi, J = self._angles_compiled(rows, v, chi, w)
+        else:
+            psi, Phi, J = self.angles(rows, v, chi, w)
+        return self.ps._local(psi, Phi, self.tr[rows], self.pr[rows]), J
+
+    def _angles_compiled(self, rows, v, chi, w):
+        """:meth:`angles` compiled (:mod:`models.kernels.disc`, held to it)."""
+        from .kernels import disc
+
+        shape = np.broadcast_shapes((rows.size, 1), np.shape(v), np.shape(chi), np.shape(w))
+        v, chi, w = (np.ascontiguousarray(np.broadcast_to(a, shape), dtype=float) for a in (v, chi, w))
+        psi, Phi, J = np.empty(v.shape), np.empty(v.shape), np.empty(v.shape)
+        tan_c = self.tan_c[rows]
+        disc.points(self.k, self.h1, tan_c, np.hypot(1.0, tan_c), self.on_h[rows], self.ox[rows],
+                    self.xc[rows], v, chi, w, psi, Phi, J)  # fmt: skip
+        return psi, Phi, J
+
+    def angles(self, rows, v, chi, w):
+        """``(psi, Phi, J)`` at ``(v, chi)`` with quadrature weights ``w``: the local incidence,
+        polar and azimuth, and the irradiance weight ``J``, each ``(m, P)`` (per row up to a
+        constant: ``rho^2 t cos^3 psi / cos^3 psi_c w`` about the centre,
+        ``2 v rho^2 / (h (h + 1)) w`` about ``H``, ``h = hypot(1, k rho)``, scaled by the unit
+        disc's); the numpy reference of :mod:`models.kernels.disc`."""
         on_h = self.on_h[rows][:, None]
         ox = self.ox[rows][:, None]
         c, s = np.cos(chi), np.sin(chi)
@@ -658,8 +682,7 @@ class _Disc:
             x[sel], y[sel], J[sel] = _wedge(self.xc[rows][sel][:, None], self.k, vw, cw)
             J[sel] *= ww
             tan_psi[sel] = np.hypot(x[sel], y[sel])
-        M = self.ps._local(np.arctan(tan_psi), np.arctan2(y, x), self.tr[rows], self.pr[rows])
-        return M, J
+        return np.arctan(tan_psi), np.arctan2(y, x), J
 
     def cells(self, rows):
         """The cells of ``rows``: the disc cut at ``P*`` (or its point nearest ``P*``) into ``v``

@@ -29,8 +29,9 @@ changes to the file of the function itself).
 Only the entry points that Python calls are cached (``run``, ``run_parallel``,
 ``run_checked``, ``run_one`` and ``angles_ok`` of :mod:`~models.kernels.drive`, the first
 three of :mod:`~models.kernels.vector`, :mod:`~models.kernels.montecarlo`'s
-``_serial``, ``_parallel`` and ``exit_transmittance``, and :mod:`~models.kernels.aperture`'s
-``nodes`` and ``rotate_sum``); a cached entry holds the code of
+``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~models.kernels.aperture`'s
+``nodes`` and ``rotate_sum``, and :mod:`~models.kernels.disc`'s ``points``); a cached entry
+holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached
 function as object code, without the LLVM IR that inlining needs: an entry compiled in a
 process that had loaded its kernel from the cache called it instead of inlining it, which
