@@ -14,7 +14,9 @@ a cusp (exponential slopes 0.05).  The error is max |M - M_ref| over the element
 geometries over the peak M00_ref of the set, ``M_ref`` the new quadrature at ``tol = 1e-8``
 (its own estimate is printed); the M00 column is the same for M00 alone.  Rows: the old
 default (``resolution="auto"``, N = max(16, ceil(10 spread / width)) radial nodes); the new
-default (``tol = 1e-4``); the new at the old default's error as tolerance (at least 1e-7, ten
+default (``tol = 1e-4``); its floor, the inner model's own cost for as many evaluations
+(what any quadrature spending them costs at least: the old default over it bounds the
+speed-up the new default can reach at its accuracy); the new at the old default's error as tolerance (at least 1e-7, ten
 times the reference's); the old at the smallest fixed resolution that matches the new
 default's error (hand-tuned, no estimate), or 256.  The broad lobe is also shown at one
 incidence, 0.6 rad, where the source's foot lies off the sample (at 0 it is the sample's
@@ -108,6 +110,7 @@ def point_source_rows(old, inner, geo, repeat):
         acc = new.replace(tol=tol).accuracy(*geo)
         capped = f", {int(acc.capped.sum())} capped" if acc.capped.any() else ""
         rows.append((f"{label}: tol {tol:.1e}{capped}", t, f"{acc.evaluations.mean():.0f}", *err(M)))
+    rows.insert(2, floor(inner, geo, int(round(float(rows[1][2]))), repeat))
     target = rows[1][3]
     for N in (2, 4, 8, 16, 32, 64, 128, 256):
         M, t = timed(lambda N=N: old.PointSourceBRDF(model=inner, distance=DISTANCE, resolution=N), geo, 1)
@@ -116,6 +119,27 @@ def point_source_rows(old, inner, geo, repeat):
             rows.append((f"old fixed N={N} ({note})", t, f"{2 * N * N}", *err(M)))
             break
     return rows, float(np.max(ref.error)), int(ref.capped.sum())
+
+
+def floor(inner, geo, evaluations, repeat):
+    """The row of the floor under the new default: the inner model's own cost for its
+    ``evaluations`` per geometry (one call on that many random geometries at the same
+    incidences), what any quadrature spending them costs at least."""
+    n = geo[0].size
+    rng = np.random.default_rng(2)
+    big = (
+        np.repeat(geo[0], evaluations),
+        rng.uniform(0.0, 1.4, n * evaluations),
+        rng.uniform(-3, 3, n * evaluations),
+    )
+    t = best_of(lambda: inner._m16(*big), repeat)[0] / n * 1e6
+    return (
+        f"floor: the new default's {evaluations} inner evaluations alone",
+        t,
+        f"{evaluations}",
+        math.nan,
+        math.nan,
+    )
 
 
 def print_point_source(old, n, repeat):
@@ -135,7 +159,8 @@ def print_point_source(old, n, repeat):
         )
         print(head)
         for label, t, evals, e, e00 in rows:
-            print(f"  {label:58} {t:9.1f} {evals:>12} {e:8.1e} {e00:8.1e} {rows[0][1] / t:9.2f}")
+            errs = "" if math.isnan(e) else f"{e:8.1e} {e00:8.1e}"
+            print(f"  {label:58} {t:9.1f} {evals:>12} {errs:>17} {rows[0][1] / t:9.2f}")
 
 
 def print_aperture(old, n, repeat):
