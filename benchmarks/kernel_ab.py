@@ -1,12 +1,14 @@
 """The kernels before and after a change, measured in one run.
 
     git archive <old commit> | tar -x -C /tmp/base
-    python benchmarks/kernel_ab.py --base /tmp/base [--rounds 3] [--what small|geometry]
+    python benchmarks/kernel_ab.py --base /tmp/base [--rounds 3] [--what small|geometry|wrappers]
 
 Runs this checkout's :func:`benchmarks.kernel_speed.small_calls` (``--what small``, the
 default: every closed-form model's one-geometry and 100-geometry ``mueller`` calls, and the
 other input forms) or :func:`benchmarks.kernel_speed.per_geometry` (``--what geometry``: 10^6
-geometries, one thread and every core, a fresh result and into ``out=``) against the package
+geometries, one thread and every core, a fresh result and into ``out=``) or
+:func:`benchmarks.kernel_speed.wrapper_calls` (``--what wrappers``: PointSourceBRDF's default
+and DetectorAperture per geometry; no numpy column) against the package
 in ``--base`` and against this checkout's, alternating fresh processes for ``--rounds`` rounds
 so that both see the same machine load (on a shared machine figures drift by tens of percent
 over minutes), and prints the best of the rounds per case with the ratio.
@@ -31,6 +33,8 @@ spec.loader.exec_module(ks)
 import models
 if sys.argv[3] == "small":
     calls = ks.small_calls(int(sys.argv[1]))
+elif sys.argv[3] == "wrappers":
+    calls = ks.wrapper_calls(int(sys.argv[1]))
 else:
     calls = {f"{name}, {col}": (t[0], v) for name, t in ks.per_geometry(10**6, int(sys.argv[1])).items()
              for col, v in zip(ks.COLUMNS, t[1:])}
@@ -65,7 +69,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--base", required=True, help="a checkout of the older version")
     ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--what", choices=("small", "geometry"), default="small")
+    ap.add_argument("--what", choices=("small", "geometry", "wrappers"), default="small")
     args = ap.parse_args()
     best = {"before": {}, "after": {}}
     print(f"load {os.getloadavg()}")

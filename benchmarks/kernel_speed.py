@@ -123,6 +123,37 @@ def small_calls(repeat):
     return result
 
 
+def wrapper_calls(repeat):
+    """``{"wrapper, case": (nan, us per geometry)}``: PointSourceBRDF at its default (``tol =
+    1e-4``, d/R = 3) around a broad lobe, a narrow lobe and a cusp (``benchmarks/wrappers.py``'s
+    three inner models) at 50, 200 and 1000 geometries, and DetectorAperture (0.7 deg, 32
+    nodes) at 800, each call on a fresh instance (nothing cached), the best of ``repeat``."""
+    inners = {
+        "broad lobe": models.SubsurfaceFacetBRDF(slopes=models.GaussianSlopes(0.2)),
+        "narrow lobe": models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.01)),
+        "cusp": models.FacetBRDF(slopes=models.ExponentialSlopes(0.05)),
+    }
+    rng = np.random.default_rng(0)
+    result = {}
+
+    def case(label, make, n):
+        ti = np.repeat([0.0, 0.3, 0.6, 0.9], -(-n // 4))[:n]
+        geo = (ti, rng.uniform(0.0, 1.4, n), rng.uniform(-math.pi, math.pi, n))
+        make().mueller(*geo)
+        result[label] = (math.nan, 1e6 * best_of(lambda: make().mueller(*geo), repeat)[0] / n)
+
+    for name, inner in inners.items():
+        for n in (50, 200, 1000):
+            case(
+                f"PointSourceBRDF {name}, {n}",
+                lambda m=inner: models.PointSourceBRDF(model=m, distance=3.0),
+                n,
+            )
+    ap = dict(model=inners["broad lobe"], aperture=math.radians(0.7), resolution=4)
+    case("DetectorAperture, 800", lambda: models.DetectorAperture(**ap), 800)
+    return result
+
+
 def _per_call(fn, repeat):
     t = time.perf_counter()
     fn()
