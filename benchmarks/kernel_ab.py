@@ -88,7 +88,7 @@ def main():
             continue
         print(
             f"{case:<48} {before[1]:10.4g} {after[1]:10.4g} {before[1] / after[1]:6.2f}x   "
-            f"{before[0]:.0f} / {after[0]:.0f}"
+            + (f"{before[0]:.0f} / {after[0]:.0f}" if before[0] < float("inf") else "-")
         )
 
 
