@@ -1,6 +1,7 @@
 """PointSourceBRDF and DetectorAperture before and after (issues 12 and 13), in one run.
 
     python benchmarks/wrappers.py [--n 200] [--repeat 3]
+    python benchmarks/wrappers.py --blocks     # DetectorAperture's block size, 2^12 to 2^16
 
 "Before" is the code of commit a0b9da6 (``models/point_source.py`` and ``models/aperture.py``
 read with ``git show`` and loaded beside the current modules, on the same inner models and
@@ -180,11 +181,41 @@ def print_aperture(old, n, repeat):
     print(f"  max |new - old| / M00 = {diff:.1e}")
 
 
+def print_aperture_blocks(repeat):
+    """DetectorAperture's compiled route per geometry at each block size
+    (``models.aperture._BLOCK``, inner-model evaluations per call) from 2^12 to 2^16, at 800,
+    8000 and 80,000 geometries: the evidence for the block size chosen."""
+    import models.aperture as aperture
+
+    kw = dict(model=INNERS["broad lobe"], aperture=math.radians(0.7), resolution=4)
+    chosen = aperture._BLOCK
+    sizes = (800, 8000, 80000)
+    geos = [geometries(n, seed=1) for n in sizes]
+    print(f"DetectorAperture per geometry (us) by block size; the module's: 2^{chosen.bit_length() - 1}")
+    try:
+        for b in range(12, 17):
+            aperture._BLOCK = 1 << b
+            cells = []
+            for geo in geos:
+                models.DetectorAperture(**kw).mueller(*geo)
+                t = best_of(lambda geo=geo: models.DetectorAperture(**kw).mueller(*geo), max(5, 10 * repeat))[
+                    0
+                ]
+                cells.append(f"{1e6 * t / geo[0].size:7.3f}")
+            print(f"  2^{b}: " + "  ".join(f"n={n} {c}" for n, c in zip(sizes, cells, strict=True)))
+    finally:
+        aperture._BLOCK = chosen
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=200, help="geometries per case (default 200)")
     ap.add_argument("--repeat", type=int, default=3, help="timings per figure; the best is kept")
+    ap.add_argument("--blocks", action="store_true", help="DetectorAperture's block sizes only")
     args = ap.parse_args(argv)
+    if args.blocks:
+        print_aperture_blocks(args.repeat)
+        return
     old_ps, old_ap = baseline("point_source"), baseline("aperture")
     warnings.simplefilter("ignore", models.point_source.AccuracyWarning)  # capped counts are printed
     print(f"load average before: {os.getloadavg()[0]:.2f}")

@@ -48,7 +48,7 @@ from .polarization import mueller16_from_jones
 __all__ = ["DetectorAperture"]
 
 #: inner-model evaluations per block (bounds the temporaries of one block)
-_BLOCK = 1 << 16
+_BLOCK = 1 << 15
 
 
 @dataclass(frozen=True)
@@ -119,8 +119,9 @@ class DetectorAperture(_Wrapper):
     def _mueller16_compiled(self, ti, tr, pr):
         """:meth:`_mueller16` with the node algebra and the rotated sum compiled
         (:mod:`models.kernels.aperture`, held to the numpy route above), the inner model
-        evaluated once per block of :data:`_BLOCK` nodes (blocks of 2^12 to 2^16 measured
-        within 5% of each other)."""
+        evaluated once per block of :data:`_BLOCK` nodes (``python benchmarks/wrappers.py
+        --blocks``: blocks of 2^12 to 2^15 nodes alike, 1.7-2.5 us per geometry; 2^16, whose
+        16 result rows are 8 MB, 2.8-3.9 from 8000 geometries on)."""
         from .kernels import aperture as kernel
 
         a, b, cos_u, w = self._nodes

@@ -16,6 +16,8 @@ the right-handed ``p_r`` is ``-x cos(tr)cos(pr) - y cos(tr)sin(pr) + z sin(tr)``
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 __all__ = [
@@ -109,12 +111,22 @@ def broadcast_angles(*arrays):
     return shape, [np.ascontiguousarray(x).reshape(-1) for x in b]
 
 
+@functools.lru_cache(maxsize=64)
+def gauss_legendre(n):
+    """``numpy.polynomial.legendre.leggauss(n)``, computed once per ``n`` (read-only arrays):
+    it takes 140 us even for ``n = 4`` (an eigenvalue problem), which a wrapper built afresh
+    for every evaluation, as in a fit, paid on every call."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
+
+
 def polar_rule(n):
     """``(t, chi, w)``, flat: Gauss-Legendre in ``t`` on [0, 1] (``n`` nodes) times the periodic
     trapezoid rule in ``chi`` (``2 n`` nodes), ``w`` the product of their weights (no area
     element: ``sum w f ~ int_0^1 int_0^2pi f dchi dt``).  :func:`disc_quadrature` and the point
     source's polar cells build on it."""
-    x, wx = np.polynomial.legendre.leggauss(n)
+    x, wx = gauss_legendre(n)
     chi = (np.arange(2 * n) + 0.5) * (np.pi / n)
     return np.repeat(0.5 * (x + 1.0), 2 * n), np.tile(chi, n), np.repeat(0.5 * wx, 2 * n) * (np.pi / n)
 

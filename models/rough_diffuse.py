@@ -66,6 +66,7 @@ from . import evaluation, modelset
 from .base import Model
 from .facet import FacetBRDF
 from .facet_btdf import _dot, angle_basis, facet_transmission_jones, projected_area, ray_basis
+from .geometry import gauss_legendre
 from .params import choice_alias, convention_param, param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
@@ -269,7 +270,7 @@ class RoughDiffuseBRDF(Model):
         """R-bar of the rough interface: one minus the fraction of internal Lambertian light
         that leaves, ``(1/(pi n^2)) int <w_r T_out> cos(tr) dOmega_r`` (``u = cos tr``
         Gauss-Legendre, uniform azimuth; the flat limit is exact)."""
-        x, w = np.polynomial.legendre.leggauss(n_u)
+        x, w = gauss_legendre(n_u)
         u = 0.5 * (x + 1.0)
         wu = 0.5 * w
         phi = (np.arange(n_phi) + 0.5) * (2.0 * math.pi / n_phi)

@@ -60,6 +60,7 @@ from scipy import integrate
 
 from .cubature import AccuracyWarning
 from .fresnel import coating_cos, fresnel_reflectance
+from .geometry import gauss_legendre
 from .thin_film import FilmStack
 
 __all__ = [
@@ -203,7 +204,7 @@ def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> floa
     """
     n = stack.indices[1].real
     up = stack.upward()
-    x, w = np.polynomial.legendre.leggauss(16)
+    x, w = gauss_legendre(16)
 
     def estimate(panels):
         edges = np.linspace(0.0, 0.5 * math.pi, panels + 1)
