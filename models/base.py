@@ -37,6 +37,18 @@ def is_isotropic(model) -> bool:
     return model.rotated(1.0) is model
 
 
+def rotated_set(model, angles):
+    """``model.rotated(angles)`` as one model set of ``angles``' shape (an array), or ``None``
+    when the model's ``rotated`` takes a single angle only (a user's model may): callers then
+    rotate angle by angle."""
+    angles = np.asarray(angles, dtype=float)
+    try:
+        turned = model.rotated(angles)
+        return turned if turned.param_shape == angles.shape else None
+    except (TypeError, ValueError, AttributeError):
+        return None
+
+
 class Model(Declared):
     """Base class of every scattering model (BRDF in 1/sr).
 

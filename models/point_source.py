@@ -104,7 +104,7 @@ import numpy as np
 from scipy import signal
 
 from . import cubature, evaluation
-from .base import Model, _Wrapper, is_isotropic
+from .base import Model, _Wrapper, is_isotropic, rotated_set
 from .cubature import AccuracyWarning
 from .geometry import disc_quadrature, polar_rule
 from .params import param
@@ -401,12 +401,7 @@ class PointSourceBRDF(_Wrapper):
     def _rotates(self):
         """True when the local models can be evaluated in one call: an isotropic inner model, or
         one whose ``rotated`` takes an array of angles (a model set)."""
-        if self._isotropic:
-            return True
-        try:
-            return self.model.rotated(np.array([0.0, 1.0])).param_shape == (2,)
-        except (TypeError, ValueError, AttributeError):
-            return False
+        return self._isotropic or rotated_set(self.model, np.array([0.0, 1.0])) is not None
 
     def _local(self, psi, Phi, tr, pr):
         """The inner model's Mueller elements ``(16, m, P)`` at local incidences ``(psi, Phi)``

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.base import is_isotropic
+from models.base import is_isotropic, rotated_set
 from models.polarization import reciprocal_jones, reciprocal_mueller
 
 __all__ = [
@@ -62,7 +62,10 @@ def _reversed(model, ti, tr, pr, method):
     """Evaluate ``method`` ('mueller' or 'jones') on the reversed paths."""
     if is_isotropic(model):
         return getattr(model, method)(tr, ti, -pr)
-    out = None
+    turned = rotated_set(model, math.pi - pr)  # every geometry's sample turned, in one call
+    if turned is not None:
+        return getattr(turned, method)(tr, ti, -pr)
+    out = None  # a model whose rotated takes one angle: geometry by geometry
     for idx in np.ndindex(ti.shape):
         v = getattr(model.rotated(math.pi - float(pr[idx])), method)(tr[idx], ti[idx], -pr[idx])
         if out is None:
