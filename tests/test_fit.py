@@ -150,6 +150,39 @@ def test_a_brdf_only_fit_predicts_from_the_first_row_alone(coated, data):
         ("maxwell_beard_fit.toml", "scatmech_mb_measurement.csv"),
     ],
 )
+@pytest.mark.parametrize("walkers", [None, 1, 7])
+def test_the_likelihood_s_kernel_route_gives_the_models_bits(scene_file, data_file, walkers):
+    """The likelihood calls a compiled model's kernel at the fitted rows directly (their angles
+    validated and broadcast once per walker count): the Mueller matrices of
+    ``model.mueller16``, bit for bit, for a single model and for model sets of 1 and 7
+    walkers, on the first call and on the cached angles (a sum of models takes the general
+    route)."""
+    sc = scene.load(references.scene_path(scene_file))
+    lik = Likelihood(sc, fitspec_from(sc), subsample(load_data(references.data_path(data_file)), 60))
+    rng = np.random.default_rng(3)
+    b = lik.spec.u_bounds()
+    d = lik.data
+    for _ in range(2):
+        u = rng.uniform(b[:, 0], b[:, 1], (walkers or 1, len(b)))
+        if walkers is None:
+            model = lik.model(lik.spec.physical(u[0]))
+        else:
+            model = lik.model(lik.walkers(u)[0])
+        # a sum of models (the paint) has no kernel of its own: the general route
+        assert model._kernel_path() == (scene_file != "red_paint_fit.toml")
+        shape, M = lik._mueller16(model)
+        ref_shape, ref = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
+        assert shape == ref_shape and np.array_equal(M, ref)
+
+
+@pytest.mark.parametrize(
+    "scene_file, data_file",
+    [
+        ("aluminium_flakes_fit.toml", "scatmech_flake_measurement.csv"),
+        ("red_paint_fit.toml", "scatmech_paint_measurement.csv"),
+        ("maxwell_beard_fit.toml", "scatmech_mb_measurement.csv"),
+    ],
+)
 def test_batched_likelihood_equals_the_scene_rebuilt_per_walker(scene_file, data_file):
     """All walkers in one call (a model set bound to the scene's keys) give the ln L of the
     scene rebuilt and validated per walker, to 1e-12; a single position is a batch of one,
