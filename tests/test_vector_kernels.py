@@ -196,7 +196,8 @@ def test_atan2_within_two_ulp(scale):
 
 def test_only_the_entry_points_are_cached():
     """Every numba function of :mod:`models.kernels` but the entry points Python calls is
-    compiled without the on-disk cache (the rule and its reason: :mod:`models.kernels`)."""
+    compiled without the on-disk cache (the rule and its reason: :mod:`models.kernels`), and
+    every entry caches in :func:`models.kernels.cache_dir`."""
     import importlib
     import pkgutil
 
@@ -220,4 +221,7 @@ def test_only_the_entry_points_are_cached():
                 seen += 1
                 cached = type(fn._cache).__name__ != "NullCache"
                 assert cached == (attr in entries.get(name, ())), f"{name}.{attr} cached: {cached}"
+                if cached:  # in the package's cache directory, never beside the (read-only) package
+                    where = fn._cache._cache_path
+                    assert where.startswith(models.kernels.cache_dir()), f"{name}.{attr} caches in {where}"
     assert seen > 40

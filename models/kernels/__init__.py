@@ -117,9 +117,10 @@ def _caching_in(path):
 
 
 with _caching_in(cache_dir()):
-    # montecarlo: RoughDiffuseBRDF's Monte Carlo, which the model imports itself; aperture:
-    # DetectorAperture's node algebra, likewise
-    from . import aperture, drive, montecarlo, vector  # noqa: E402, F401  (decorated here, cached there)
+    # every module with a cached entry, those the models import themselves too (montecarlo:
+    # RoughDiffuseBRDF's Monte Carlo; aperture, disc: DetectorAperture's and PointSourceBRDF's
+    # node algebra): one first imported elsewhere would cache beside the package
+    from . import aperture, disc, drive, montecarlo, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
 def _mutable(x):
