@@ -14,7 +14,7 @@ from test_kernels import CONFIGS, _geometries
 
 import models
 from models.kernels import Compiled, drive, vector
-from models.kernels.vector_math import REDUCED_MAX, atan2, exp_neg, sincos, sqrt
+from models.kernels.vector_math import REDUCED_MAX, atan2, exp_neg, hypot, sincos, sqrt
 
 #: test_kernels' configurations, and Cook-Torrance under strokes (its azimuth's cosine and
 #: sine are parameter rows)
@@ -192,6 +192,29 @@ def test_atan2_within_two_ulp(scale):
     got = _atan2(y, x)
     assert _ulps(got[ref != 0], ref[ref != 0]) <= 2.0
     assert np.array_equal(np.signbit(got), np.signbit(ref)) and np.array_equal(got[ref == 0], ref[ref == 0])
+
+
+@njit
+def _hypot(x, y):
+    out = np.empty_like(x)
+    for i in range(x.size):
+        out[i] = hypot(x[i], y[i])
+    return out
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-300, 1e300])
+def test_hypot_within_two_ulp(scale):
+    """Any signs and ratios, from subnormal to huge arguments (whose squares overflow or
+    underflow unscaled), the axes and zero."""
+    rng = np.random.default_rng(12)
+    x = rng.uniform(-1.0, 1.0, 200_000) * scale * np.exp(rng.uniform(-30.0, 0.0, 200_000))
+    y = rng.uniform(-1.0, 1.0, x.size) * scale
+    x = np.concatenate([x, [0.0, -0.0, 1e-320, 3.0, 0.0]])
+    y = np.concatenate([y, [0.0, 2.0, 0.0, -4.0, -1e308]])
+    ref = np.hypot(x, y)
+    got = _hypot(x, y)
+    assert np.all(np.isfinite(got)) and _ulps(got[ref != 0], ref[ref != 0]) <= 2.0
+    assert np.array_equal(got[ref == 0], ref[ref == 0])
 
 
 def test_only_the_entry_points_are_cached():

@@ -8,9 +8,9 @@ A geometry's points all lie in one of the three coordinate systems of
 centre, or the wedge of rays from ``H``), so the choice is made once per geometry and the
 loop over its points has no branch and no C library call
 (:mod:`~models.kernels.vector_math`'s sines, cosines and arctangents, the ``sqrt``
-intrinsic): LLVM runs it on SIMD lanes.  The hypotenuses are scaled by a power of two, as
-the C library's ``hypot``, because the disc's radius over the source's height, ``k``, reaches
-1e300 (and ``1 / k`` with it).
+intrinsic): LLVM runs it on SIMD lanes.  The hypotenuses are
+:func:`~models.kernels.vector_math.hypot`'s, scaled, because the disc's radius over the
+source's height, ``k``, reaches 1e300 (and ``1 / k`` with it).
 """
 
 from __future__ import annotations
@@ -20,20 +20,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .vector_math import atan2, inverse_binade, sincos, sqrt
+from .vector_math import atan2, hypot, sincos, sqrt
 
 _TWO_PI = 2.0 * math.pi
-
-
-@njit(error_model="numpy", inline="always")
-def _hypot(x, y):
-    """``hypot(x, y)`` without overflow or underflow: both scaled by the power of two that
-    brings the larger near 1 (exact), within about an ulp of the C library's."""
-    ax, ay = abs(x), abs(y)
-    hi, lo = max(ax, ay), min(ax, ay)
-    scale = inverse_binade(hi if hi > 0.0 else 1.0)
-    a, b = hi * scale, lo * scale
-    return sqrt(a * a + b * b) / scale
 
 
 @njit(error_model="numpy", inline="always")
@@ -52,13 +41,13 @@ def _polar(k, h1, tan_c, sec_c, about_h, ox, v, chi, w):
     os_ = ox * s
     rho = sqrt(max(1.0 - os_ * os_, 0.0)) - ox * c
     krho = k * rho
-    h = _hypot(1.0, krho)
+    h = hypot(1.0, krho)
     t = _t_of_v(v, h, krho) if about_h else v
     r = rho * t
     x = tan_c + k * (ox + r * c)
     y = k * r * s
-    tan_psi = _hypot(x, y)
-    cos_ratio = sec_c / _hypot(1.0, tan_psi)
+    tan_psi = hypot(x, y)
+    cos_ratio = sec_c / hypot(1.0, tan_psi)
     j = 2.0 * v * (h1 / h) * ((h1 + 1.0) / (h + 1.0)) if about_h else t * (cos_ratio * cos_ratio * cos_ratio)
     return atan2(tan_psi, 1.0), atan2(y, x), w * rho * rho * j
 
@@ -78,13 +67,13 @@ def _wedge(k, xc, u, alpha, w):
     cc = sqrt(1.0 - sc * sc)
     r_f = xc * cc + cp
     r_n = (xc - 1.0) * (xc + 1.0) / r_f if r_f > 0.0 else 0.0
-    h_n, h_f = _hypot(1.0, k * r_n), _hypot(1.0, k * r_f)
+    h_n, h_f = hypot(1.0, k * r_n), hypot(1.0, k * r_f)
     g = (1.0 - u) * _share(r_n, h_n) + u * _share(r_f, h_f)
     a = (1.0 - u) / h_n + u / h_f
     r = sqrt(g * (1.0 + a)) / a
     x, y = k * r * cc, k * r * sc
     j = 2.0 * cp * cp / (h_n * h_f * (h_n + h_f))
-    return atan2(_hypot(x, y), 1.0), atan2(y, x), j * w
+    return atan2(hypot(x, y), 1.0), atan2(y, x), j * w
 
 
 @njit(cache=True, error_model="numpy")
