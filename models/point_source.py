@@ -608,6 +608,7 @@ class _Disc:
         self.k = min(ps.sample_radius / ps.distance, 1e300)
         self.h1 = math.hypot(1.0, self.k)
         self.tan_c = np.tan(ti)  # H to C, in units of d
+        self.sec_c = np.hypot(1.0, self.tan_c)  # 1 / cos psi_c
         xc = _over(self.tan_c, self.k)  # H to C, in units of R
         self.on_h = xc < 1.0
         self.ox = np.where(self.on_h, -xc, 0.0)  # O from C
@@ -646,8 +647,7 @@ class _Disc:
         shape = np.broadcast_shapes((rows.size, 1), np.shape(v), np.shape(chi), np.shape(w))
         v, chi, w = (np.ascontiguousarray(np.broadcast_to(a, shape), dtype=float) for a in (v, chi, w))
         psi, Phi, J = np.empty(v.shape), np.empty(v.shape), np.empty(v.shape)
-        tan_c = self.tan_c[rows]
-        disc.points(self.k, self.h1, tan_c, np.hypot(1.0, tan_c), self.on_h[rows], self.ox[rows],
+        disc.points(self.k, self.h1, self.tan_c[rows], self.sec_c[rows], self.on_h[rows], self.ox[rows],
                     self.xc[rows], v, chi, w, psi, Phi, J)  # fmt: skip
         return psi, Phi, J
 
@@ -668,7 +668,7 @@ class _Disc:
         x = tan_c + self.k * (ox + r * c)  # from H, units of d
         y = self.k * r * s
         tan_psi = np.hypot(x, y)
-        cos_ratio = np.hypot(1.0, tan_c) / np.hypot(1.0, tan_psi)  # cos psi / cos psi_c
+        cos_ratio = self.sec_c[rows][:, None] / np.hypot(1.0, tan_psi)  # cos psi / cos psi_c
         J = np.where(on_h, 2.0 * v * (self.h1 / h) * ((self.h1 + 1.0) / (h + 1.0)), t * cos_ratio**3)
         J = w * rho * rho * J
         sel = self.wedge[rows]

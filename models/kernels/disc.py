@@ -88,13 +88,9 @@ def points(k, h1, tan_c, sec_c, on_h, ox, xc, v, chi, w, psi, phi, jac):
         if not math.isnan(xc[i]):
             for j in range(P):
                 psi[i, j], phi[i, j], jac[i, j] = _wedge(k, xc[i], v[i, j], chi[i, j], w[i, j])
-        elif on_h[i]:
-            for j in range(P):
-                psi[i, j], phi[i, j], jac[i, j] = _polar(
-                    k, h1, tan_c[i], sec_c[i], True, ox[i], v[i, j], chi[i, j], w[i, j]
-                )
-        else:
-            for j in range(P):
-                psi[i, j], phi[i, j], jac[i, j] = _polar(
-                    k, h1, tan_c[i], sec_c[i], False, ox[i], v[i, j], chi[i, j], w[i, j]
-                )
+            continue
+        about_h = on_h[i]  # the same for the geometry's points: the loop's select folds away
+        for j in range(P):
+            psi[i, j], phi[i, j], jac[i, j] = _polar(
+                k, h1, tan_c[i], sec_c[i], about_h, ox[i], v[i, j], chi[i, j], w[i, j]
+            )
