@@ -35,6 +35,7 @@ __all__ = [
     "CHUNK",
     "KERNEL_CHUNK",
     "Plan",
+    "FixedAngles",
     "small_angles",
     "as_matrices",
     "float32_guarded",
@@ -248,6 +249,34 @@ class Plan:
             if self.leaves:
                 model = with_leaves(model, dict(zip(self.leaves, parts[3:], strict=True)))
             yield slice(start, stop), parts[0], parts[1], parts[2], model
+
+
+class FixedAngles:
+    """Angles at which many models are evaluated, one after another (a fit's rows, each
+    likelihood evaluation a new model set of the walkers): :meth:`mueller16` is
+    ``model.mueller16`` at them.  For a compiled model whose geometries fit in one chunk, the
+    angles are validated and broadcast once per broadcast shape and handed to its kernel as
+    :class:`Plan`'s single chunk hands them: the same flat inputs and the same kernel, so
+    the same bits, without the validation and broadcasting a :class:`Plan` repeats per call."""
+
+    def __init__(self, theta_i, theta_r, phi_r):
+        self.angles = (theta_i, theta_r, phi_r)
+        self._flat = {}  # broadcast shape: the three angles, flat
+
+    def mueller16(self, model):
+        """``(shape, M)``: ``model.mueller16`` at the angles."""
+        if not model._kernel_path():
+            return model.mueller16(*self.angles)
+        leaves = model._sets
+        shape = np.broadcast_shapes(*(np.shape(a) for a in self.angles), *(v.shape for v in leaves.values()))
+        if math.prod(shape) > KERNEL_CHUNK:
+            return model.mueller16(*self.angles)
+        flat = self._flat.get(shape)
+        if flat is None:
+            flat = self._flat[shape] = [_whole(a, shape) for a in checked_angles(model, *self.angles)]
+        if leaves:
+            model = with_leaves(model, {k: _whole(v, shape) for k, v in leaves.items()})
+        return shape, model._m16(*flat)
 
 
 def _whole(a, shape):

@@ -152,8 +152,9 @@ def test_a_brdf_only_fit_predicts_from_the_first_row_alone(coated, data):
 )
 @pytest.mark.parametrize("walkers", [None, 1, 7])
 def test_the_likelihood_s_kernel_route_gives_the_models_bits(scene_file, data_file, walkers):
-    """The likelihood calls a compiled model's kernel at the fitted rows directly (their angles
-    validated and broadcast once per walker count): the Mueller matrices of
+    """The likelihood calls a compiled model's kernel at the fitted rows directly
+    (models.evaluation.FixedAngles: their angles validated and broadcast once per walker
+    count): the Mueller matrices of
     ``model.mueller16``, bit for bit, for a single model and for model sets of 1 and 7
     walkers, on the first call and on the cached angles (a sum of models takes the general
     route)."""
@@ -170,7 +171,7 @@ def test_the_likelihood_s_kernel_route_gives_the_models_bits(scene_file, data_fi
             model = lik.model(lik.walkers(u)[0])
         # a sum of models (the paint) has no kernel of its own: the general route
         assert model._kernel_path() == (scene_file != "red_paint_fit.toml")
-        shape, M = lik._mueller16(model)
+        shape, M = lik._rows.mueller16(model)
         ref_shape, ref = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
         assert shape == ref_shape and np.array_equal(M, ref)
 

@@ -32,7 +32,6 @@ import math
 import numpy as np
 
 from models import evaluation
-from models.modelset import with_leaves
 from models.polarization import ellipsometric, wrap_axis
 from models.scene import binding
 
@@ -81,12 +80,6 @@ def replicate(pred: dict, variances: dict, rng) -> dict:
 _LOG2PI = math.log(2.0 * math.pi)
 
 
-def _flat(a, shape):
-    """``a`` broadcast to ``shape``, flat and contiguous (as :class:`models.evaluation.Plan`
-    hands a chunk's inputs to the kernels)."""
-    return np.ascontiguousarray(np.broadcast_to(a, shape)).reshape(-1)
-
-
 def scene_for_data(scene, data):
     """``scene`` with the detector aperture of ``data``'s sidecar, when it records one
     (the instrument that took the data decides, not the scene's default)."""
@@ -122,7 +115,8 @@ class Likelihood:
         d = self.data
         self._log_obs = np.log(d.brdf)
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
-        self._flat_angles = {}  # the fitted rows' angles, flat, per broadcast shape
+        # the fitted rows, evaluated for every walker of every step: validated once
+        self._rows = evaluation.FixedAngles(d.theta_i, d.theta_r, d.phi_r)
         self.terms = _terms(spec, d)
         self.n_points = len(d)
         # Whether the point source and the aperture matter (and the aperture's quadrature) is
@@ -153,7 +147,9 @@ class Likelihood:
         (default: all four); for ``("brdf",)``, a BRDF-only fit, only the BRDF, from the
         Mueller matrix's first row (no polarization state)."""
         d = self.data if data is None else data
-        shape, M = self._mueller16(model) if data is None else model.mueller16(d.theta_i, d.theta_r, d.phi_r)
+        shape, M = (
+            self._rows.mueller16(model) if data is None else model.mueller16(d.theta_i, d.theta_r, d.phi_r)
+        )
         M = M.reshape((4, 4) + shape)
         if terms == ("brdf",):
             M = M[:1]
@@ -169,26 +165,6 @@ class Likelihood:
             return {"brdf": S[0] / d.incident[:, 0]}
         i, eta, pc, p = ellipsometric(np.moveaxis(S, 0, -1))
         return {"brdf": i / d.incident[:, 0], "eta": eta, "P": p, "P_C": pc}
-
-    def _mueller16(self, model):
-        """``model.mueller16`` at the fitted rows.  For a compiled model or model set whose
-        geometries fit in one chunk, the kernel is called as that route calls it (the same
-        flat inputs, the same kernel: the same bits) without what it repeats on every call:
-        the data's angles are validated and broadcast once per shape (the walkers' count)."""
-        d = self.data
-        if not model._kernel_path():
-            return model.mueller16(d.theta_i, d.theta_r, d.phi_r)
-        leaves = model._sets
-        shape = np.broadcast_shapes(d.theta_i.shape, *(v.shape for v in leaves.values()))
-        if math.prod(shape) > evaluation.KERNEL_CHUNK:
-            return model.mueller16(d.theta_i, d.theta_r, d.phi_r)
-        angles = self._flat_angles.get(shape)
-        if angles is None:
-            checked = evaluation.checked_angles(model, d.theta_i, d.theta_r, d.phi_r)
-            angles = self._flat_angles[shape] = [_flat(a, shape) for a in checked]
-        if leaves:
-            model = with_leaves(model, {k: _flat(v, shape) for k, v in leaves.items()})
-        return shape, model._m16(*angles)
 
     # -- likelihood ----------------------------------------------------------------
     def _variances(self, noise):
