@@ -127,7 +127,9 @@ def wrapper_calls(repeat):
     """``{"wrapper, case": (nan, us per geometry)}``: PointSourceBRDF at its default (``tol =
     1e-4``, d/R = 3) around a broad lobe, a narrow lobe and a cusp (``benchmarks/wrappers.py``'s
     three inner models) at 50, 200 and 1000 geometries, and DetectorAperture (0.7 deg, 32
-    nodes) at 800, each call on a fresh instance (nothing cached), the best of ``repeat``."""
+    nodes) at 800, each call on a fresh instance (nothing cached), the best of ``repeat``.
+    The models are restated here, not imported: ``kernel_ab.py`` runs this file inside the
+    older checkout, whose ``benchmarks/wrappers.py`` may differ or be absent."""
     inners = {
         "broad lobe": models.SubsurfaceFacetBRDF(slopes=models.GaussianSlopes(0.2)),
         "narrow lobe": models.CookTorranceBRDF(slopes=models.GaussianSlopes(0.01)),

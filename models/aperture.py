@@ -120,8 +120,8 @@ class DetectorAperture(_Wrapper):
         """:meth:`_mueller16` with the node algebra and the rotated sum compiled
         (:mod:`models.kernels.aperture`, held to the numpy route above), the inner model
         evaluated once per block of :data:`_BLOCK` nodes (``python benchmarks/wrappers.py
-        --blocks``: blocks of 2^12 to 2^15 nodes alike, 1.7-2.5 us per geometry; 2^16, whose
-        16 result rows are 8 MB, 2.8-3.9 from 8000 geometries on)."""
+        --blocks``, one run: blocks of 2^12 to 2^15 nodes alike, 1.7-2.5 us per geometry; 2^16,
+        whose 16 result rows are 8 MB, 2.8-3.3 from 8000 geometries on)."""
         from .kernels import aperture as kernel
 
         a, b, cos_u, w = self._nodes
