@@ -170,10 +170,11 @@ def test_sincos_and_exp_within_two_ulp(span):
 
 
 @njit
-def _atan2(y, x):
-    out = np.empty_like(x)
-    for i in range(x.size):
-        out[i] = atan2(y[i], x[i])
+def _each(f, a, b):
+    """``f(a[i], b[i])`` for every ``i``: a kernel helper of two arguments over arrays."""
+    out = np.empty_like(a)
+    for i in range(a.size):
+        out[i] = f(a[i], b[i])
     return out
 
 
@@ -189,17 +190,9 @@ def test_atan2_within_two_ulp(scale):
     x = np.concatenate([x, seam / math.tan(math.pi / 8) * (1 + rng.uniform(-1e-9, 1e-9, seam.size)), -seam,
                         [0.0, -0.0, 1e-320, -1e-320], [0.0, 0.0, -0.0, -0.0]])  # fmt: skip
     ref = np.arctan2(y, x)
-    got = _atan2(y, x)
+    got = _each(atan2, y, x)
     assert _ulps(got[ref != 0], ref[ref != 0]) <= 2.0
     assert np.array_equal(np.signbit(got), np.signbit(ref)) and np.array_equal(got[ref == 0], ref[ref == 0])
-
-
-@njit
-def _hypot(x, y):
-    out = np.empty_like(x)
-    for i in range(x.size):
-        out[i] = hypot(x[i], y[i])
-    return out
 
 
 @pytest.mark.parametrize("scale", [1.0, 1e-300, 1e300])
@@ -212,7 +205,7 @@ def test_hypot_within_two_ulp(scale):
     x = np.concatenate([x, [0.0, -0.0, 1e-320, 3.0, 0.0]])
     y = np.concatenate([y, [0.0, 2.0, 0.0, -4.0, -1e308]])
     ref = np.hypot(x, y)
-    got = _hypot(x, y)
+    got = _each(hypot, x, y)
     assert np.all(np.isfinite(got)) and _ulps(got[ref != 0], ref[ref != 0]) <= 2.0
     assert np.array_equal(got[ref == 0], ref[ref == 0])
 
