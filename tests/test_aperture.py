@@ -154,3 +154,16 @@ def test_double_angle_of_nodes_near_and_on_the_normal():
     c2, s2 = _double_angle_scaled(c, s)
     np.testing.assert_allclose(c2, [-7 / 25, 1.0, 1.0, 1.0], rtol=1e-15)
     np.testing.assert_allclose(s2, [24 / 25, 0.0, 0.0, 0.0], rtol=1e-15, atol=0)
+
+
+def test_the_quadrature_rule_is_shared_and_read_only():
+    """Apertures of one size and resolution share one rule (a fit builds the aperture afresh
+    for every evaluation), which no caller can alter; other sizes get their own."""
+    kw = dict(model=FACET, aperture=math.radians(0.7), resolution=4)
+    a, b = models.DetectorAperture(**kw)._nodes, models.DetectorAperture(**kw)._nodes
+    assert all(x is y for x, y in zip(a, b, strict=True))
+    assert not any(x.flags.writeable for x in a)
+    with pytest.raises(ValueError):
+        a[3][0] = 0.0
+    other = models.DetectorAperture(**{**kw, "aperture": math.radians(2.0)})._nodes
+    assert not np.array_equal(other[0], a[0])
