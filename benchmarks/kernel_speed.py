@@ -127,7 +127,7 @@ def wrapper_calls(repeat):
     """``{"wrapper, case": (nan, us per geometry)}``: PointSourceBRDF at its default (``tol =
     1e-4``, d/R = 3) around a broad lobe, a narrow lobe and a cusp (``benchmarks/wrappers.py``'s
     three inner models) at 50, 200 and 1000 geometries, and DetectorAperture (0.7 deg, 32
-    nodes) at 800, each call on a fresh instance (nothing cached), the best of ``repeat``.
+    nodes) at 1, 50 and 800, each call on a fresh instance (nothing cached), the best of ``repeat``.
     The models are restated here, not imported: ``kernel_ab.py`` runs this file inside the
     older checkout, whose ``benchmarks/wrappers.py`` may differ or be absent."""
     inners = {
@@ -152,7 +152,8 @@ def wrapper_calls(repeat):
                 n,
             )
     ap = dict(model=inners["broad lobe"], aperture=math.radians(0.7), resolution=4)
-    case("DetectorAperture, 800", lambda: models.DetectorAperture(**ap), 800)
+    for n in (1, 50, 800):  # a fit's fresh aperture per evaluation: the small calls show its set-up
+        case(f"DetectorAperture, {n}", lambda: models.DetectorAperture(**ap), n)
     return result
 
 
