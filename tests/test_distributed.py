@@ -18,7 +18,15 @@ from models.params import param
 from validation.cli import main
 from validation.fitting.compare import compare_fits
 from validation.fitting.datafile import load_data
-from validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor, _chunks
+from validation.fitting.executors import (
+    DaskExecutor,
+    ProcessExecutor,
+    SerialExecutor,
+    _chunks,
+    _dask_kernel_threads,
+    _local_cores,
+    kernel_threads,
+)
 from validation.fitting.fitspec import fitspec_from
 from validation.fitting.likelihood import Likelihood
 from validation.fitting.recovery import recovery_study, subsample
@@ -56,6 +64,36 @@ def test_chunks_keep_order_and_cover_every_item():
 def test_map_one_task_per_item_keeps_order(cluster):
     assert cluster.map(abs, [-3, 1, -2, 5, -8], tasks=5) == [3, 1, 2, 5, 8]
     assert SerialExecutor().map(abs, [-1, 2], tasks=2) == [1, 2]
+
+
+def _kernel_threads_here(_):
+    import numba
+
+    return numba.get_num_threads()
+
+
+def test_workers_share_the_cores_among_their_kernel_threads(cluster):
+    """Each worker runs the compiled kernels on its share of its machine's cores: left at numba's
+    default (a thread per core), two workers on two cores ran the full report's model
+    comparison 3.8x slower than with one thread each (benchmarks/comparison_workers.py)."""
+    share = max(1, _local_cores() // 2)
+    with ProcessExecutor(2) as ex:
+        assert ex.map(_kernel_threads_here, [0, 1], tasks=2) == [kernel_threads(2)] * 2 == [share] * 2
+    # the cluster: two single-threaded workers on this machine
+    assert cluster.map(_kernel_threads_here, [0, 1], tasks=2) == [share] * 2
+    assert kernel_threads(1) == _local_cores() and kernel_threads(10**6) == 1
+
+
+def test_dask_workers_split_their_host_s_cores():
+    """Per host, its cores over all the task threads of its workers there; at least one."""
+    info = {
+        "a": {"host": "h1", "nthreads": 2},
+        "b": {"host": "h1", "nthreads": 2},
+        "c": {"host": "h2", "nthreads": 1},
+        "d": {"host": "h3", "nthreads": 8},
+    }
+    cores = {"a": 16, "b": 16, "c": 6, "d": 4}
+    assert _dask_kernel_threads(info, cores) == {"a": 4, "b": 4, "c": 6, "d": 1}
 
 
 def test_recovery_members_identical_on_a_cluster(setup, cluster):
