@@ -237,11 +237,19 @@ def comparison_settings(quick):
     )
 
 
+def _comparison(quick):
+    from validation.fitting.compare import seed003_pairing
+    from validation.fitting.executors import make_executor
+
+    # the full run's 8 fits on both cores: 63.1 s in-process, 34.3 s on 2 workers
+    # (benchmarks/comparison_workers.py); the quick run's take seconds, less than starting workers
+    with make_executor(1 if quick else 2, None) as ex:  # identical results on any executor (tested)
+        return seed003_pairing(**comparison_settings(quick), executor=ex)
+
+
 def comparison_cases(ctx):
     """:func:`validation.fitting.compare.seed003_pairing` with the run's settings, once per run."""
-    from validation.fitting.compare import seed003_pairing
-
-    return ctx.compute(seed003_pairing, **comparison_settings(ctx.quick))
+    return ctx.compute(_comparison, ctx.quick)
 
 
 def comparison_margins(cases):
