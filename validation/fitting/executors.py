@@ -85,8 +85,8 @@ def _worker_init(threads):
     a traceback.  Its compiled kernels run on ``threads`` threads (:func:`kernel_threads`):
     left at numba's default, every worker starts one per core, and the workers' threads then
     wait on each other (the full report's model comparison, 8 fits on 2 workers on 2 cores,
-    ``python benchmarks/comparison_workers.py --baseline <d6f7214>``: 129.9 s so, against
-    63.1 s in-process and 34.3 s with one thread per worker)."""
+    ``python benchmarks/comparison_workers.py --baseline <d6f7214>``: 129.9 s with a thread
+    per core in each, against 63.1 s in-process and 34.3 s with one thread per worker)."""
     import signal
 
     import numba
