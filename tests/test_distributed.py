@@ -72,16 +72,30 @@ def _kernel_threads_here(_):
     return numba.get_num_threads()
 
 
-def test_workers_share_the_cores_among_their_kernel_threads(cluster):
-    """Each worker runs the compiled kernels on its share of its machine's cores: left at numba's
-    default (a thread per core), two workers on two cores ran the full report's model
-    comparison 3.8x slower than with one thread each (benchmarks/comparison_workers.py)."""
+def _blas_threads_here(_):
+    from threadpoolctl import threadpool_info
+
+    return sorted({p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"})
+
+
+def test_local_workers_share_the_cores_among_their_threads(monkeypatch):
+    """Each local worker runs the compiled kernels and BLAS on its share of its machine's cores:
+    left at numba's default (a thread per core), two workers on two cores ran the full
+    report's model comparison 3.8x slower than with one thread each; left at BLAS's, the
+    stability sweep on two workers took 25.2 s against 10.1 s in-process
+    (benchmarks/study_workers.py)."""
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        monkeypatch.delenv(var, raising=False)  # the workers' own limits, not inherited ones
     share = max(1, _local_cores() // 2)
     with ProcessExecutor(2) as ex:
         assert ex.map(_kernel_threads_here, [0, 1], tasks=2) == [kernel_threads(2)] * 2 == [share] * 2
-    # the cluster: two single-threaded workers on this machine
-    assert cluster.map(_kernel_threads_here, [0, 1], tasks=2) == [share] * 2
+        assert ex.map(_blas_threads_here, [0, 1], tasks=2) == [[share]] * 2  # numpy's and scipy's
     assert kernel_threads(1) == _local_cores() and kernel_threads(10**6) == 1
+
+
+def test_dask_workers_share_their_host_s_cores_among_their_kernel_threads(cluster):
+    """The cluster: two single-threaded workers on this machine, a share of its cores each."""
+    assert cluster.map(_kernel_threads_here, [0, 1], tasks=2) == [max(1, _local_cores() // 2)] * 2
 
 
 def test_dask_workers_split_their_host_s_cores():

@@ -242,7 +242,7 @@ def _comparison(quick):
     from validation.fitting.executors import make_executor
 
     # the full run's 8 fits on both cores: 63.1 s in-process, 34.3 s on 2 workers
-    # (benchmarks/comparison_workers.py); the quick run's take seconds, less than starting workers
+    # (benchmarks/study_workers.py); the quick run's take seconds, less than starting workers
     with make_executor(1 if quick else 2, None) as ex:  # identical results on any executor (tested)
         return seed003_pairing(**comparison_settings(quick), executor=ex)
 

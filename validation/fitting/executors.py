@@ -85,14 +85,19 @@ def _worker_init(threads):
     a traceback.  Its compiled kernels run on ``threads`` threads (:func:`kernel_threads`):
     left at numba's default, every worker starts one per core, and the workers' threads then
     wait on each other (the full report's model comparison, 8 fits on 2 workers on 2 cores,
-    ``python benchmarks/comparison_workers.py --baseline <d6f7214>``: 129.9 s with a thread
+    ``python benchmarks/study_workers.py --baseline <d6f7214>``: 129.9 s with a thread
     per core in each, against 63.1 s in-process and 34.3 s with one thread per worker)."""
     import signal
 
     import numba
+    import scipy.linalg  # noqa: F401  (loads scipy's own BLAS now, so that the limit covers it)
+    from threadpoolctl import threadpool_limits
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    # BLAS's threads spin between calls: the workers' small eigenvalue and least-squares
+    # problems then kept the other workers' cores busy
+    threadpool_limits(limits=threads)
 
 
 def _run_pickled_chunk(key, blob, chunk):

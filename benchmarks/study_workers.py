@@ -1,0 +1,99 @@
+"""The full report's model comparison (or the stability sweep) in-process and on local worker
+processes, in one run.
+
+    python benchmarks/study_workers.py [--study comparison|sweep] [--workers 1 2] [--baseline DIR]
+
+``comparison`` (the default) runs :func:`validation.fitting.compare.seed003_pairing` with the
+full report's settings (:func:`validation.checks.fitting.comparison_settings`: 8 fits, 24
+walkers, differential evolution to N >= 50 tau); ``sweep`` runs the full stability sweep
+(:func:`validation.studies.stability.sweep`, energy integrals included: ~300 small tasks).
+Each ``--workers`` value runs in a fresh process, and prints the seconds and a digest of the
+results (every fit's chain and table row; every finding): the digests must be equal (the
+results do not depend on the executor).  ``--baseline DIR``: another checkout (e.g. ``git
+archive <commit> | tar -x -C DIR``) run the same way, alternating with this one, for
+before/after figures.  A tree never run before compiles its kernels in its first run (numba's
+cache is keyed by the source files' paths): ``--warm`` runs each tree once in-process,
+untimed, first.  The machine's load is printed before and after: figures from a shared
+machine are noisy.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# run inside the checkout given as argv[1]; a __main__ guard, since workers are spawned
+CHILD = r"""
+import hashlib, sys, time
+sys.path.insert(0, sys.argv[1])
+
+def comparison(ex):
+    from validation.checks.fitting import comparison_settings
+    from validation.fitting.compare import seed003_pairing
+
+    h = hashlib.sha1()
+    for c in seed003_pairing(**comparison_settings(False), executor=ex):
+        for f in c["fits"]:
+            h.update(f.chain.chain.tobytes())
+        h.update(repr(c["rows"]).encode())
+    return h
+
+def sweep(ex):
+    from validation.studies.stability import sweep
+
+    return hashlib.sha1(repr(sweep(energy=True, executor=ex)).encode())
+
+def main():
+    from validation.fitting.executors import make_executor
+
+    t = time.perf_counter()
+    with make_executor(int(sys.argv[2]), None) as ex:
+        h = {"comparison": comparison, "sweep": sweep}[sys.argv[3]](ex)
+    print(f"{time.perf_counter() - t:.1f} {h.hexdigest()[:16]}")
+
+if __name__ == "__main__":
+    main()
+"""
+
+
+def timed(checkout, workers, study):
+    """``(seconds, digest)`` of ``study`` from ``checkout`` on ``workers`` processes."""
+    r = subprocess.run(
+        [sys.executable, "-c", CHILD, checkout, str(workers), study],
+        capture_output=True,
+        text=True,
+        cwd=checkout,
+    )
+    if r.returncode != 0:
+        raise RuntimeError(f"{checkout}, workers {workers}: exit {r.returncode}\n{r.stderr}")
+    seconds, digest = r.stdout.split()[-2:]
+    return float(seconds), digest
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--study", choices=("comparison", "sweep"), default="comparison")
+    ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--baseline", help="another checkout, run the same way for before/after figures")
+    ap.add_argument("--warm", action="store_true", help="run each tree once, untimed, first")
+    args = ap.parse_args()
+    trees = [("this checkout", ROOT)] + ([("baseline", args.baseline)] if args.baseline else [])
+    for _, tree in trees if args.warm else ():
+        timed(tree, 1, args.study)
+    print(f"load before: {os.getloadavg()}")
+    digests = set()
+    for w in args.workers:
+        for name, tree in trees:
+            seconds, digest = timed(tree, w, args.study)
+            digests.add(digest)
+            print(f"{name:<14} workers {w}: {seconds:7.1f} s  digest {digest}")
+    print("results identical across executors and checkouts" if len(digests) == 1 else "RESULTS DIFFER")
+    print(f"load after: {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()
