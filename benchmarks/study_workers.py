@@ -1,12 +1,15 @@
-"""The full report's model comparison (or the stability sweep) in-process and on local worker
-processes, in one run.
+"""Studies of the full report (the model comparison, the stability sweep, the recovery) in-process
+and on local worker processes, in one run.
 
-    python benchmarks/study_workers.py [--study comparison|sweep] [--workers 1 2] [--baseline DIR]
+    python benchmarks/study_workers.py [--study comparison|sweep|recovery] [--workers 1 2]
+                                      [--baseline DIR] [--warm]
 
 ``comparison`` (the default) runs :func:`validation.fitting.compare.seed003_pairing` with the
 full report's settings (:func:`validation.checks.fitting.comparison_settings`: 8 fits, 24
 walkers, differential evolution to N >= 50 tau); ``sweep`` runs the full stability sweep
-(:func:`validation.studies.stability.sweep`, energy integrals included: ~300 small tasks).
+(:func:`validation.studies.stability.sweep`, energy integrals included: ~300 small tasks);
+``recovery`` the full report's injection-recovery study (100 small fits to N >= 50 tau; a
+tree whose study cannot be given an executor is refused).
 Each ``--workers`` value runs in a fresh process, and prints the seconds and a digest of the
 results (every fit's chain and table row; every finding): the digests must be equal (the
 results do not depend on the executor).  ``--baseline DIR``: another checkout (e.g. ``git
@@ -47,12 +50,21 @@ def sweep(ex):
 
     return hashlib.sha1(repr(sweep(energy=True, executor=ex)).encode())
 
+def recovery(ex):
+    import inspect
+    from validation.checks.fitting import _recovery
+    from validation.checks.registry import SEED
+
+    if "executor" not in inspect.signature(_recovery).parameters:
+        raise SystemExit("this tree's recovery study runs on its own executor only")
+    return hashlib.sha1(repr(_recovery(False, SEED, ex)).encode())
+
 def main():
     from validation.fitting.executors import make_executor
 
     t = time.perf_counter()
     with make_executor(int(sys.argv[2]), None) as ex:
-        h = {"comparison": comparison, "sweep": sweep}[sys.argv[3]](ex)
+        h = {"comparison": comparison, "sweep": sweep, "recovery": recovery}[sys.argv[3]](ex)
     print(f"{time.perf_counter() - t:.1f} {h.hexdigest()[:16]}")
 
 if __name__ == "__main__":
@@ -76,7 +88,7 @@ def timed(checkout, workers, study):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--study", choices=("comparison", "sweep"), default="comparison")
+    ap.add_argument("--study", choices=("comparison", "sweep", "recovery"), default="comparison")
     ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--baseline", help="another checkout, run the same way for before/after figures")
     ap.add_argument("--warm", action="store_true", help="run each tree once, untimed, first")

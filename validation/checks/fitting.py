@@ -168,7 +168,8 @@ def recovery_settings(quick, seed=0):
     )
 
 
-def _recovery(quick, seed):
+def _recovery(quick, seed, executor=None):
+    """The recovery study of the run (on ``executor``, default: :func:`recovery_settings`' workers)."""
     from models import scene as scene_mod
     from validation.fitting.datafile import load_data
     from validation.fitting.executors import make_executor
@@ -179,7 +180,8 @@ def _recovery(quick, seed):
     sc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
     spec = fitspec_from(sc, rs["free"], rs["noise"])
     data = load_data(references.data_path(RECOVERY_DATA))
-    with make_executor(rs.get("workers", 1), None) as ex:  # identical results on any executor (tested)
+    own = make_executor(rs.get("workers", 1), None) if executor is None else contextlib.nullcontext(executor)
+    with own as ex:  # identical results on any executor (tested)
         return recovery_study(
             sc,
             spec,
