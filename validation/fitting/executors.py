@@ -17,9 +17,10 @@ and however the items are grouped.
 * :class:`DaskExecutor`: a ``dask.distributed`` cluster (``--scheduler ADDRESS``,
   or a ``Client``/``LocalCluster`` object in tests).
 
-Workers share their machine's cores: each runs the compiled kernels on its share of them
-(:func:`kernel_threads`), not on one thread per core as numba would, so that workers on one
-machine do not start more threads than it has cores.  The thread count changes no result.
+Workers share their machine's cores: each runs the compiled kernels, BLAS and OpenMP on its
+share of them (:func:`kernel_threads`, :func:`_share_cores`), not on one thread per core as
+each library would, so that workers on one machine do not start more threads than it has
+cores.  The thread count changes no result.
 """
 
 from __future__ import annotations
@@ -79,25 +80,42 @@ def kernel_threads(workers: int) -> int:
     return max(1, _local_cores() // workers)
 
 
+_LIMITED = None  # the BLAS/OpenMP thread limit this process applied (see _share_cores)
+
+
+def _share_cores(threads):
+    """Run this thread's compiled kernels, and this process's BLAS and OpenMP, on ``threads``
+    threads: a worker's share of its machine's cores (:func:`kernel_threads`).
+
+    Left at their defaults, every worker starts a thread per core and the workers' threads
+    then wait on each other (the full report's model comparison, 8 fits on 2 workers on 2
+    cores, ``python benchmarks/study_workers.py --baseline <d6f7214>``: 129.9 s with a
+    kernel thread per core in each, against 63.1 s in-process and 34.3 s with one); BLAS's
+    threads also spin between calls, so the workers' small eigenvalue and least-squares
+    problems kept the other workers' cores busy (the stability sweep on 2 workers, ``--study
+    sweep``: 25.2 s against 10.1 s in-process; 8.6 s with BLAS limited too).  numba's count is
+    per thread (a Dask worker's task threads each set theirs); the BLAS limit is per process
+    and applied once."""
+    global _LIMITED
+    import numba
+
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    if _LIMITED != threads:
+        import scipy.linalg  # noqa: F401  (loads scipy's own BLAS now, so that the limit covers it)
+        from threadpoolctl import threadpool_limits
+
+        threadpool_limits(limits=threads)
+        _LIMITED = threads
+
+
 def _worker_init(threads):
-    """A local worker's set-up.  It leaves Ctrl-C to the parent (which stops the pool and says
-    how to resume): the terminal sends it to every process of the group, and each would print
-    a traceback.  Its compiled kernels run on ``threads`` threads (:func:`kernel_threads`):
-    left at numba's default, every worker starts one per core, and the workers' threads then
-    wait on each other (the full report's model comparison, 8 fits on 2 workers on 2 cores,
-    ``python benchmarks/study_workers.py --baseline <d6f7214>``: 129.9 s with a thread
-    per core in each, against 63.1 s in-process and 34.3 s with one thread per worker)."""
+    """A local worker's set-up: it leaves Ctrl-C to the parent (which stops the pool and says
+    how to resume: the terminal sends it to every process of the group, and each would print
+    a traceback) and runs on its share of the cores (:func:`_share_cores`)."""
     import signal
 
-    import numba
-    import scipy.linalg  # noqa: F401  (loads scipy's own BLAS now, so that the limit covers it)
-    from threadpoolctl import threadpool_limits
-
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    # BLAS's threads spin between calls: the workers' small eigenvalue and least-squares
-    # problems then kept the other workers' cores busy
-    threadpool_limits(limits=threads)
+    _share_cores(threads)
 
 
 def _run_pickled_chunk(key, blob, chunk):
@@ -244,13 +262,11 @@ def _dask_kernel_threads(info, cores):
 
 
 def _run_chunk_dask(fn, chunk, threads):
-    """A chunk on a Dask worker, its kernels on the worker's share of its host's cores (one
-    thread for a worker that joined after the executor was made)."""
-    import numba
+    """A chunk on a Dask worker, on the worker's share of its host's cores (:func:`_share_cores`;
+    one thread for a worker that joined after the executor was made)."""
     from dask.distributed import get_worker
 
-    n = threads.get(get_worker().address, 1)
-    numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))  # this task's thread only
+    _share_cores(threads.get(get_worker().address, 1))
     return _run_chunk(fn, chunk)
 
 
