@@ -12,7 +12,7 @@ walkers, differential evolution to N >= 50 tau); ``sweep`` runs the full stabili
 tree whose study cannot be given an executor is refused).
 Each ``--workers`` value runs in a fresh process, and prints the seconds and a digest of the
 results (every fit's chain and table row; every finding): the digests must be equal (the
-results do not depend on the executor).  ``--baseline DIR``: another checkout (e.g. ``git
+results do not depend on the executor), and the command exits 1 when they are not.  ``--baseline DIR``: another checkout (e.g. ``git
 archive <commit> | tar -x -C DIR``) run the same way, alternating with this one, for
 before/after figures.  A tree never run before compiles its kernels in its first run (numba's
 cache is keyed by the source files' paths): ``--warm`` runs each tree once in-process,
@@ -103,8 +103,10 @@ def main():
             seconds, digest = timed(tree, w, args.study)
             digests.add(digest)
             print(f"{name:<14} workers {w}: {seconds:7.1f} s  digest {digest}")
-    print("results identical across executors and checkouts" if len(digests) == 1 else "RESULTS DIFFER")
     print(f"load after: {os.getloadavg()}")
+    if len(digests) != 1:
+        sys.exit("RESULTS DIFFER between executors or checkouts: the results must not depend on them")
+    print("results identical across executors and checkouts")
 
 
 if __name__ == "__main__":
