@@ -12,9 +12,9 @@ walkers, differential evolution to N >= 50 tau); ``sweep`` runs the full stabili
 tree whose study cannot be given an executor is refused).
 Each ``--workers`` value runs in a fresh process, and prints the seconds and a digest of the
 results (every fit's chain and table row; every finding): the digests must be equal (the
-results do not depend on the executor), and the command exits 1 when they are not.  ``--baseline DIR``: another checkout (e.g. ``git
-archive <commit> | tar -x -C DIR``) run the same way, alternating with this one, for
-before/after figures.  A tree never run before compiles its kernels in its first run (numba's
+results do not depend on the executor), and the command exits 1 when they are not.
+``--baseline DIR``: another checkout (e.g. ``git archive <commit> | tar -x -C DIR``) run the
+same way, alternating with this one, for before/after figures.  A tree never run before compiles its kernels in its first run (numba's
 cache is keyed by the source files' paths): ``--warm`` runs each tree once in-process,
 untimed, first.  The machine's load is printed before and after: figures from a shared
 machine are noisy.
