@@ -1,6 +1,7 @@
 """RoughDiffuseBRDF's compiled Monte Carlo (models/kernels/montecarlo.py): held to the
 numpy reference within 1e-12 relative to M00, and both held to the numbers the model gave
-at a0b9da6, before it was compiled (tests/data/rough_diffuse_a0b9da6.npz)."""
+at a0b9da6, before it was compiled (tests/data/rough_diffuse_a0b9da6.npz), within the same
+1e-12 (bit for bit only where numpy's vectorized functions round as where they were saved)."""
 
 import importlib.util
 import math
@@ -41,11 +42,12 @@ def test_same_numbers_as_before_the_kernel(name, backend):
         M, E = m.mueller_with_error(*(curve if name == "carc" else scattered))
         got_rbar = m._rbar
     if backend == "numpy":
-        # the same code: identical volume terms (the surface term, when added, was the
-        # FacetBRDF kernel's then and is FacetBRDF's numpy reference here)
-        assert np.array_equal(E, err) and got_rbar == rbar
-        if not m.surface:
-            assert np.array_equal(M, mean)
+        # the same code, but not the same bits on every machine: numpy dispatches its
+        # vectorized exp, sin and cos by the CPU's SIMD instructions, and they round
+        # differently (an AMD EPYC with AVX2 and numpy 2.4 here: up to 5e-15 of the largest
+        # error off the saved numbers); R-bar, a quadrature of scalar calls, is identical.
+        # Both paths are held to REL below.
+        assert got_rbar == rbar
     else:
         assert abs(got_rbar - rbar) <= REL * rbar
     assert_within_m00(M, mean, mean[..., 0, 0])

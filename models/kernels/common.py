@@ -95,10 +95,13 @@ def csqrt(a, b):
     if a == T(0.0) and b == T(0.0):
         return T(0.0), T(0.0)
     # |a|, |b| are index-sized (up to |n + ik|^2 ~ 3.3e32): their squares overflow float32 from
-    # 1.8e19 and underflow below 1.1e-19 (float64 only near INDEX_MIN); scaled by the larger,
-    # r (hence t) stays finite and nonzero there
+    # 1.8e19 and underflow below 1.1e-19; scaled by the larger, r (hence t) stays finite and
+    # nonzero there.  float64 (1e-300 > 0, a constant per precision) holds the squares
+    # unscaled: below 1e-154 they underflow, and t is then off by at most sqrt(2) at a size
+    # (< 1e-77) that moves no Fresnel coefficient; without the scaled branch the loops that
+    # use csqrt stay within LLVM's vectorization cost model (Cook-Torrance, LLVM 22)
     s = max(abs(a), abs(b))
-    if T(1.0e-19) < s < T(1.0e19):
+    if T(1e-300) > T(0.0) or T(1.0e-19) < s < T(1.0e19):
         r = sqrt(a * a + b * b)
     else:
         a_s, b_s = a / s, b / s

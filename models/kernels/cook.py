@@ -35,13 +35,30 @@ def fresnel_average(c, mr, mi, pec):
     """Natural-light reflectance ``(|r_s|^2 + |r_p|^2) / 2`` at cosine ``c`` for relative index
     ``mr + i mi`` (:func:`models.cook_torrance.fresnel_average`)."""
     T = type(c)
+    if T(1e-300) > T(0.0):
+        # float64: the perfect conductor and m = 1 (whose denominators vanish at grazing) are
+        # selects after the arithmetic, not early returns, and |r|^2 is |numerator|^2 /
+        # |denominator|^2 (squares of index-sized values, < 1e66, fit): two real divisions
+        # instead of two complex ones whose branches a vector loop computes both of.  With
+        # the returns or those divisions LLVM 22's cost model (numba 0.68) kept the
+        # Cook-Torrance loops scalar: 1.9-2.5x slower per geometry (benchmarks/kernel_ab.py
+        # --what geometry against the branching form).
+        m2r, m2i, wr, wi = refraction_w(c, mr, mi)
+        ar, ai = m2r * c, m2i * c
+        rs2 = ((c - wr) * (c - wr) + wi * wi) / ((c + wr) * (c + wr) + wi * wi)
+        rp2 = ((ar - wr) * (ar - wr) + (ai - wi) * (ai - wi)) / (
+            (ar + wr) * (ar + wr) + (ai + wi) * (ai + wi)
+        )
+        unit = mr == T(1.0) and mi == T(0.0)
+        return T(1.0) if pec else (T(0.0) if unit else T(0.5) * (rs2 + rp2))
     if pec:
         return T(1.0)
     if mr == T(1.0) and mi == T(0.0):
         return T(0.0)
+    # float32: those squares overflow from 1.8e19; Smith's division scales them
     m2r, m2i, wr, wi = refraction_w(c, mr, mi)
-    rsr, rsi = cdiv(c - wr, -wi, c + wr, wi)
     ar, ai = m2r * c, m2i * c
+    rsr, rsi = cdiv(c - wr, -wi, c + wr, wi)
     rpr, rpi = cdiv(ar - wr, ai - wi, ar + wr, ai + wi)
     return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
 
@@ -92,10 +109,8 @@ def cook(geo, p, o):
     cii, cri = coating_cos(ci, nv), coating_cos(cr, nv)
     sii, sri = internal_sine(cii, si, nv), internal_sine(cri, sr, nv)
     val = ct_value(cii, sii, cri, sri, cp, sp, p, sub_r / nv, sub_i / nv, o[2])
-    if nv != T(1.0):
-        val *= dielectric_transmittance(ci, nv) * dielectric_transmittance(cr, nv)
-    if o[1] == 0:
-        val *= T(1.0) / (ci * cr)
-    else:
-        val *= T(1.0 / (4.0 * math.pi)) / (nv * nv * cii * cri)
-    return diag16(val)
+    # both factors computed, then selected (no branch: the loop stays on SIMD lanes)
+    film = dielectric_transmittance(ci, nv) * dielectric_transmittance(cr, nv)
+    val *= film if nv != T(1.0) else T(1.0)
+    paper, corrected = T(1.0) / (ci * cr), T(1.0 / (4.0 * math.pi)) / (nv * nv * cii * cri)
+    return diag16(val * (paper if o[1] == 0 else corrected))
