@@ -1,18 +1,32 @@
-"""Build hook: record the git commit of the checkout a wheel is built from.
+"""Build hooks: the package list of the one namespace, and the git commit of the checkout.
 
-``pip install .`` copies the package into site-packages, where ``git`` can no
-longer say which commit the code came from; the report's provenance reads the
-commit written here (``validation/_build_commit.txt``) instead.  Everything else
-about the build is declared in pyproject.toml.
+* ``scatterbench`` maps its subpackages onto the repository's top-level folders
+  (pyproject.toml's package-dir): every folder with an ``__init__.py`` under ``models/``,
+  ``validation/`` and ``references/`` is ``scatterbench.<its dotted path>``, found here so
+  that a new subpackage cannot be left out of the wheel.
+* ``pip install .`` copies the package into site-packages, where ``git`` can no
+  longer say which commit the code came from; the report's provenance reads the
+  commit written here (``scatterbench/validation/_build_commit.txt``) instead.
+
+Everything else about the build is declared in pyproject.toml.
 """
 
 import importlib.util
 import os
 
-from setuptools import setup
+from setuptools import find_packages, setup
 from setuptools.command.build_py import build_py
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+FOLDERS = ("models", "validation", "references")
+
+
+def _packages():
+    out = ["scatterbench"]
+    for top in FOLDERS:
+        out += [f"scatterbench.{top}"]
+        out += [f"scatterbench.{top}.{sub}" for sub in find_packages(os.path.join(HERE, top))]
+    return out
 
 
 def _provenance():
@@ -31,10 +45,10 @@ class BuildPyWithCommit(build_py):
         super().run()
         commit = _provenance().describe(HERE)
         if commit and not self.dry_run:
-            target = os.path.join(self.build_lib, "validation", "_build_commit.txt")
+            target = os.path.join(self.build_lib, "scatterbench", "validation", "_build_commit.txt")
             os.makedirs(os.path.dirname(target), exist_ok=True)
             with open(target, "w") as fh:
                 fh.write(commit + "\n")
 
 
-setup(cmdclass={"build_py": BuildPyWithCommit})
+setup(packages=_packages(), cmdclass={"build_py": BuildPyWithCommit})

@@ -3,7 +3,7 @@ distribution Gaussian enough for nominal coverage, independent of any sampler?
 
 For each cell (number of geometries x speckle level) this simulates ``--injections`` data sets
 from the coated-flake scene at its values (seeded), finds the least-squares optimum of sigma and
-the coating index (:func:`validation.fitting.sampling.optimize`) and counts how often the truth lies
+the coating index (:func:`scatterbench.validation.fitting.sampling.optimize`) and counts how often the truth lies
 within 1 and 2 Gauss-Newton standard deviations (sampling coordinates).  Cheap (~10 ms an
 injection), so thousands of injections pin coverage to a few tenths of a percent, far tighter
 than the 50-injection MCMC recovery study can; the study's own ``curvature`` columns are the same
@@ -26,13 +26,13 @@ import time
 
 import numpy as np
 
-import references
-from models import scene
-from validation.fitting.datafile import load_data
-from validation.fitting.fitspec import fitspec_from
-from validation.fitting.likelihood import Likelihood
-from validation.fitting.recovery import simulate, subsample
-from validation.fitting.sampling import optimize
+from scatterbench import references
+from scatterbench.models import scene
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.recovery import simulate, subsample
+from scatterbench.validation.fitting.sampling import optimize
 
 
 def main(argv=None):

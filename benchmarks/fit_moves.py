@@ -3,12 +3,12 @@
     python benchmarks/fit_moves.py [--max-steps 12000]
 
 Runs the report's full seed 003 model comparison
-(:func:`validation.checks.fitting.comparison_settings`) once with emcee's stretch move and
+(:func:`scatterbench.validation.checks.fitting.comparison_settings`) once with emcee's stretch move and
 once with the differential-evolution mixture (``ChainSettings.moves``), the same seed and
 step budget, and prints per fit the final ``max tau``, the steps run, whether ``N >= 50
 tau`` was reached, and each run's time.  It is why the report's comparison uses ``"de"``.
 
-The figures cited in :func:`validation.checks.fitting.comparison_settings` come from::
+The figures cited in :func:`scatterbench.validation.checks.fitting.comparison_settings` come from::
 
     python benchmarks/fit_moves.py --max-steps 2000
 
@@ -28,8 +28,8 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import argparse
 import time
 
-from validation.checks.fitting import comparison_settings
-from validation.fitting.compare import seed003_pairing
+from scatterbench.validation.checks.fitting import comparison_settings
+from scatterbench.validation.fitting.compare import seed003_pairing
 
 
 def run(moves, max_steps):

@@ -26,6 +26,9 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+from benchmarks.checkouts import environment  # noqa: E402
+
 SOURCE = os.path.join(ROOT, "references", "data", "scatmech_flake_measurement.csv")
 SCENE = os.path.join(ROOT, "references", "scenes", "aluminium_flakes_clearcoat.toml")
 COLUMNS = ("theta_i_deg", "theta_r_deg", "phi_r_deg", "brdf", "incident")
@@ -56,12 +59,17 @@ def write_data(folder, rows=110):
 
 def run(checkout, data, out, workers, seed):
     """Run ``scatterbench fit`` from ``checkout``: ``(seconds, evaluations/s, stop line, executor)``."""
+    cli = (
+        "scatterbench.validation.cli"
+        if os.path.isdir(os.path.join(checkout, "namespace"))
+        else "validation.cli"
+    )
     cmd = [
-        sys.executable, "-m", "validation.cli", "fit", data, "--scene", SCENE,
+        sys.executable, "-m", cli, "fit", data, "--scene", SCENE,
         "--free", "sigma:0.01:1:log", "--free", "coating:1.2:2", "--noise", "brdf=0.05",
         "--out", out, "--force", "--no-progress", "--workers", str(workers), "--seed", str(seed),
     ]  # fmt: skip
-    env = dict(os.environ, PYTHONPATH=checkout)
+    env = environment(checkout)
     t = time.perf_counter()
     r = subprocess.run(cmd, cwd=checkout, env=env, capture_output=True, text=True)
     seconds = time.perf_counter() - t

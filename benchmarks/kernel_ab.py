@@ -24,13 +24,19 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, HERE)
+from benchmarks.checkouts import IMPORT_MODELS, environment  # noqa: E402
+
 # kernel_speed puts its own checkout first on sys.path: run a copy of it inside each tree
-CHILD = r"""
+CHILD = (
+    r"""
 import importlib.util, json, sys
 spec = importlib.util.spec_from_file_location("ks", sys.argv[2])
 ks = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(ks)
-import models
+"""
+    + IMPORT_MODELS
+    + r"""
 if sys.argv[3] == "small":
     calls = ks.small_calls(int(sys.argv[1]))
 elif sys.argv[3] == "wrappers":
@@ -40,6 +46,7 @@ else:
              for col, v in zip(ks.COLUMNS, t[1:])}
 print(json.dumps({"models": models.__file__, "calls": calls}))
 """
+)
 
 
 def measure(root, repeat, what):
@@ -47,7 +54,7 @@ def measure(root, repeat, what):
     copy = os.path.join(root, "benchmarks", "_kernel_ab_copy.py")
     shutil.copy(os.path.join(HERE, "benchmarks", "kernel_speed.py"), copy)
     try:
-        env = dict(os.environ, PYTHONPATH=root)
+        env = environment(root)
         r = subprocess.run(
             [sys.executable, "-c", CHILD, str(repeat), copy, what],
             env=env,
@@ -60,8 +67,9 @@ def measure(root, repeat, what):
     if r.returncode:
         raise SystemExit(r.stderr)
     data = json.loads(r.stdout.strip().splitlines()[-1])
-    if not data["models"].startswith(os.path.realpath(root)):
-        raise SystemExit(f"measured {data['models']}, not the package in {root}")
+    where = env.get("PYTHONPATH") or os.path.realpath(root)
+    if not os.path.realpath(data["models"]).startswith(os.path.realpath(where)):
+        raise SystemExit(f"measured {data['models']}, not the package of {root}")
     return data["calls"]
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 import sys
 
-# the checkout's packages, not an installed copy, when run as ``python benchmarks/...``
+# the checkout's benchmarks (``benchmarks.speed``) when run as ``python benchmarks/...``
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 import argparse
@@ -31,10 +31,16 @@ import time
 import numba
 import numpy as np
 
-import models
 from benchmarks.speed import best_of
-from validation.checks.common import random_geometries
-from validation.studies.tradeoff import precision_error
+
+try:
+    from scatterbench import models
+    from scatterbench.validation.checks.common import random_geometries
+    from scatterbench.validation.studies.tradeoff import precision_error
+except ImportError:  # benchmarks/kernel_ab.py runs this file in a checkout from before the namespace
+    import models
+    from validation.checks.common import random_geometries
+    from validation.studies.tradeoff import precision_error
 
 AL = 1.37 + 7.62j
 MODELS = {
@@ -48,7 +54,8 @@ MODELS = {
     "MaxwellBeardBRDF": lambda: models.MaxwellBeardBRDF(polarized=True),
 }
 FIRST_CALL = (
-    "import time; t = time.perf_counter(); import models; "
+    "import time; t = time.perf_counter()\n"
+    f"{'from scatterbench import models' if models.__name__.startswith('scatterbench') else 'import models'}\n"
     "models.SubsurfaceFacetBRDF().mueller(0.5, 0.6, 0.1); print(time.perf_counter() - t)"
 )
 
@@ -166,7 +173,7 @@ def _per_call(fn, repeat):
 
 def float32(n, repeat):
     """``(float64 us, float32 us, error)`` per geometry, SubsurfaceFacetBRDF; the error is
-    the precision knob's (:func:`validation.studies.tradeoff.precision_error`)."""
+    the precision knob's (:func:`scatterbench.validation.studies.tradeoff.precision_error`)."""
     m = models.SubsurfaceFacetBRDF()
     ti, tr, pr = geometries(n)
     m.mueller(ti[:10], tr[:10], pr[:10], precision="float32")
@@ -179,7 +186,8 @@ def float32(n, repeat):
 def first_call():
     """``(cold s, warm s)``: a fresh interpreter's import + first call, cache empty then filled."""
     with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=os.path.dirname(os.path.dirname(__file__)))
+        # the same package as this process's (sys.path[0] is a checkout from before the namespace)
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=os.pathsep.join(sys.path))
         runs = [
             subprocess.run([sys.executable, "-c", FIRST_CALL], env=env, capture_output=True, text=True)
             for _ in "cw"

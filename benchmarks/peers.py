@@ -27,7 +27,7 @@ For every pair two figures on each side: *per call*, one geometry per call
 geometry*, ``--n`` geometries in one call for the array implementations (scatterbench,
 Mitsuba's LLVM variants) or a Python loop over ``--loop`` of them for the one-geometry
 APIs.  Each is the best CPU time over short batches after a warm-up call
-(:func:`validation.studies.tradeoff.time_call`, >= 0.2 s of work), with the best wall
+(:func:`scatterbench.validation.studies.tradeoff.time_call`, >= 0.2 s of work), with the best wall
 time beside it; scatterbench evaluates in float64, SCATMECH in double, Mitsuba in
 float32.  Mitsuba is timed from direction vectors already in its arrays (its input),
 scatterbench from angles.  Every row also states how far the two implementations'
@@ -58,10 +58,10 @@ from importlib import metadata
 import numba
 import numpy as np
 
-import models
-from models.geometry import incident_direction, scattered_direction
-from validation.checks.common import random_geometries
-from validation.studies.tradeoff import time_call
+from scatterbench import models
+from scatterbench.models.geometry import incident_direction, scattered_direction
+from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.studies.tradeoff import time_call
 
 DEFAULT_OUT = os.path.join(
     os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "references", "data", "peer_timings.json"
@@ -374,7 +374,7 @@ def main(argv=None):
     for s in skipped:
         print(f"skipped: {s}")
     if not args.no_save:
-        from validation.atomic import atomic_write_json
+        from scatterbench.validation.atomic import atomic_write_json
 
         machine["load_average_at_end"] = os.getloadavg()
         atomic_write_json(args.out, {

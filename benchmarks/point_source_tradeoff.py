@@ -25,8 +25,8 @@ import numpy as np
 
 # Use the models of the checkout this script lives in (not an installed copy).
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-import models  # noqa: E402
-from validation.checks.seed001 import energy_published  # noqa: E402
+from scatterbench import models  # noqa: E402
+from scatterbench.validation.checks.seed001 import energy_published  # noqa: E402
 
 
 def _timed(fn, repeat=1):

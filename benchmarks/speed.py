@@ -22,8 +22,8 @@ import time
 
 import numpy as np
 
-import models
-from validation.checks.table1 import compute_table1
+from scatterbench import models
+from scatterbench.validation.checks.table1 import compute_table1
 
 QUOTED_US = {"Facet (compiled SCATMECH, quoted)": 0.5, "Subsurface facet (compiled SCATMECH, quoted)": 5.2}
 

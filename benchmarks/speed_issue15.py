@@ -23,10 +23,10 @@ import math
 
 import numpy as np
 
-import models
 from benchmarks.speed import best_of
-from models.shadowing import LambdaTable
-from models.thin_film import FilmStack
+from scatterbench import models
+from scatterbench.models.shadowing import LambdaTable
+from scatterbench.models.thin_film import FilmStack
 
 N = 100_000
 

@@ -29,7 +29,7 @@ import time
 
 import numpy as np
 
-import models
+from scatterbench import models
 
 QUOTED_US = {"diffuse": 11.0, "single": 9.5}
 

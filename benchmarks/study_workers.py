@@ -4,10 +4,10 @@ and on local worker processes, in one run.
     python benchmarks/study_workers.py [--study comparison|sweep|recovery] [--workers 1 2]
                                       [--baseline DIR] [--warm]
 
-``comparison`` (the default) runs :func:`validation.fitting.compare.seed003_pairing` with the
-full report's settings (:func:`validation.checks.fitting.comparison_settings`: 8 fits, 24
+``comparison`` (the default) runs :func:`scatterbench.validation.fitting.compare.seed003_pairing` with the
+full report's settings (:func:`scatterbench.validation.checks.fitting.comparison_settings`: 8 fits, 24
 walkers, differential evolution to N >= 50 tau); ``sweep`` runs the full stability sweep
-(:func:`validation.studies.stability.sweep`, energy integrals included: ~300 small tasks);
+(:func:`scatterbench.validation.studies.stability.sweep`, energy integrals included: ~300 small tasks);
 ``recovery`` the full report's injection-recovery study (100 small fits to N >= 50 tau; a
 tree whose study cannot be given an executor is refused).
 Each ``--workers`` value runs in a fresh process, and prints the seconds and a digest of the
@@ -28,15 +28,22 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+from benchmarks.checkouts import environment  # noqa: E402
 
 # run inside the checkout given as argv[1]; a __main__ guard, since workers are spawned
 CHILD = r"""
-import hashlib, sys, time
-sys.path.insert(0, sys.argv[1])
+import hashlib, importlib, sys, time
+
+def mod(name):
+    try:
+        return importlib.import_module("scatterbench." + name)
+    except ImportError:  # a checkout from before the one namespace
+        return importlib.import_module(name)
 
 def comparison(ex):
-    from validation.checks.fitting import comparison_settings
-    from validation.fitting.compare import seed003_pairing
+    comparison_settings = mod("validation.checks.fitting").comparison_settings
+    seed003_pairing = mod("validation.fitting.compare").seed003_pairing
 
     h = hashlib.sha1()
     for c in seed003_pairing(**comparison_settings(False), executor=ex):
@@ -46,21 +53,20 @@ def comparison(ex):
     return h
 
 def sweep(ex):
-    from validation.studies.stability import sweep
-
+    sweep = mod("validation.studies.stability").sweep
     return hashlib.sha1(repr(sweep(energy=True, executor=ex)).encode())
 
 def recovery(ex):
     import inspect
-    from validation.checks.fitting import _recovery
-    from validation.checks.registry import SEED
+    _recovery = mod("validation.checks.fitting")._recovery
+    SEED = mod("validation.checks.registry").SEED
 
     if "executor" not in inspect.signature(_recovery).parameters:
         raise SystemExit("this tree's recovery study runs on its own executor only")
     return hashlib.sha1(repr(_recovery(False, SEED, ex)).encode())
 
 def main():
-    from validation.fitting.executors import make_executor
+    make_executor = mod("validation.fitting.executors").make_executor
 
     t = time.perf_counter()
     with make_executor(int(sys.argv[2]), None) as ex:
@@ -76,6 +82,7 @@ def timed(checkout, workers, study):
     """``(seconds, digest)`` of ``study`` from ``checkout`` on ``workers`` processes."""
     r = subprocess.run(
         [sys.executable, "-c", CHILD, checkout, str(workers), study],
+        env=environment(checkout),
         capture_output=True,
         text=True,
         cwd=checkout,

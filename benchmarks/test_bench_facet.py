@@ -9,8 +9,8 @@ import math
 
 from conftest import per_geometry
 
-import models
-from validation.checks.table1 import compute_table1
+from scatterbench import models
+from scatterbench.validation.checks.table1 import compute_table1
 
 
 def test_subsurface_facet_mueller_1e6(benchmark, geometries_1e6):

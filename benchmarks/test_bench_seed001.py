@@ -12,7 +12,7 @@ import math
 import numpy as np
 from conftest import per_geometry
 
-import models
+from scatterbench import models
 
 
 def test_cook_torrance_brdf_1e6(benchmark, geometries_1e6):

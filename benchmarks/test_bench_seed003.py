@@ -12,7 +12,7 @@ import math
 import numpy as np
 from conftest import per_geometry
 
-import models
+from scatterbench import models
 
 
 def test_diffuse_subsurface_mueller_1e6(benchmark, geometries_1e6):

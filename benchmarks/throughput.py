@@ -29,15 +29,10 @@ up to ``--heavy-max-exp`` (default 5; 7 takes minutes to tens of minutes each).
 
 from __future__ import annotations
 
-import os
-import sys
-
-# the checkout's packages, not an installed copy, when run as ``python benchmarks/...``
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
 import argparse
 import json
 import subprocess
+import sys
 
 #: a streamed run's allowed growth over the process baseline (issue 12), MB
 BOUND_MB = 50.0
@@ -46,9 +41,9 @@ HEAVY = {"RoughDiffuseBRDF", "PointSourceBRDF", "DetectorAperture"}
 CHILD = r"""
 import json, math, os, resource, sys, time
 import numpy as np
-import models
+from scatterbench import models
 name, n, what = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-from validation.studies.stability import _BASES
+from scatterbench.validation.studies.stability import _BASES
 cls = next(c for c in models.Model.registry if c.__name__ == name)
 m = _BASES[name]() if name in _BASES else cls()
 k = int(round(math.sqrt(n / 4)))
@@ -89,15 +84,7 @@ print(json.dumps({"n": N, "seconds": dt, "us": dt / N * 1e6, "base_mb": base, "p
 
 def run(name, n, what):
     """One model at ``n`` geometries in a fresh interpreter: ``{n, seconds, us, base_mb, peak_mb}``."""
-    env = dict(
-        os.environ,
-        PYTHONPATH=os.pathsep.join(
-            [os.path.dirname(os.path.dirname(os.path.abspath(__file__))), os.environ.get("PYTHONPATH", "")]
-        ),
-    )
-    r = subprocess.run(
-        [sys.executable, "-c", CHILD, name, str(n), what], capture_output=True, text=True, env=env
-    )
+    r = subprocess.run([sys.executable, "-c", CHILD, name, str(n), what], capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(r.stderr)
     return json.loads(r.stdout)
@@ -126,7 +113,7 @@ def main():
     ap.add_argument("--what", nargs="*", default=["brdf", "iter_mueller"], choices=["brdf", "iter_mueller"])
     ap.add_argument("--models", nargs="*", default=None)
     args = ap.parse_args()
-    import models
+    from scatterbench import models
 
     names = args.models or [c.__name__ for c in models.Model.registry if c is not models.Sum]
     print(f"{'model':<26} {'what':<12} {'N':>9} {'us/geom':>9} {'base MB':>8} {'peak MB':>9} {'delta MB':>8}")

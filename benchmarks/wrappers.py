@@ -47,8 +47,8 @@ import warnings
 
 import numpy as np
 
-import models
 from benchmarks.speed import best_of
+from scatterbench import models
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BASE = "a0b9da6"
@@ -65,8 +65,8 @@ def baseline(name):
     src = subprocess.run(
         ["git", "-C", ROOT, "show", f"{BASE}:models/{name}.py"], capture_output=True, text=True, check=True
     ).stdout
-    mod = types.ModuleType(f"models._before_{name}")
-    mod.__package__ = "models"
+    mod = types.ModuleType(f"scatterbench.models._before_{name}")
+    mod.__package__ = "scatterbench.models"
     sys.modules[mod.__name__] = mod
     exec(compile(src, f"{BASE}:models/{name}.py", "exec"), mod.__dict__)
     return mod
@@ -185,7 +185,7 @@ def print_aperture_blocks(repeat):
     """DetectorAperture's compiled route per geometry at each block size
     (``models.aperture._BLOCK``, inner-model evaluations per call) from 2^12 to 2^16, at 800,
     8000 and 80,000 geometries: the evidence for the block size chosen."""
-    import models.aperture as aperture
+    import scatterbench.models.aperture as aperture
 
     kw = dict(model=INNERS["broad lobe"], aperture=math.radians(0.7), resolution=4)
     chosen = aperture._BLOCK

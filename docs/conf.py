@@ -15,8 +15,9 @@ import matplotlib
 matplotlib.use("Agg")
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
-if os.path.isdir(os.path.join(ROOT, "models")):
-    sys.path.insert(0, ROOT)  # the checkout being documented wins over an installed copy
+# The site documents the installed ``scatterbench`` (its folders map under one namespace only
+# through the installation: pyproject.toml's package-dir); to document a checkout, install it
+# editable first (``pip install -e ".[docs]"``).
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "_ext"))
 
 project = "scatterbench"
@@ -48,7 +49,7 @@ myst_heading_anchors = 3
 
 autosummary_generate = True
 # importing validation/cli/__main__.py runs the CLI: autosummary must not import it
-autosummary_mock_imports = ["validation.cli.__main__"]
+autosummary_mock_imports = ["scatterbench.validation.cli.__main__"]
 autodoc_default_options = {"members": True, "inherited-members": False}
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types
 numpydoc_show_class_members = False  # autosummary tables list the members

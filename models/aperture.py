@@ -14,7 +14,7 @@ the horizon (a cone that reaches past grazing) carry no light and no weight.
 Quadrature.  With the polar offset ``u`` from the nominal axis and
 ``r = 2 sin(u / 2)``, the solid-angle element is ``r dr dchi`` (Lambert's
 equal-area map), so the cone is a disc of radius ``2 sin(aperture / 4)`` and
-:func:`models.geometry.disc_quadrature` applies (``resolution`` Gauss-Legendre
+:func:`scatterbench.models.geometry.disc_quadrature` applies (``resolution`` Gauss-Legendre
 radial nodes x ``2 resolution`` azimuths).
 
 Polarization.  The model's Mueller matrix at a direction ``k`` of the cone is in
@@ -113,7 +113,7 @@ class DetectorAperture(_Wrapper):
 
     def _mueller16_compiled(self, ti, tr, pr):
         """:meth:`_mueller16` with the node algebra and the rotated sum compiled
-        (:mod:`models.kernels.aperture`, held to the numpy route above), the inner model
+        (:mod:`scatterbench.models.kernels.aperture`, held to the numpy route above), the inner model
         evaluated once per block of :data:`_BLOCK` nodes (``python benchmarks/wrappers.py
         --blocks``, one run: blocks of 2^12 to 2^15 nodes alike, 1.7-2.5 us per geometry; 2^16,
         whose 16 result rows are 8 MB, 2.8-3.3 from 8000 geometries on)."""

@@ -1,7 +1,7 @@
 """The model interface: one evaluation path for one geometry or millions.
 
 Every BRDF/BTDF model is a frozen dataclass of declared parameters
-(:mod:`models.params`) deriving from :class:`Model`.  A model implements
+(:mod:`scatterbench.models.params`) deriving from :class:`Model`.  A model implements
 ``_mueller16(theta_i, theta_r, phi_r)`` on flat float64 arrays and returns the
 16 Mueller elements as a ``(16, n)`` array; :class:`Model` validates and
 broadcasts the user's angles, evaluates them in cache-sized chunks (so memory
@@ -70,7 +70,7 @@ class Model(Declared):
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        if not cls.__name__.startswith("_") and cls.__module__.startswith("models"):
+        if not cls.__name__.startswith("_") and cls.__module__.startswith("scatterbench.models"):
             Model.registry.append(cls)
 
     #: True when ``_mueller16``/``_brdf_flat`` take array parameters (flat, one per
@@ -85,7 +85,7 @@ class Model(Declared):
         raise NotImplementedError(f"{type(self).__name__} is depolarizing: it has no Jones matrix")
 
     def _kernel_spec(self):
-        """``(code, parameters, options)`` for a compiled kernel (:mod:`models.kernels`), or
+        """``(code, parameters, options)`` for a compiled kernel (:mod:`scatterbench.models.kernels`), or
         ``None`` where no kernel covers this model and its options (then numpy)."""
         return None
 
@@ -97,7 +97,7 @@ class Model(Declared):
 
     @cached_property
     def _sets(self) -> dict:
-        """``{path: array}``: the parameters that are arrays (:mod:`models.modelset`)."""
+        """``{path: array}``: the parameters that are arrays (:mod:`scatterbench.models.modelset`)."""
         return array_leaves(self)
 
     @property
@@ -184,8 +184,8 @@ class Model(Declared):
         set (:attr:`param_shape`).  ``out``, optional: a ``(16, N)`` array of the
         precision's dtype (e.g. a ``numpy.memmap``) to write into, element-major, for very
         large evaluations.  ``precision``: ``"float64"`` or ``"float32"``: the float32
-        kernels (:mod:`models.kernels`) where the parameters lie in their float32-safe domain
-        (:mod:`models.float32_domain`); otherwise, as for a model without a kernel, the
+        kernels (:mod:`scatterbench.models.kernels`) where the parameters lie in their float32-safe domain
+        (:mod:`scatterbench.models.float32_domain`); otherwise, as for a model without a kernel, the
         float64 evaluation rounded to float32 (:attr:`float32_fallback` says why).
         """
         fast = self._fast(theta_i, theta_r, phi_r, 16, precision, out)
@@ -225,7 +225,7 @@ class Model(Declared):
         """Why ``precision="float32"`` evaluates this model in float64 and rounds the result
         (a sentence), or ``None`` when the float32 kernel evaluates it: no kernel covers the
         model or its options, the numpy backend is selected, or the parameters lie outside
-        the float32-safe domain (:mod:`models.float32_domain`; decided once per model)."""
+        the float32-safe domain (:mod:`scatterbench.models.float32_domain`; decided once per model)."""
         if not self._has_kernel:
             return f"no compiled kernel covers {type(self).__name__} with these options"
         if evaluation.current_backend() != "numba":
@@ -238,7 +238,7 @@ class Model(Declared):
 
     def _falls_back(self) -> bool:
         """True when a float32 request runs the kernel in float64 here (outside the
-        float32-safe domain, unless :func:`models.evaluation.raw_float32` is in effect)."""
+        float32-safe domain, unless :func:`scatterbench.models.evaluation.raw_float32` is in effect)."""
         return self._float32_unsafe is not None and evaluation.float32_guarded()
 
     def _fill(self, plan, out, rows, precision):
@@ -256,7 +256,7 @@ class Model(Declared):
                 out[:, sl] = m._m16(ti, tr, pr) if rows == 16 else m._m00(ti, tr, pr)
 
     def _fast(self, theta_i, theta_r, phi_r, rows, precision, out=None):
-        """A small call (:meth:`models.kernels.Compiled.fast`) straight into the kernel, or
+        """A small call (:meth:`scatterbench.models.kernels.Compiled.fast`) straight into the kernel, or
         ``None`` for the general path (which also raises the errors)."""
         kernel = None if self._sets else self._compiled()
         if kernel is None:

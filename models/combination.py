@@ -1,6 +1,6 @@
 """Monte Carlo standard errors through incoherent sums (seed 003 Sec. 4 combinations).
 
-``m1 + m2`` and ``w * m`` (:class:`models.base.Sum`) already combine any models;
+``m1 + m2`` and ``w * m`` (:class:`scatterbench.models.base.Sum`) already combine any models;
 :func:`mueller_with_error` adds the standard error of a sum whose terms include
 Monte Carlo models (those with ``mueller_with_error``): errors of independent
 terms add in quadrature, weighted; deterministic terms contribute none.

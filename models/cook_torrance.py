@@ -17,18 +17,18 @@ the Beckmann density of facet normals per projected area
 area.  ``convention="paper"`` keeps the printed form (it is ``4 pi``
 times the normalized BRDF and its albedo exceeds 1 -- a property of the paper);
 ``"corrected"`` is the normalized form, which equals the M00 of
-:class:`models.FacetBRDF` with ``GaussianSlopes(sigma=m)`` when there is no
+:class:`scatterbench.models.FacetBRDF` with ``GaussianSlopes(sigma=m)`` when there is no
 shadowing.
 
 Roughness (``slopes``).  Eq. 8's ``m`` is the ``sigma`` of
-:class:`models.GaussianSlopes`: ``D / pi = exp(-tan^2 alpha / m^2) / (pi m^2 cos^4
+:class:`scatterbench.models.GaussianSlopes`: ``D / pi = exp(-tan^2 alpha / m^2) / (pi m^2 cos^4
 alpha)`` is Beckmann's density of facet normals, and ``cos^4 alpha D / pi`` is the
 Gaussian slope density ``P3(zeta) = exp(-(zeta/m)^2) / (pi m^2)`` at ``zeta = tan
-alpha`` (``<zeta^2> = m^2``).  :class:`models.StrokeSlopes` gives Eq. 19's brushed D.
+alpha`` (``<zeta^2> = m^2``).  :class:`scatterbench.models.StrokeSlopes` gives Eq. 19's brushed D.
 
 Fresnel.  ``F`` is computed with the real-valued form Eq. 13-16
 (:func:`fresnel_real`), tested equal to the complex Born & Wolf form
-(:func:`models.fresnel.fresnel_reflectance`, Eq. 11-12) to 1e-12.  Two slips of
+(:func:`scatterbench.models.fresnel.fresnel_reflectance`, Eq. 11-12) to 1e-12.  Two slips of
 the printed Eq. 13-16 are fixed there (see :func:`fresnel_real`), and the labels
 of Eq. 11/13 (``parallel``) and 12/14 (``perpendicular``) are swapped in the
 paper: Eq. 11 and 13 are the s (perpendicular, TE) reflectance.  The average
@@ -139,7 +139,7 @@ def _fs_fp(c, s2, root, a):
 
 def fresnel_average(cos_i, index):
     """Natural-light reflectance ``F = (F_s + F_p) / 2`` (Eq. 17) of relative index ``index``:
-    the shared complex Fresnel reflectances (:func:`models.fresnel.fresnel_reflectance`),
+    the shared complex Fresnel reflectances (:func:`scatterbench.models.fresnel.fresnel_reflectance`),
     which the corrected real form :func:`fresnel_real` equals (checked in validate)."""
     rs, rp = fresnel_reflectance(cos_i, 1.0, index)
     return 0.5 * (rs + rp)
@@ -189,15 +189,15 @@ def ct_kernel(ci, cr, cp, sp, d_fn, index, shadowing, smith=None):
 
 
 def smith_slopes(slopes):
-    """The slopes whose Smith ``Lambda`` (:mod:`models.shadowing`) the ``"smith"`` option uses:
+    """The slopes whose Smith ``Lambda`` (:mod:`scatterbench.models.shadowing`) the ``"smith"`` option uses:
     ``GaussianSlopes(sigma=m)`` itself (Beckmann ``alpha = m``, the erf form); for
-    :class:`models.StrokeSlopes` the anisotropic Gaussian with the same exponent,
+    :class:`scatterbench.models.StrokeSlopes` the anisotropic Gaussian with the same exponent,
     ``AnisotropicGaussianSlopes(m_par, m_perp, stroke_angle)``, whose ``Lambda`` is the
     Beckmann one at the projected roughness ``m(phi)^2 = (m_par cos phi')^2 + (m_perp
     sin phi')^2`` (``phi'`` from the strokes).  For equal ``m`` values it is exact; for
     brushed roughness it is an approximation, as Eq. 19's prefactor ``1 / m(beta)^2``
     differs from the anisotropic Gaussian's ``1 / (m_par m_perp)`` (see
-    :mod:`models.stroke_slopes`)."""
+    :mod:`scatterbench.models.stroke_slopes`)."""
     if isinstance(slopes, StrokeSlopes):
         if slopes.isotropic:
             return GaussianSlopes(sigma=slopes.m_parallel)
@@ -210,7 +210,7 @@ def smith_slopes(slopes):
 def _check_m(value) -> float:
     """The old ``m=`` keyword (Eq. 8's rms slope), validated in the range of the slope width
     it sets (``GaussianSlopes.sigma``, ``StrokeSlopes.m_parallel``/``m_perpendicular``:
-    :func:`models.params.width_param`) and named ``m``, the keyword the user gave."""
+    :func:`scatterbench.models.params.width_param`) and named ``m``, the keyword the user gave."""
     return check_real("m", value, SLOPE_WIDTH_MIN, SLOPE_WIDTH_MAX)
 
 
@@ -221,9 +221,9 @@ def _slopes_from_m(given, current):
 
 class _CookTorranceBase(Model):
     """Shared parts of the scalar Cook-Torrance models (depolarizing, M00 only): the
-    roughness is a declared ``slopes`` (:class:`models.GaussianSlopes`, Eq. 8, or
-    :class:`models.StrokeSlopes`, Eq. 19), whose density D is evaluated by
-    :func:`models.stroke_slopes.stroke_d`."""
+    roughness is a declared ``slopes`` (:class:`scatterbench.models.GaussianSlopes`, Eq. 8, or
+    :class:`scatterbench.models.StrokeSlopes`, Eq. 19), whose density D is evaluated by
+    :func:`scatterbench.models.stroke_slopes.stroke_d`."""
 
     depolarizing = True
 
@@ -237,14 +237,14 @@ class _CookTorranceBase(Model):
 
     def _m_rows(self):
         """``[m_parallel, m_perpendicular, stroke_angle]`` of the slopes (``[m, m, 0]`` for
-        ``GaussianSlopes(sigma=m)``): :func:`models.kernel_specs.slope_rows` without coverage."""
+        ``GaussianSlopes(sigma=m)``): :func:`scatterbench.models.kernel_specs.slope_rows` without coverage."""
         return kernel_specs.slope_rows(self.slopes)[1][:3]
 
     def _d_fn(self):
         return stroke_d(*self._m_rows())
 
     def _cook_spec(self, variant, coating):
-        """The Cook-Torrance kernel (every shadowing option: :data:`models.kernel_specs.COOK_SHADOWING`)."""
+        """The Cook-Torrance kernel (every shadowing option: :data:`scatterbench.models.kernel_specs.COOK_SHADOWING`)."""
         m_rows = self._m_rows()
         rows = [
             coating,
@@ -279,7 +279,7 @@ class _CookTorranceBase(Model):
         """Mueller BRDF ``(..., 4, 4)``: the ideal depolarizer ``diag(f, 0, 0, 0)``
         with ``M00 = f`` the scalar BRDF.  The model is scalar (natural light,
         Eq. 17): it predicts no polarization, so only ``M00`` carries information.
-        ``out`` and ``precision`` as for :meth:`models.Model.mueller`.
+        ``out`` and ``precision`` as for :meth:`scatterbench.models.Model.mueller`.
         (Overridden for this docstring, which ``help(model.mueller)`` shows.)"""
         return super().mueller(theta_i, theta_r, phi_r, out=out, precision=precision)
 
@@ -295,7 +295,7 @@ class CookTorranceBRDF(_CookTorranceBase):
     ----------
     slopes : GaussianSlopes or StrokeSlopes
         Facet slopes of D: ``GaussianSlopes(sigma=m)`` is Eq. 8 with rms slope ``m``
-        (Beckmann's ``alpha``), :class:`models.StrokeSlopes` Eq. 19's brushed
+        (Beckmann's ``alpha``), :class:`scatterbench.models.StrokeSlopes` Eq. 19's brushed
         roughness.  Old keyword ``m=`` (a number: ``GaussianSlopes(sigma=m)``).
     substrate : complex or math.inf
         Metal index ``n + ik`` relative to the ambient (Eq. 10); ``inf``: ``F = 1``.
@@ -309,7 +309,7 @@ class CookTorranceBRDF(_CookTorranceBase):
         Eq. 18 (Blinn's V-groove ``G``), ``G = 1``, or the separable Smith ``G1(i) G1(o)``
         from the Beckmann ``Lambda`` of the model's ``m`` (:func:`smith_slopes`; not in
         seed 001).  With ``"smith"`` and ``convention="corrected"`` the model is
-        :class:`models.FacetBRDF` with ``GaussianSlopes(sigma=m)`` and ``shadowing="smith"``
+        :class:`scatterbench.models.FacetBRDF` with ``GaussianSlopes(sigma=m)`` and ``shadowing="smith"``
         (M00).  Options a fused kernel does not cover run on this numpy path.
     """
 

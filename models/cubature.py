@@ -50,8 +50,8 @@ GM_POINTS = GM_U.size
 
 class AccuracyWarning(RuntimeWarning):
     """A refinement stopped at its cap before its estimated error met the tolerance (the
-    adaptive quadratures of :class:`models.PointSourceBRDF` and of
-    :func:`models.smooth_interface.film_hemispherical_reflectance`)."""
+    adaptive quadratures of :class:`scatterbench.models.PointSourceBRDF` and of
+    :func:`scatterbench.models.smooth_interface.film_hemispherical_reflectance`)."""
 
 
 @dataclass

@@ -11,7 +11,7 @@ is
 
 with ``M_diff`` built from ``|t|^2`` of both passes (four non-zero elements).
 ``R-bar`` uses the ``1/pi`` normalization (seed 003 Eq. 22 prints
-``1/(2 pi)``; see :func:`models.smooth_interface.internal_hemispherical_reflectance`),
+``1/(2 pi)``; see :func:`scatterbench.models.smooth_interface.internal_hemispherical_reflectance`),
 computed to ~1e-15 rather than with SCATMECH's 0.2-degree rectangle rule.  With
 it, at ``rho = 1`` the specular reflectance plus the integrated diffuse BRDF is
 exactly 1 (derivation: the diffuse term integrates to ``T(ti)``; tests check it
@@ -19,10 +19,10 @@ numerically).  SCATMECH: ``Diffuse_Subsurface_BRDF_Model``
 (``reflectance.table = rho``).
 
 Films on the interface (``coating_films``: ambient | films | binder).  Both crossings take
-the stack's amplitudes (:mod:`models.smooth_interface`, F1-F3: ``n |a|^2`` is the stack's
+the stack's amplitudes (:mod:`scatterbench.models.smooth_interface`, F1-F3: ``n |a|^2`` is the stack's
 transmittance in, and out), and ``R-bar`` is the stack's internal reflectance seen from
 inside the binder, averaged with Eq. 22's ``1/pi`` (F5,
-:func:`models.smooth_interface.film_hemispherical_reflectance`).  The unit-albedo argument
+:func:`scatterbench.models.smooth_interface.film_hemispherical_reflectance`).  The unit-albedo argument
 carries over for lossless films: at ``rho = 1`` the diffuse term integrates to the stack's
 transmittance ``T_01(ti)``, so with its reflectance ``R_01(ti)`` the total is 1 (tested);
 an absorbing film keeps it below 1.
@@ -63,7 +63,7 @@ class DiffuseSubsurfaceBRDF(FilmedCoating, Model):
     rho : float
         Diffuse reflectance of the underlying material, in [0, 1].
     coating_films : Films or None
-        Thin films on the interface (:class:`models.Films`, from the ambient down), on the
+        Thin films on the interface (:class:`scatterbench.models.Films`, from the ambient down), on the
         index ``coating``; ``None`` (default): the bare interface of seed 003.
     """
 
@@ -85,8 +85,8 @@ class DiffuseSubsurfaceBRDF(FilmedCoating, Model):
     def rbar(self):
         """Internal hemispherical reflectance ``R-bar`` (Eq. 22 with 1/pi): a float, or an
         array like ``coating`` in a model set (the quadrature runs once per distinct index
-        and is cached, :func:`models.smooth_interface.internal_hemispherical_reflectance`);
-        through films, the stack's (:func:`models.smooth_interface.film_hemispherical_reflectance`)."""
+        and is cached, :func:`scatterbench.models.smooth_interface.internal_hemispherical_reflectance`);
+        through films, the stack's (:func:`scatterbench.models.smooth_interface.film_hemispherical_reflectance`)."""
         if self._top_stack is not None:
             return film_hemispherical_reflectance(self._top_stack)
         n = self.coating

@@ -1,10 +1,10 @@
 """How a model is evaluated: backend, precision, broadcasting and chunks, model sets.
 
-:class:`models.Model` validates the angles, broadcasts them against its parameter shape
-(:mod:`models.modelset`) and evaluates them in chunks through one dispatcher per
+:class:`scatterbench.models.Model` validates the angles, broadcasts them against its parameter shape
+(:mod:`scatterbench.models.modelset`) and evaluates them in chunks through one dispatcher per
 quantity (``_m16`` for the Mueller matrix, ``_m00`` for its first element):
 
-* the compiled kernels (:mod:`models.kernels`, numba) for the closed-form models and
+* the compiled kernels (:mod:`scatterbench.models.kernels`, numba) for the closed-form models and
   the options they cover, the default backend;
 * otherwise the numpy implementation (``_mueller16``, ``_brdf_flat``), the reference
   path the kernels are tested against (``with models.backend("numpy"): ...`` selects
@@ -82,14 +82,14 @@ _FLOAT32_GUARD = contextvars.ContextVar("scatterbench_float32_guard", default=Tr
 
 def float32_guarded() -> bool:
     """True (the default) when float32 requests outside a model's float32-safe domain are
-    evaluated in float64 (:mod:`models.float32_domain`)."""
+    evaluated in float64 (:mod:`scatterbench.models.float32_domain`)."""
     return _FLOAT32_GUARD.get()
 
 
 @contextlib.contextmanager
 def raw_float32():
     """Run the float32 kernels inside the ``with`` block even outside their float32-safe
-    domain (:mod:`models.float32_domain`): for tests of the kernels themselves (finite at
+    domain (:mod:`scatterbench.models.float32_domain`): for tests of the kernels themselves (finite at
     the ends of the declared ranges), never for results."""
     token = _FLOAT32_GUARD.set(False)
     try:

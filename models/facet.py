@@ -22,12 +22,12 @@ so ``q_ab = r_s (e_a . e_b) + (K - 2 r_s)(e_a . h)(e_b . h) / |h|^2`` for basis
 vectors ``e_a`` of the outgoing and ``e_b`` of the incident ray.  The dot
 products reduce to Eq. 19's ``a2 = p_r'.h`` and ``a3 = p_i'.h`` and to
 ``s_r'.h = sin ti' sin phi``, ``s_i'.h = sin tr' sin phi``.  ``K`` is smooth at
-``alpha = 0`` (:func:`models.fresnel.reflection_rs_k`), so exact
+``alpha = 0`` (:func:`scatterbench.models.fresnel.reflection_rs_k`), so exact
 retroreflection is finite with no special case, where Eq. 18 is 0/0.  Because
 ``q = r_s U + K V`` with real ``U``, ``V`` (a non-absorbing coating has real
 transmission coefficients), the Jones elements are formed directly as real and
 imaginary parts and the Mueller matrix follows in real arithmetic on cache-sized
-chunks (:func:`models.polarization.mueller16_from_jones`).
+chunks (:func:`scatterbench.models.polarization.mueller16_from_jones`).
 """
 
 from __future__ import annotations
@@ -51,9 +51,9 @@ __all__ = ["FacetBRDF", "facet_jones", "local_cosine", "substrate_rs_k"]
 
 
 def substrate_rs_k(cos_i, n, substrate):
-    """``r_s`` and ``K = (r_s + r_p) / sin^2`` (:func:`models.fresnel.reflection_rs_k`) for
+    """``r_s`` and ``K = (r_s + r_p) / sin^2`` (:func:`scatterbench.models.fresnel.reflection_rs_k`) for
     light in the coating ``n`` meeting ``substrate``: an index (``n + ik`` or ``math.inf``)
-    or a layer stack (:class:`models.FilmStack`, whose ``reflection_rs_k(cos_i, n)`` it
+    or a layer stack (:class:`scatterbench.models.FilmStack`, whose ``reflection_rs_k(cos_i, n)`` it
     calls).  The one place the facet models take their reflection coefficients from."""
     if isinstance(substrate, FilmStack):
         return substrate.reflection_rs_k(cos_i, n)
@@ -62,9 +62,9 @@ def substrate_rs_k(cos_i, n, substrate):
 
 
 def _index_or_stack(name, value):
-    """The ``check`` of a facet model's ``substrate`` (:func:`models.params.param`): a
-    :class:`models.FilmStack` (which validated itself when built) as it is, anything else
-    validated as an index (:func:`models.params.check_index`)."""
+    """The ``check`` of a facet model's ``substrate`` (:func:`scatterbench.models.params.param`): a
+    :class:`scatterbench.models.FilmStack` (which validated itself when built) as it is, anything else
+    validated as an index (:func:`scatterbench.models.params.check_index`)."""
     return value if isinstance(value, FilmStack) else check_index(name, value)
 
 
@@ -115,13 +115,13 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none", top=None):
 
     Flat float64 arrays in.  Zero where a ray is grazing (``theta = pi/2``: no
     projected area, as in SCATMECH) or where the slope density vanishes.
-    ``substrate`` is an index or a :class:`models.FilmStack`
+    ``substrate`` is an index or a :class:`scatterbench.models.FilmStack`
     (:func:`substrate_rs_k`); ``shadowing`` one of
-    :data:`models.shadowing.SHADOWING` (``"none"``: seed 000's model, untouched),
+    :data:`scatterbench.models.shadowing.SHADOWING` (``"none"``: seed 000's model, untouched),
     applied with the internal directions (in the coating).  ``top``: ``None`` (the bare
-    coating, Eq. 14-15) or a :class:`models.FilmStack` of films on the coating's top
+    coating, Eq. 14-15) or a :class:`scatterbench.models.FilmStack` of films on the coating's top
     surface (substrate ``n``), whose complex crossing amplitudes replace ``t(theta; 1, n)``
-    (:func:`models.smooth_interface.film_transmission`).
+    (:func:`scatterbench.models.smooth_interface.film_transmission`).
     """
     cos_ext, sin_int, cos_int = _polar(ti, tr, n)
     sp, cp = np.sin(pr), np.cos(pr)
@@ -157,7 +157,7 @@ def facet_jones(ti, tr, pr, n, substrate, slopes, shadowing="none", top=None):
 def _through_films(parts, cos_ext, top):
     """The facet's Jones elements ``(re, im)`` times the complex crossing amplitudes of the
     films on the coating, ``t_out,a(theta_r) t_in,b(theta_i)`` for element ``ab``
-    (:func:`models.smooth_interface.film_transmission`, F1-F2): complex products, so the
+    (:func:`scatterbench.models.smooth_interface.film_transmission`, F1-F2): complex products, so the
     relative s/p phase of the films' transmission reaches the Mueller matrix."""
     (tsi, tpi), (tsr, tpr) = film_transmission(cos_ext[0], cos_ext[1], top)
     out = []
@@ -171,7 +171,7 @@ def _jones_elements(rs, K, root, h_dots, d, crossing):
     """``q_ab = r_s D_ab + (K - 2 r_s) (e_a.h)(e_b.h)/|h|^2`` (module docstring) as
     ``(re, im)`` pairs scaled by ``root``, times the coating's real transmission factors
     ``crossing = ((t_s,in, t_s,out), (t_p,in, t_p,out))``
-    (:func:`models.fresnel.coating_transmission`), or without any for ``crossing=None``."""
+    (:func:`scatterbench.models.fresnel.coating_transmission`), or without any for ``crossing=None``."""
     r_re = rs.real * root
     r_im = rs.imag * root
     k_re = K.real * root
@@ -214,7 +214,7 @@ class _FacetModel(Model):
         return 1.0
 
     def _top(self):
-        """The films on the coating's top surface as a :class:`models.FilmStack`, or ``None``."""
+        """The films on the coating's top surface as a :class:`scatterbench.models.FilmStack`, or ``None``."""
         return None
 
     def _parts(self, ti, tr, pr):
@@ -227,7 +227,7 @@ class _FacetModel(Model):
 
     def _kernel_spec(self):
         """The facet kernel; numpy for films (on the facets or the coating) and slopes or
-        shadowing it does not cover (:mod:`models.kernel_specs`)."""
+        shadowing it does not cover (:mod:`scatterbench.models.kernel_specs`)."""
         slopes = kernel_specs.slope_rows(self.slopes)
         if slopes is None or isinstance(self.substrate, FilmStack) or self._top() is not None:
             return None
@@ -290,11 +290,11 @@ class FacetBRDF(_FacetModel):
         Facet slope distribution ``P3^xy`` (e.g. :class:`ExponentialSlopes`).
     substrate : complex, math.inf or FilmStack
         Index ``n + ik`` of the material below the facets (``k >= 0``),
-        ``math.inf`` for a perfect conductor, or a :class:`models.FilmStack`
+        ``math.inf`` for a perfect conductor, or a :class:`scatterbench.models.FilmStack`
         (films on the facets, e.g. an interference pigment).
     shadowing : str
         ``"none"`` (seed 000), ``"smith"`` (separable Smith ``G1(i) G1(o)``) or
-        ``"smith-correlated"`` (height-correlated), :mod:`models.shadowing`.
+        ``"smith-correlated"`` (height-correlated), :mod:`scatterbench.models.shadowing`.
 
     Examples
     --------

@@ -64,7 +64,7 @@ def _cross(a, b):
 
 
 def ray_basis(k):
-    """``(s, p)`` of rays ``k`` given as ``(3, ...)`` arrays: :func:`models.geometry.sp_basis`
+    """``(s, p)`` of rays ``k`` given as ``(3, ...)`` arrays: :func:`scatterbench.models.geometry.sp_basis`
     (``s = unit(z x k)``, ``p = k x s``, ``s = +y`` along the z axis) in this layout."""
     s, p = sp_basis(np.moveaxis(k, 0, -1))
     return np.moveaxis(s, -1, 0), np.moveaxis(p, -1, 0)
@@ -176,7 +176,7 @@ class FacetBTDF(Model):
         (``"paper"``, ``"exact"``).
     shadowing : str
         ``"none"`` (seed 003), ``"smith"`` or ``"smith-correlated"``
-        (:mod:`models.shadowing`): the incident direction's shadowing and the
+        (:mod:`scatterbench.models.shadowing`): the incident direction's shadowing and the
         masking of the transmitted direction from below, ``chi+`` on each (Walter
         et al. 2007 Eq. 21-23).  Smith's ``G1`` satisfies ``int G1(i) (i.m)+ D dm =
         cos theta_i``, the projected-area identity that ``"paper"`` assumes, so it

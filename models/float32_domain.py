@@ -1,15 +1,15 @@
 """The float32-safe parameter domain of the compiled kernels, and the float64 fallback outside it.
 
-``precision="float32"`` runs the float32 kernels (:mod:`models.kernels`): the float64 formulas in
+``precision="float32"`` runs the float32 kernels (:mod:`scatterbench.models.kernels`): the float64 formulas in
 float32 arithmetic, whose machine epsilon is ``EPS = 2^-23`` (1.19e-7), smallest normal number
 ``TINY`` (1.18e-38) and largest ``HUGE`` (3.40e38).  Where a model's parameters let that
-arithmetic lose more than :data:`TOLERANCE` of the model's scale, :class:`models.Model` evaluates
+arithmetic lose more than :data:`TOLERANCE` of the model's scale, :class:`scatterbench.models.Model` evaluates
 the request in float64 and rounds the result to float32 instead (``model.float32_fallback`` says
 why).  The choice is made once per model from its parameters (a model set: from all its
 elements, and one fallback element sends the whole set to float64), never per geometry.
 
 **Error measure.**  ``E = max |M32 - M64| / max M64_00`` over every element and geometry (the
-trade-off study's precision knob, :func:`validation.studies.tradeoff.precision_error`): relative
+trade-off study's precision knob, :func:`scatterbench.validation.studies.tradeoff.precision_error`): relative
 to the model's peak, because a lobe's tails leave float32's range (``exp(-104)`` underflows)
 long before float64's, which no parameter can help.  Polar angles up to 89 degrees: every
 BRDF carries ``1 / cos(theta)`` factors whose condition ``theta tan(theta)`` grows without bound
@@ -31,7 +31,7 @@ sensitivity to it; ``u = EPS / 2`` is the unit roundoff, ``Delta`` the sine erro
   few EPS.  The s/p bases and the Jones elements are sums of terms linear in a sine, with
   coefficients up to the element's scale, and ``|J|^2`` doubles the error: ``4 Delta``.
   The kernels now evaluate that formula in float64 and round it
-  (:func:`models.kernels.common.polar`), which keeps their sines within 1.125 EPS; the domain
+  (:func:`scatterbench.models.kernels.common.polar`), which keeps their sines within 1.125 EPS; the domain
   still charges ``Delta``, an allowance that also covers what a bound from the accurate sines
   would have to add and that is not derived here: the polar angles' own rounding (up to
   ``(pi / 4) EPS`` per sine and cosine) moved into the slopes by ``1 / h_z``, which grows
@@ -70,7 +70,7 @@ sensitivity to it; ``u = EPS / 2`` is the unit roundoff, ``Delta`` the sine erro
   atan(sqrt(t) / (cos + cos))`` with ``t`` near 0 (rounded to ``~ 2 EPS``) one of ``<= 2
   Delta``; ``exp(-2 beta / tau)`` and ``theta_N / Omega`` scale them by ``2 / tau`` and
   ``1 / Omega``, and the shadowing function's relative sensitivity to either is ``<= 1``.
-* facet transmission (:class:`models.FacetBTDF`, index ``n``, sines from ``math.sin``):
+* facet transmission (:class:`scatterbench.models.FacetBTDF`, index ``n``, sines from ``math.sin``):
   ``(n + 1) / (n - 1) (4 + 2 L / w + 16 w)``.  ``h = k_in - n k_out`` has ``|h| >= n - 1`` and
   an error ``<= 2 EPS (n + 1)``: the factors ``(n - 1)`` of the coefficients and ``1 / |h|^2``
   (the 4), the slope ``h_xy / h_z`` within a narrow lobe (``2 L / w``), and for a wide lobe the
@@ -138,7 +138,7 @@ LOBE_SLOPE = {
     ANISO_GGX: 4.0 / math.sqrt(5.0) * (5.0 / 6.0) ** 3,
 }
 #: parameter rows that are angles: the float32 rows take them reduced to (-pi, pi] in float64
-#: (:class:`models.kernels.Compiled`), so any finite value is exact enough
+#: (:class:`scatterbench.models.kernels.Compiled`), so any finite value is exact enough
 ANGLE_ROWS = ("rotation", "stroke_angle")
 #: rows holding an angle's cosine or sine: in [-1, 1], where rounding to float32 (to zero
 #: below 1.2e-38) is the angle's own rounding
@@ -232,9 +232,9 @@ def condition(code, rows, iopt):
     Parameters
     ----------
     code : str
-        The kernel (:data:`models.kernels.drive.CODES`).
+        The kernel (:data:`scatterbench.models.kernels.drive.CODES`).
     rows : dict
-        The kernel's parameter rows by name (:data:`models.kernels.drive.ROWS`), flat float64
+        The kernel's parameter rows by name (:data:`scatterbench.models.kernels.drive.ROWS`), flat float64
         arrays of one length.
     iopt : sequence of int
         The kernel's options.

@@ -122,7 +122,7 @@ def coating_cos(cos_theta, n):
 
     This form, not ``sqrt(1 - sin^2 / n^2)``: near grazing under a thin coating (``n ~ 1``)
     the difference of two numbers near 1 loses the digits of ``c^2`` (in float32 all of
-    them), and for ``n = 1`` it is ``c`` exactly.  :mod:`models.kernels.common` has its
+    them), and for ``n = 1`` it is ``c`` exactly.  :mod:`scatterbench.models.kernels.common` has its
     scalar twin."""
     return np.sqrt(n * n - 1.0 + cos_theta * cos_theta) * (1.0 / n)
 

@@ -1,7 +1,7 @@
 """What the compiled kernels cover, without importing them: the codes of slope
 distributions and shadowing, and a model's parameters laid out as kernel rows.
 
-A model's ``_kernel_spec`` (see :class:`models.Model`) returns ``(code, rows, options)``
+A model's ``_kernel_spec`` (see :class:`scatterbench.models.Model`) returns ``(code, rows, options)``
 built with these helpers, or ``None`` where the kernels do not cover it; then the numpy
 implementation runs.  Not covered (numpy): tabulated slopes and the angle distributions
 (their normalizations are quadratures), Smith shadowing of distributions without a

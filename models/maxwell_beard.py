@@ -12,7 +12,7 @@ detector (the facet's local angle of incidence) and ``theta_N`` the polar
 angle of their bisector (the facet normal).  Maxwell-Beard's measured
 ``f_facet^(0)`` (the facet distribution at the Fresnel reference) is here the
 facet model's, so ``R(0) f_facet^(0) [R(beta)/R(0)]`` is the unpolarized
-:class:`models.FacetBRDF` and the specular term is ``FacetBRDF x SO``: the same
+:class:`scatterbench.models.FacetBRDF` and the specular term is ``FacetBRDF x SO``: the same
 as SCATMECH's ``Shadowed_Facet_BRDF_Model`` with
 ``Maxwell_Beard_Shadow_Function`` (tests compare with it).  ``rho_D`` and
 ``rho_V`` are BRDF values (1/sr).

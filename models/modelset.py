@@ -1,6 +1,6 @@
 """Model sets: models whose declared real or index parameters are numpy arrays.
 
-A declared ``real``, ``real_index`` or ``index`` parameter (:mod:`models.params`) may be
+A declared ``real``, ``real_index`` or ``index`` parameter (:mod:`scatterbench.models.params`) may be
 an array of any shape; the model then stands for one model per element (astropy's
 "model sets").  Its *parameter shape* is the broadcast of the shapes of all its array
 parameters, those of nested declared objects included (``FacetBRDF(slopes=
@@ -9,7 +9,7 @@ GaussianSlopes(sigma=array))``), and evaluation broadcasts it against the angles
 
 The helpers here walk a model's tree of declared parameters.  A *path* names one
 parameter: a tuple of field names and tuple indices, e.g. ``("slopes", "sigma")`` or
-``("terms", 1, 1, "coating")`` (the second term of a :class:`models.Sum`).
+``("terms", 1, 1, "coating")`` (the second term of a :class:`scatterbench.models.Sum`).
 :func:`with_leaves` builds a model with some parameters replaced *without* validating
 them again: for callers that checked the values once, vectorized (a fit checks its
 walkers' values against the prior bounds, which were checked against the models).
@@ -44,7 +44,7 @@ def _declared_fields(obj):
 def _walk(obj, path, visit):
     """Call ``visit(path, value, kind)`` for every declared real/index value under ``obj``.
 
-    A declared object where a value goes (a :class:`models.FilmStack` as a substrate
+    A declared object where a value goes (a :class:`scatterbench.models.FilmStack` as a substrate
     index) is walked into, like an ``object`` field."""
     if isinstance(obj, Declared) and dataclasses.is_dataclass(obj):
         for f in _declared_fields(obj):
@@ -74,7 +74,7 @@ def scalar_leaves(obj) -> dict:
 
 
 def path_text(path) -> str:
-    """A path as the dotted text :meth:`models.Model.with_values` takes."""
+    """A path as the dotted text :meth:`scatterbench.models.Model.with_values` takes."""
     return ".".join(str(k) for k in path)
 
 
@@ -136,7 +136,7 @@ def with_leaves(obj, leaves: dict):
 
 def rebuilt(obj, leaves: dict):
     """``obj`` with the parameters at the given paths replaced and everything validated again
-    (:meth:`models.params.Declared.replace`, vectorized for arrays)."""
+    (:meth:`scatterbench.models.params.Declared.replace`, vectorized for arrays)."""
     if not leaves:
         return obj
     changes = _changed(obj, leaves, rebuilt)

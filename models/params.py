@@ -1,6 +1,6 @@
 """Declared, validated model parameters.
 
-Every model and distribution in :mod:`models` is a frozen dataclass whose fields
+Every model and distribution in :mod:`scatterbench.models` is a frozen dataclass whose fields
 are declared with :func:`param`: a default, a one-line description and a kind
 that fixes the allowed range.  ``Declared.__post_init__`` validates every field
 and raises a ``ValueError`` that names the parameter and its allowed range, so a

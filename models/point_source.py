@@ -60,7 +60,7 @@ holds ``R / d`` up to 1e6 against an independent integration in units of ``d``).
 coordinates are cut at ``P*`` into at most four cells (``t`` below and above ``t*``, ``chi``
 on either side of ``chi*``), each graded exponentially towards ``P*`` over the lobe's width on
 the disc (``width * d``; across the wedge's rays ``width / tan psi`` of azimuth, where a lobe at
-grazing incidence is narrowest), and integrated by adaptive cubature (:mod:`models.cubature`:
+grazing incidence is narrowest), and integrated by adaptive cubature (:mod:`scatterbench.models.cubature`:
 Genz-Malik rules whose embedded difference, and the change a split makes, bound each region's
 error; regions above their share are halved until the geometry meets ``tol``).  A lobe broad compared with the incidence spread (``spread <=
 2 width``) or no lobe at all is tried first with the product rule in ``(t, chi)`` at 4 and 8
@@ -72,7 +72,7 @@ is rotated per node as a model set (``model.rotated(array)``, one call per block
 whose ``rotated`` takes a single angle (a user's model) is rotated node by node, one call per
 distinct azimuth, on the same nodes: the same quadrature, only slower.
 With the numba backend (the default) the node algebra, each point's local incidence and
-irradiance weight, runs compiled (:mod:`models.kernels.disc`, held to :meth:`_Disc.angles`).
+irradiance weight, runs compiled (:mod:`scatterbench.models.kernels.disc`, held to :meth:`_Disc.angles`).
 
 A fixed ``resolution`` (an int) is the product rule of earlier versions, unrefined and
 unestimated: Gauss-Legendre in the radius about the disc centre (``resolution`` nodes, weight
@@ -575,7 +575,7 @@ def _weighted_mean(M, J):
 
 
 def _product_nodes(n_r):
-    """``(t, chi, w)`` ``(1, K)`` of :func:`models.geometry.polar_rule`; the area element is the
+    """``(t, chi, w)`` ``(1, K)`` of :func:`scatterbench.models.geometry.polar_rule`; the area element is the
     integrand's."""
     return tuple(a[None, :] for a in polar_rule(n_r))
 
@@ -641,7 +641,7 @@ class _Disc:
         return self.ps._local(psi, Phi, self.tr[rows], self.pr[rows]), J
 
     def _angles_compiled(self, rows, v, chi, w):
-        """:meth:`angles` compiled (:mod:`models.kernels.disc`, held to it)."""
+        """:meth:`angles` compiled (:mod:`scatterbench.models.kernels.disc`, held to it)."""
         from .kernels import disc
 
         shape = np.broadcast_shapes((rows.size, 1), np.shape(v), np.shape(chi), np.shape(w))
@@ -656,7 +656,7 @@ class _Disc:
         polar and azimuth, and the irradiance weight ``J``, each ``(m, P)`` (per row up to a
         constant: ``rho^2 t cos^3 psi / cos^3 psi_c w`` about the centre,
         ``2 v rho^2 / (h (h + 1)) w`` about ``H``, ``h = hypot(1, k rho)``, scaled by the unit
-        disc's); the numpy reference of :mod:`models.kernels.disc`."""
+        disc's); the numpy reference of :mod:`scatterbench.models.kernels.disc`."""
         on_h = self.on_h[rows][:, None]
         ox = self.ox[rows][:, None]
         c, s = np.cos(chi), np.sin(chi)

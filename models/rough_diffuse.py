@@ -18,7 +18,7 @@ facet slopes ``(zeta_1, zeta_2)``:
   for the reversed scattered ray ``-k_r``.
 * Snell's law through each facet gives the internal directions ``k_1'``
   (Eq. 30) and ``k_2'`` (the internal ray that leaves along ``k_r``), and the
-  facet Jones matrices (:func:`models.facet_btdf.facet_transmission_jones`,
+  facet Jones matrices (:func:`scatterbench.models.facet_btdf.facet_transmission_jones`,
   flux factors ``n cos(iota_t)/cos(iota_i)`` in and ``cos(iota_air)/(n
   cos(iota_int))`` out).
 * Volume: single scattering, phase matrix of Eq. 7 (or depolarizing) times the
@@ -45,11 +45,11 @@ inverse CDF (2048 midpoint quantiles; relative error < 1e-6).
 
 The mean over pairs is the estimate and ``std / sqrt(pairs)`` its standard
 error (:meth:`RoughDiffuseBRDF.mueller_with_error`).  It is computed by the compiled
-loop :mod:`models.kernels.montecarlo` (the default backend: one pass per geometry over
+loop :mod:`scatterbench.models.kernels.montecarlo` (the default backend: one pass per geometry over
 the same facet pairs, no temporaries) or, ``with models.backend("numpy")``, by the numpy
 implementation here, the reference the tests hold the kernel to (1e-12 relative to
 ``M00``).  With ``surface=True`` the
-direct reflection by the exposed rough surface (:class:`models.FacetBRDF`
+direct reflection by the exposed rough surface (:class:`scatterbench.models.FacetBRDF`
 with substrate ``n``, the coating's index) is added (deterministic, zero error).  No shadowing, as
 in the paper.
 """
@@ -170,7 +170,7 @@ class RoughDiffuseBRDF(Model):
         Not part of ``convention``: the default is the rough R-bar, and joining the two
         would change what a model built with defaults computes.
     convention : "paper" | "corrected"
-        The surface term.  ``"paper"``: :class:`models.FacetBRDF` as printed, with
+        The surface term.  ``"paper"``: :class:`scatterbench.models.FacetBRDF` as printed, with
         Eq. 37's ``1/cos(theta_i)`` normalization of the slopes seen by the incident ray
         (as SCATMECH).  ``"corrected"``: scaled by ``cos(theta_i) / N(theta_i)`` to the
         exact Eq. 36 normalization that the volume terms use (energy then stays <= 1 for
@@ -392,7 +392,7 @@ class RoughDiffuseBRDF(Model):
 
     @staticmethod
     def _montecarlo():
-        """The compiled Monte Carlo (:mod:`models.kernels.montecarlo`), or ``None`` on the
+        """The compiled Monte Carlo (:mod:`scatterbench.models.kernels.montecarlo`), or ``None`` on the
         numpy backend (the reference it is tested against)."""
         if evaluation.current_backend() != "numba":
             return None

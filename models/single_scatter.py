@@ -2,7 +2,7 @@
 
 A ray refracts into a half-space of real index ``n`` (the ``coating``: the binder
 around the scatterers), scatters once with the
-phase function of :mod:`models.phase` at a depth with the exponential
+phase function of :mod:`scatterbench.models.phase` at a depth with the exponential
 probability of Eq. 16-19, and refracts out.  The Mueller BRDF (Eq. 20) is
 
     f = P(k_i', k_r') (x) [diag(t_r) J diag(t_i)] * cos ti' cos tr' / (cos ti cos tr (cos ti' + cos tr'))
@@ -24,13 +24,13 @@ reciprocity, which the tests check).  With the depolarizing phase
 only ``|t|^2`` enter and the model is SCATMECH's ``First_Diffuse_BRDF_Model``
 (with ``Unpolarized_Phase_Function``, no absorption), which it matches to
 1e-12.  The ``cos'/cos`` factors are carried by the amplitudes of
-:func:`models.smooth_interface.interface_amplitudes`, so grazing geometries give
+:func:`scatterbench.models.smooth_interface.interface_amplitudes`, so grazing geometries give
 exact zeros.
 
 Films on the interface (``coating_films``: ambient | films | binder).  The amplitudes
 ``t_r``, ``t_i`` of Eq. 20 become the stack's complex crossing amplitudes, ``t_01`` in and
-``t_10 kz_0 / kz_s`` out (:mod:`models.smooth_interface`, F1-F2; with the ``sqrt(cos'/cos)``
-factor, :func:`models.smooth_interface.film_amplitudes`).  The Jones elements above become
+``t_10 kz_0 / kz_s`` out (:mod:`scatterbench.models.smooth_interface`, F1-F2; with the ``sqrt(cos'/cos)``
+factor, :func:`scatterbench.models.smooth_interface.film_amplitudes`).  The Jones elements above become
 complex products ``a_out,a J_ab a_in,b`` (the films' s/p phase difference reaches the
 polarized model's U and V rows); the depolarizing phase sees only ``|a|^2``, the stack's
 transmittances over ``n`` (F3).  Directions, the phase function and the depth integral
@@ -67,7 +67,7 @@ class SingleScatterBRDF(FilmedCoating, Model):
     phase : HenyeyGreenstein
         Phase function (polarized Eq. 7 or depolarizing).
     coating_films : Films or None
-        Thin films on the interface (:class:`models.Films`, from the ambient down), on the
+        Thin films on the interface (:class:`scatterbench.models.Films`, from the ambient down), on the
         index ``coating``; ``None`` (default): the bare interface of seed 003.
     """
 

@@ -3,7 +3,7 @@
 For a ray at external polar angle ``theta`` (cosine ``c``) entering a medium of
 real index ``n >= 1`` (internal cosine ``c'``), the Fresnel amplitudes are
 ``t_s = 2c / (c + n c')``, ``t_p = 2c / (n c + c')`` (Born & Wolf, as in
-:mod:`models.fresnel`, with ``w = n c'``).  Seed 003 Eq. 14, 20, 24-27 always
+:mod:`scatterbench.models.fresnel`, with ``w = n c'``).  Seed 003 Eq. 14, 20, 24-27 always
 multiply ``|t|^2`` by ``c'/c``; the amplitudes carrying that factor,
 
     a_s = t_s sqrt(c'/c) = 2 sqrt(c c') / (c + n c'),
@@ -15,14 +15,14 @@ By reciprocity of the transmittance the same amplitudes describe the exit of a
 ray leaving at ``theta`` (seed 003 Eq. 11, 25).
 
 Thin films on the interface (ambient | films | coating, ``coating_films`` of the coated
-models; :mod:`models.thin_film`).  The films change neither direction (the Snell invariant
+models; :mod:`scatterbench.models.thin_film`).  The films change neither direction (the Snell invariant
 ``sin theta`` is the same in every layer) nor the solid-angle and projection factors; they
 change the amplitudes of the two crossings, which become complex:
 
 * entrance (F1): ``t_in = t_01(theta)``, the stack's transmission from the ambient into the
-  coating (:meth:`models.FilmStack.transmission_down`);
+  coating (:meth:`scatterbench.models.FilmStack.transmission_down`);
 * exit (F2): the ray leaves the coating at ``theta'`` and emerges at ``theta`` with the
-  stack's upward amplitude ``t_10`` (:meth:`models.FilmStack.transmission_up`).  Seed 000
+  stack's upward amplitude ``t_10`` (:meth:`scatterbench.models.FilmStack.transmission_up`).  Seed 000
   Eq. 14-15 and seed 003 Eq. 11, 25 write the exit with ``t(theta; 1, n)``, which for one
   interface is ``t_10 kz_0 / kz_s`` (``kz_0 = cos theta``, ``kz_s = n cos theta'``): the
   Fresnel exit amplitude with the ratio of the normal wavevectors that the radiance
@@ -33,7 +33,7 @@ Flux (F3): ``n |a|^2`` with ``a = t sqrt(c'/c)`` is the transmittance of the cro
 either factor: ``T_01 = (kz_s / kz_0) |t_01|^2`` and ``T_10 = (kz_0 / kz_s) |t_10|^2``, the
 ratios of the normal Poynting fluxes (``Re(kz)`` of real outer media is ``kz``).  An
 absorbing film lowers both below ``1 - R``, so the models' energy still balances.
-Reciprocity (F4): the stack obeys ``t_10 kz_0 = t_01 kz_s`` (:mod:`models.thin_film`,
+Reciprocity (F4): the stack obeys ``t_10 kz_0 = t_01 kz_s`` (:mod:`scatterbench.models.thin_film`,
 (R)), so ``t_out(theta) = t_in(theta)`` and a model built from (F1)-(F2) keeps the bare
 model's Helmholtz reciprocity; the exit is nonetheless computed from ``t_10`` (the
 physics), and the reciprocity tests compare the two crossings.  The relative s/p phase
@@ -42,7 +42,7 @@ depolarizing ones.  A zero-thickness film, or one whose index is the coating's o
 ambient's, gives the bare interface.
 
 R-bar with films (F5): seed 003 Eq. 22's average (``1/pi``) of the internal reflectance
-``R_10`` of the stack seen from inside the coating (:meth:`models.FilmStack.upward`),
+``R_10`` of the stack seen from inside the coating (:meth:`scatterbench.models.FilmStack.upward`),
 ``int_0^1 R_10 du`` over ``u = sin^2 theta'``.  With films the Stokes shortcut of
 :func:`internal_hemispherical_reflectance` does not hold (an absorbing film makes
 ``R_10 != R_01`` and ``R_10 < 1`` beyond the critical angle), so it is integrated:
@@ -157,7 +157,7 @@ def _rbar(n: float) -> float:
 def film_transmission(cos_in, cos_out, stack: FilmStack):
     """``((t_s, t_p) in, (t_s, t_p) out)``: the complex amplitudes (F1)-(F2) (module docstring)
     that replace ``t(theta; 1, n)`` for a ray entering at the external cosine ``cos_in``, and
-    one leaving at ``cos_out``, through the films of ``stack`` (a :class:`models.FilmStack` on
+    one leaving at ``cos_out``, through the films of ``stack`` (a :class:`scatterbench.models.FilmStack` on
     the coating's index, under the ambient 1).  Each crossing is computed at its own cosine
     only: the entrance from ``t_01``, the exit from ``t_10`` (F4: not from ``t_01``)."""
     c = np.asarray(cos_out, dtype=float)
@@ -189,7 +189,7 @@ def film_amplitudes(cos_ext, stack: FilmStack):
 def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> float:
     """``R-bar`` (F5): ``int_0^1 R_10 du``, ``u = sin^2 theta'`` inside the coating (``1/pi``
     normalization, as :func:`internal_hemispherical_reflectance`), for the films of
-    ``stack`` (a :class:`models.FilmStack` on the coating's real index) under the ambient 1.
+    ``stack`` (a :class:`scatterbench.models.FilmStack` on the coating's real index) under the ambient 1.
 
     ``R_10`` has square-root branch points where the ambient's and the coating's normal
     wavevectors vanish (the critical angle and internal grazing; the films' own are even in
@@ -199,7 +199,7 @@ def film_hemispherical_reflectance(stack: FilmStack, tol: float = 1e-14) -> floa
     times constants).  Composite 16-point Gauss-Legendre, panels doubled until two estimates
     differ by at most ``tol`` (interference fringes of thick films need many panels); at
     2^14 panels the last estimate stands (a film thousands of wavelengths thick, whose
-    fringes are finer than any measurement resolves), with an :class:`~models.cubature.AccuracyWarning`
+    fringes are finer than any measurement resolves), with an :class:`~scatterbench.models.cubature.AccuracyWarning`
     giving the last two estimates' difference.
     """
     n = stack.indices[1].real

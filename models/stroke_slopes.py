@@ -19,7 +19,7 @@ In slope space (``zeta = tan(alpha) (cos beta, sin beta)`` in stroke axes,
 the anisotropic Gaussian's exponent with the prefactor ``1 / m(beta)^2`` in
 place of ``1 / (m_par m_perp)``.  It is normalized (for each ``beta`` the
 radial integral is ``m(beta)^2 / 2``), and it is *not* the anisotropic Gaussian
-of :class:`models.AnisotropicGaussianSlopes`: their ratio is
+of :class:`scatterbench.models.AnisotropicGaussianSlopes`: their ratio is
 ``(m_perp/m_par) cos^2 beta + (m_par/m_perp) sin^2 beta``, and at zero slope the
 density depends on the direction of approach (``1/(pi m(beta)^2)``); the value
 at exactly ``zeta = 0`` is taken as its azimuthal mean
@@ -82,7 +82,7 @@ class StrokeSlopes(SlopeDistribution):
 
     ``P3 = exp(-(u/m_par)^2 - (v/m_perp)^2) / (pi m(beta)^2)`` with ``(u, v)``
     the slope along / across the strokes, which lie at ``stroke_angle`` from x.
-    ``m_par = m_perp = m`` is :class:`models.GaussianSlopes` with ``sigma = m``.
+    ``m_par = m_perp = m`` is :class:`scatterbench.models.GaussianSlopes` with ``sigma = m``.
     """
 
     m_parallel: float = width_param(

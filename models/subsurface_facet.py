@@ -5,7 +5,7 @@ Films on the coating (``coating_films``, ambient | films | coating).  Seed 000 E
 write the Jones matrix as ``q = diag(t_r) Q diag(t_i)`` with ``t_i = t(theta_i; 1, n)``
 (Eq. 14, entrance) and ``t_r = t(theta_r; 1, n)`` (Eq. 15, exit) for s and p, ``Q`` the
 facet's reflection in the internal rays' bases.  With films each factor becomes the
-stack's complex amplitude (:mod:`models.smooth_interface`, F1-F2):
+stack's complex amplitude (:mod:`scatterbench.models.smooth_interface`, F1-F2):
 
     t_i -> t_01(theta_i)                        entrance: ambient -> films -> coating
     t_r -> t_10(theta_r') kz_0 / kz_s           exit: coating -> films -> ambient,
@@ -16,7 +16,7 @@ difference reaches the Mueller matrix's U and V rows).  Nothing else of Eq. 2-13
 changes: planar films bend no ray, so the internal directions, the facet, its slope density
 and the Jacobian are the bare coating's.  Energy: ``|t|^2`` times the ``kz`` ratios are the
 stack's transmittances (F3), below ``1 - R`` with an absorbing film; reciprocity: the stack
-has ``t_10 kz_0 = t_01 kz_s`` (:mod:`models.thin_film`, (R)), so the exit factor at
+has ``t_10 kz_0 = t_01 kz_s`` (:mod:`scatterbench.models.thin_film`, (R)), so the exit factor at
 ``theta`` equals the entrance factor at ``theta`` and ``q`` keeps Eq. 16-18's symmetry
 (F4; tested to the bare model's tolerance).  Without films the model is seed 000's, the
 compiled kernel included.
@@ -57,14 +57,14 @@ class SubsurfaceFacetBRDF(FilmedCoating, _FacetModel):
         Real index ``n >= 1`` of the coating (1 reproduces :class:`FacetBRDF`).
     substrate : complex, math.inf or FilmStack
         Index of the flakes / substrate, ``n + ik`` with ``k >= 0``, ``inf``, or a
-        :class:`models.FilmStack` (films on the flakes, seen from the coating: e.g.
+        :class:`scatterbench.models.FilmStack` (films on the flakes, seen from the coating: e.g.
         mica flakes with a TiO2 film).
     shadowing : str
         ``"none"`` (seed 000), ``"smith"`` or ``"smith-correlated"``
-        (:mod:`models.shadowing`), evaluated inside the coating with the refracted
+        (:mod:`scatterbench.models.shadowing`), evaluated inside the coating with the refracted
         directions: the facets mask the internal rays.
     coating_films : Films or None
-        Thin films on the coating's top surface (:class:`models.Films`: layers from the
+        Thin films on the coating's top surface (:class:`scatterbench.models.Films`: layers from the
         ambient down, and the wavelength), on the index ``coating``: e.g. an anti-reflection
         film.  ``None`` (default): the bare coating of seed 000.  Module docstring: the
         films' complex transmission amplitudes replace Eq. 14-15's ``t(theta; 1, n)``.

@@ -7,9 +7,9 @@ index of whatever the light arrives from (the ambient, or a coating), given
 when coefficients are asked for, so a stack can stand wherever a substrate
 index can (``FacetBRDF(slopes=..., substrate=FilmStack(...))``).
 
-Conventions are those of :mod:`models.fresnel` (Born & Wolf, SCATMECH): with
+Conventions are those of :mod:`scatterbench.models.fresnel` (Born & Wolf, SCATMECH): with
 ``kz_j = n_j cos(theta_j) = sqrt(n_j^2 - (n_0 sin theta_0)^2)`` on the branch
-with ``Im >= 0`` (decaying, as :func:`models.fresnel._w`), each interface
+with ``Im >= 0`` (decaying, as :func:`scatterbench.models.fresnel._w`), each interface
 ``j | j+1`` has
 
     r_s = (kz_j - kz_j1) / (kz_j + kz_j1)
@@ -29,7 +29,7 @@ r02`` for both polarizations, phases included), so the recursion leaves such fil
 out: summed, they are 0/0 at exact grazing between media of one index, where
 ``1 + r01 r12 = 0``.  Likewise two media of one index meet in no interface
 (``r = 0``, ``t = 1``, set exactly).  A stack without films of positive thickness is
-the bare interface, evaluated by :func:`models.fresnel.fresnel_coefficients`
+the bare interface, evaluated by :func:`scatterbench.models.fresnel.fresnel_coefficients`
 itself.  A perfect-conductor substrate (``math.inf``) has ``r_s = -1``,
 ``r_p = +1``, ``t = 0`` at the last interface.
 
@@ -188,7 +188,7 @@ class FilmStack(Declared):
         return _rouard(kz, ns, thickness, self.wavelength_nm, r, t)
 
     def reflection_rs_k(self, cos_i, n_incident):
-        """``r_s`` and ``K = (r_s + r_p) / sin^2(theta)`` (:func:`models.fresnel.reflection_rs_k`).
+        """``r_s`` and ``K = (r_s + r_p) / sin^2(theta)`` (:func:`scatterbench.models.fresnel.reflection_rs_k`).
 
         ``K`` multiplies terms of order ``sin^2(theta)`` in the facet Jones matrix, so
         its rounding error there stays ~1e-16 however small ``sin``; at exactly
@@ -275,8 +275,8 @@ class FilmStack(Declared):
 class Films(Declared):
     """Thin films with no substrate of their own: a model places them on an index it holds.
 
-    ``coating_films=Films(...)`` of :class:`models.SubsurfaceFacetBRDF`,
-    :class:`models.SingleScatterBRDF` and :class:`models.DiffuseSubsurfaceBRDF` puts them on
+    ``coating_films=Films(...)`` of :class:`scatterbench.models.SubsurfaceFacetBRDF`,
+    :class:`scatterbench.models.SingleScatterBRDF` and :class:`scatterbench.models.DiffuseSubsurfaceBRDF` puts them on
     the coating's top surface (ambient | films | coating, :meth:`on` the model's
     ``coating``), so the coating's index is stated once, by the model.
 
@@ -316,7 +316,7 @@ class FilmedCoating:
 
 
 def check_films(name, value):
-    """The ``check`` of a ``coating_films`` parameter (:func:`models.params.param`): ``None``
+    """The ``check`` of a ``coating_films`` parameter (:func:`scatterbench.models.params.param`): ``None``
     (no films: the bare interface) or a :class:`Films`, which validated itself when built."""
     if value is None or isinstance(value, Films):
         return value

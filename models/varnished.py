@@ -11,17 +11,17 @@ and F uses the relative index ``n / n_v`` (Eq. 22).  ``F_in`` and ``F_out`` are
 the natural-light air-varnish reflectances at ``psi`` and ``Theta`` (Eq. 11-12
 with ``n_v`` and ``1/n_v``; ``F_out(Theta) = F_in(theta)`` by Stokes' relations).
 ``m(beta)`` is Eq. 19 with ``beta`` the azimuth of the (internal) bisector from
-the strokes (:mod:`models.stroke_slopes`).
+the strokes (:mod:`scatterbench.models.stroke_slopes`).
 
 ``convention="paper"`` is Eq. 24 as printed; ``"corrected"`` divides by ``4 pi``
-(the normalization of :class:`models.CookTorranceBRDF`) and applies the refraction
+(the normalization of :class:`scatterbench.models.CookTorranceBRDF`) and applies the refraction
 Jacobian below.  The old keywords ``normalization`` (``published``/``energy``) and
 ``solid_angle`` (``published``/``refracted``) map onto it when they agree; their
 mixed pairs are no model of their own: scale one of the two conventions by the
 exact ``4 pi`` (``(1 / (4 pi)) * VarnishedCookTorranceBRDF()`` is the energy
 normalization with the printed solid angle).
 
-What Eq. 24 leaves out (measured against :class:`models.SubsurfaceFacetBRDF`,
+What Eq. 24 leaves out (measured against :class:`scatterbench.models.SubsurfaceFacetBRDF`,
 see ``validation.checks.seed001``):
 
 * the solid-angle Jacobian of refraction.  Radiance crossing into a medium of
@@ -94,7 +94,7 @@ def _convention_from_old(given, current):
 def _slopes_from_strokes(given, current):
     """The old ``m_parallel`` / ``m_perpendicular`` / ``stroke_angle`` keywords (or ``m`` for
     both ``m`` values, as :class:`CookTorranceBRDF`'s), completed from the current slopes, as a
-    :class:`models.StrokeSlopes`."""
+    :class:`scatterbench.models.StrokeSlopes`."""
     given = dict(given)
     if "m" in given:
         if "m_parallel" in given or "m_perpendicular" in given:
@@ -116,7 +116,7 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
     Parameters
     ----------
     slopes : StrokeSlopes or GaussianSlopes
-        Brushed roughness of Eq. 19 (:class:`models.StrokeSlopes`: the paper's
+        Brushed roughness of Eq. 19 (:class:`scatterbench.models.StrokeSlopes`: the paper's
         ``m_parallel``, ``m_perpendicular`` and the strokes' azimuth); equal ``m``
         values, or ``GaussianSlopes(sigma=m)``, give isotropic Cook-Torrance roughness
         ``m``.  Old keywords ``m_parallel``, ``m_perpendicular``, ``stroke_angle`` (and ``m``
@@ -135,7 +135,7 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
     shadowing : "blinn" | "none" | "smith"
         Eq. 18 with the internal angles (Eq. 24's ``G(Psi, Theta)``), ``G = 1``, or the
         separable Smith ``G1 G1`` of the internal directions from the Beckmann ``Lambda``
-        of the model's roughness (:func:`models.cook_torrance.smith_slopes`; not in seed
+        of the model's roughness (:func:`scatterbench.models.cook_torrance.smith_slopes`; not in seed
         001).  Options a fused kernel does not cover run on this numpy path.
     """
 

@@ -1,4 +1,4 @@
-"""The coefficients of :func:`models.kernels.vector_math.atan2`'s polynomial, derived.
+"""The coefficients of :func:`scatterbench.models.kernels.vector_math.atan2`'s polynomial, derived.
 
     pip install mpmath && python scripts/fit_atan_coefficients.py
 

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-import models
+from scatterbench import models
 
 ILL = 'name = "x"\n[illumination]\ntheta_i_deg = 45\n'
 FACETS = ILL + '[substrate]\nindex = 1.5\ndistribution = "gaussian"\nsigma = 0.2\n'

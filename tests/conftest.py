@@ -13,8 +13,8 @@ def quick_report(tmp_path_factory):
 
     The browser test opens its page; the per-check tests read its checks; ``validate
     --quick`` run on the same context shares every check's result (each runs once)."""
-    from validation.report import write_report
-    from validation.report.core import Context
+    from scatterbench.validation.report import write_report
+    from scatterbench.validation.report.core import Context
 
     ctx = Context(quick=True)
     out = tmp_path_factory.mktemp("report")

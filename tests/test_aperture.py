@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models.geometry import scattered_direction, sp_basis, sp_basis_angles
-from models.polarization import is_physical, jones_to_mueller
+from scatterbench import models
+from scatterbench.models.geometry import scattered_direction, sp_basis, sp_basis_angles
+from scatterbench.models.polarization import is_physical, jones_to_mueller
 
 FACET = models.FacetBRDF(slopes=models.GaussianSlopes(0.05), substrate=1.37 + 7.62j)
 
@@ -147,7 +147,7 @@ def test_fast_node_algebra_equals_the_direct_route(inner, deg, resolution, backe
 def test_double_angle_of_nodes_near_and_on_the_normal():
     """Jones rotations whose components would underflow when squared are scaled first; a node
     exactly on the normal is in the nominal basis (c, s) = (1, 0)."""
-    from models.aperture import _double_angle_scaled
+    from scatterbench.models.aperture import _double_angle_scaled
 
     c = np.array([3e-170, 0.0, -2e-200, 1.0])
     s = np.array([4e-170, 0.0, 0.0, 0.0])

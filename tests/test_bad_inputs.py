@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import pytest
 from command_files import DATA, FACETS, FAST, HEAD, ILL, ROWS, SCENE
 
-from validation.cli import main
+from scatterbench.validation.cli import main
 
 HEAD_S = "theta_i_deg,theta_r_deg,phi_r_deg,brdf\n"  # incident from a sidecar
 STUDY = FAST[:-1]  # the studies have no --no-plots
@@ -600,16 +600,21 @@ cli_case(
     "--out o: not a folder",
     files={"o": "a file"},
 )
-cli_case("check model without a colon", ["check", "models"], "MODULE:NAME")
+cli_case("check model without a colon", ["check", "scatterbench.models"], "MODULE:NAME")
 cli_case("check model module missing", ["check", "nosuch_module_x:Model"], "nosuch_module_x")
-cli_case("check model name missing", ["check", "models:NoSuchModel"], "NoSuchModel")
-cli_case("check unknown check name", ["check", "models:FacetBRDF", "--checks", "nosuch"], "nosuch")
+cli_case("check model name missing", ["check", "scatterbench.models:NoSuchModel"], "NoSuchModel")
 cli_case(
-    "check json is a folder", ["check", "models:FacetBRDF", "--json", "sub"], "--json", files={"sub": None}
+    "check unknown check name", ["check", "scatterbench.models:FacetBRDF", "--checks", "nosuch"], "nosuch"
+)
+cli_case(
+    "check json is a folder",
+    ["check", "scatterbench.models:FacetBRDF", "--json", "sub"],
+    "--json",
+    files={"sub": None},
 )
 cli_case(
     "check json in a file's folder",
-    ["check", "models:FacetBRDF", "--json", "f/x.json"],
+    ["check", "scatterbench.models:FacetBRDF", "--json", "f/x.json"],
     "/f: not a folder",
     files={"f": "a file"},
 )
@@ -628,7 +633,7 @@ cli_case("fit without --scene", ["fit", "d.csv", "--out", "o"], "--scene")
 # ----------------------------------------------------------------------------- nightly history
 def _nightly(folder, **kw):
     """The nightly API on a tiny report (no section, no check): ``(code, stdout, stderr)``."""
-    from validation.report import nightly
+    from scatterbench.validation.report import nightly
 
     res = nightly(os.path.join(folder, "h"), quick=True, only=[], checks=[], **kw)
     return res[0], "\n".join(map(str, res)), ""
@@ -736,7 +741,7 @@ def _lock_held(folder):
     )
     try:
         assert holder.stdout.readline().strip() == "locked"
-        from validation.report import nightly
+        from scatterbench.validation.report import nightly
 
         try:
             nightly(os.path.join(folder, "h"), quick=True, only=[], checks=[], wait=0)
@@ -750,7 +755,7 @@ def _lock_held(folder):
 
 _HOLD_LOCK = """
 import sys, time
-from validation.atomic import file_lock
+from scatterbench.validation.atomic import file_lock
 with file_lock(sys.argv[1]):
     print("locked", flush=True)
     time.sleep(60)

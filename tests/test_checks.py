@@ -12,11 +12,18 @@ import math
 
 import pytest
 
-from validation.checks import registry
-from validation.checks.registry import CheckContext, CheckSpec, Finding, judge, registered, run_checks
-from validation.checks.table1 import compute_table1
-from validation.cli import main
-from validation.cli import validate as validate_cmd
+from scatterbench.validation.checks import registry
+from scatterbench.validation.checks.registry import (
+    CheckContext,
+    CheckSpec,
+    Finding,
+    judge,
+    registered,
+    run_checks,
+)
+from scatterbench.validation.checks.table1 import compute_table1
+from scatterbench.validation.cli import main
+from scatterbench.validation.cli import validate as validate_cmd
 
 QUICK = registered(quick=True)
 
@@ -264,9 +271,9 @@ def test_validate_command_exit_codes_and_strict_json(monkeypatch, tmp_path, caps
 
 
 def test_report_section_that_raises_is_a_failed_machinery_entry(monkeypatch):
-    import validation.report.build as build
-    from validation.report import build_report, sections
-    from validation.report.core import SectionSpec
+    import scatterbench.validation.report.build as build
+    from scatterbench.validation.report import build_report, sections
+    from scatterbench.validation.report.core import SectionSpec
 
     def broken(ctx):
         raise RuntimeError("drawing failed")

@@ -3,7 +3,7 @@
 import subprocess
 import sys
 
-from validation.cli import main
+from scatterbench.validation.cli import main
 
 
 def test_table1_and_models_commands(capsys):
@@ -14,5 +14,7 @@ def test_table1_and_models_commands(capsys):
 
 
 def test_console_script_runs():
-    r = subprocess.run([sys.executable, "-m", "validation.cli", "models"], capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "scatterbench.validation.cli", "models"], capture_output=True, text=True
+    )
     assert r.returncode == 0 and "SubsurfaceFacetBRDF" in r.stdout

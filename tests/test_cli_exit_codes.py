@@ -16,11 +16,11 @@ import time
 
 import pytest
 
-import references
+from scatterbench import references
 
 COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
-CLI = [sys.executable, "-m", "validation.cli"]
+CLI = [sys.executable, "-m", "scatterbench.validation.cli"]
 
 
 def _run(args, **kw):
@@ -43,9 +43,9 @@ def test_usage_error_exits_2():
 
 
 _BUG = (
-    "import sys, validation.cli.models as m\n"
+    "import sys, scatterbench.validation.cli.models as m\n"
     "m._cmd_models = lambda args: 1 / 0\n"
-    "from validation.cli import main\n"
+    "from scatterbench.validation.cli import main\n"
     "sys.exit(main(['models']))\n"
 )
 
@@ -103,7 +103,7 @@ def test_ctrl_c_during_a_fit_says_how_to_resume_in_one_line(tmp_path, workers):
 
 _NIGHTLY = (
     "import sys, time\n"
-    "from validation.report import nightly\n"
+    "from scatterbench.validation.report import nightly\n"
     "run = nightly(sys.argv[1], quick=True, only=[], checks=[], _after_build=lambda tmp: time.sleep(2))\n"
     "print(run.run_dir)\n"
     "sys.exit(run.code)\n"
@@ -140,7 +140,7 @@ def test_readme_documents_every_exit_code():
     """Cron users read the codes in the README: the table there lists exactly main()'s codes."""
     import re
 
-    import validation.cli as cli
+    import scatterbench.validation.cli as cli
 
     readme = open(
         os.path.join(os.path.dirname(os.path.dirname(__file__)), "README.md"), encoding="utf-8"

@@ -12,19 +12,18 @@ import pytest
 from scipy import integrate
 from test_thin_film import TMM_TOL, _absorbed
 
-import models
-import references
-from models import scene
-from models.cubature import AccuracyWarning
-from models.smooth_interface import (
+from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.models.cubature import AccuracyWarning
+from scatterbench.models.smooth_interface import (
     film_hemispherical_reflectance,
     film_transmission,
     internal_hemispherical_reflectance,
 )
-from models.thin_film import Films, FilmStack
-from validation.checks.common import random_geometries
-from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench.models.thin_film import Films, FilmStack
+from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 N = 1.5  # the clear coat
 LAM = 550.0

@@ -9,10 +9,9 @@ import sys
 import numpy as np
 import pytest
 
-import models
-import references
-from models import scene
-from validation.studies import colour as C
+from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.validation.studies import colour as C
 
 WL = C.WAVELENGTHS_NM
 

@@ -14,19 +14,18 @@ import kit_models as km
 import numpy as np
 import pytest
 
-import models
-import references
-from models.params import param
-from validation.checks.conformance import Conformant, as_model, conformance_checks
-from validation.checks.conformance_scatmech import (
+from scatterbench import models, references
+from scatterbench.models.params import param
+from scatterbench.validation.checks.conformance import Conformant, as_model, conformance_checks
+from scatterbench.validation.checks.conformance_scatmech import (
     EXPONENT_MAX,
     SCATMECH_ARITHMETIC,
     SCATMECH_FLOOR,
     matching_cases,
 )
-from validation.checks.registry import CheckContext
-from validation.checks.seed000 import scatmech_facet_model
-from validation.testing import (
+from scatterbench.validation.checks.registry import CheckContext
+from scatterbench.validation.checks.seed000 import scatmech_facet_model
+from scatterbench.validation.testing import (
     Contributed,
     check_model,
     contributed_section,
@@ -325,8 +324,8 @@ def test_scatmech_live_path(monkeypatch):
 
 # ----------------------------------------------------------------------------- CLI
 def _cli(*args, cwd=TESTS, env_path=""):
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (env_path, ROOT) if p)}
-    cmd = [sys.executable, "-m", "validation.cli", *args]
+    env = {**os.environ, "PYTHONPATH": env_path}
+    cmd = [sys.executable, "-m", "scatterbench.validation.cli", *args]
     return subprocess.run(cmd, capture_output=True, text=True, cwd=cwd, env=env, timeout=600)
 
 
@@ -357,7 +356,7 @@ def test_cli_check_exit_codes(tmp_path):
 
 def test_load_model_takes_instances_classes_and_factories():
     assert isinstance(load_model("kit_models:Lambertian"), km.Lambertian)
-    assert isinstance(load_model("models:FacetBRDF"), models.FacetBRDF)
+    assert isinstance(load_model("scatterbench.models:FacetBRDF"), models.FacetBRDF)
     with pytest.raises(ValueError, match="calling it with no arguments raised TypeError"):
         load_model("kit_models:Lambertian.brdf")
 
@@ -400,13 +399,13 @@ def test_example_package_is_contributed(installed_example):
     listed = _cli("models", env_path=installed_example)
     assert listed.returncode == 0 and "lambert-specular = lambert_specular:LambertSpecular" in listed.stdout
     code = (
-        "from validation.studies.stability import _default_targets, sweep_model, edge_instances\n"
-        "from validation.testing import contributed_models\n"
+        "from scatterbench.validation.studies.stability import _default_targets, sweep_model, edge_instances\n"
+        "from scatterbench.validation.testing import contributed_models\n"
         "c = contributed_models(); assert [x.name for x in c] == ['lambert-specular'], c\n"
         "names = [n for n, _ in _default_targets() if n]; assert names == ['lambert-specular'], names\n"
         "m = dict(_default_targets())['lambert-specular']; print(len(edge_instances(m)), sweep_model(m, energy=True))\n"
     )
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join((installed_example, ROOT))}
+    env = {**os.environ, "PYTHONPATH": installed_example}
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip() == "1 []"  # in the sweep, with no finding
@@ -416,7 +415,7 @@ def test_example_package_is_contributed(installed_example):
 
 def test_example_package_own_tests_pass(installed_example):
     """The README's 'Validate your own model' flow: the example's own pytest, green."""
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join((installed_example, ROOT))}
+    env = {**os.environ, "PYTHONPATH": installed_example}
     cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", os.path.join(EXAMPLE, "tests")]
     r = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=EXAMPLE, timeout=600)
     assert r.returncode == 0, r.stdout + r.stderr

@@ -1,6 +1,6 @@
 """Cook-Torrance with Smith shadowing-masking (issue 15): ``shadowing="smith"`` beside Blinn's.
 
-Mapping: seed 001's ``m`` is the rms slope ``sigma`` of :class:`models.GaussianSlopes`
+Mapping: seed 001's ``m`` is the rms slope ``sigma`` of :class:`scatterbench.models.GaussianSlopes`
 (Beckmann ``alpha = m``), so corrected Cook-Torrance with Smith G is the exposed facet
 model with ``GaussianSlopes(sigma=m)`` and ``shadowing="smith"`` (M00).
 """
@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models.cook_torrance import smith_slopes
-from models.shadowing import lambda_gaussian, smith_g1
-from validation.checks.common import random_geometries
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.models.cook_torrance import smith_slopes
+from scatterbench.models.shadowing import lambda_gaussian, smith_g1
+from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 
 def _geometries(n=3000, seed=3):

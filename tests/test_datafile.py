@@ -6,8 +6,8 @@ import os
 import numpy as np
 import pytest
 
-import references
-from validation.fitting.datafile import DataFileError, load_data, write_data
+from scatterbench import references
+from scatterbench.validation.fitting.datafile import DataFileError, load_data, write_data
 
 SCATMECH = references.data_path("scatmech_flake_measurement.csv")
 HEAD = "theta_i_deg,theta_r_deg,phi_r_deg,brdf,incident\n"

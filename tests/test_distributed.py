@@ -10,15 +10,14 @@ import command_files
 import numpy as np
 import pytest
 
-import models
-import references
-from models import scene
-from models.base import Model
-from models.params import param
-from validation.cli import main
-from validation.fitting.compare import compare_fits
-from validation.fitting.datafile import load_data
-from validation.fitting.executors import (
+from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.models.base import Model
+from scatterbench.models.params import param
+from scatterbench.validation.cli import main
+from scatterbench.validation.fitting.compare import compare_fits
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.executors import (
     DaskExecutor,
     ProcessExecutor,
     SerialExecutor,
@@ -27,11 +26,11 @@ from validation.fitting.executors import (
     _local_cores,
     kernel_threads,
 )
-from validation.fitting.fitspec import fitspec_from
-from validation.fitting.likelihood import Likelihood
-from validation.fitting.recovery import recovery_study, subsample
-from validation.fitting.settings import ChainSettings
-from validation.studies.stability import classify, sweep
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.recovery import recovery_study, subsample
+from scatterbench.validation.fitting.settings import ChainSettings
+from scatterbench.validation.studies.stability import classify, sweep
 
 COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
@@ -181,7 +180,7 @@ def test_stability_command_rejects_a_bad_worker_count(capsys):
 @pytest.mark.parametrize("command", ["fit", "stability"])
 def test_an_unreachable_scheduler_is_an_input_error(command, monkeypatch, tmp_path, capsys):
     """No scheduler at the address: ``error: scheduler: ...``, exit 2 (not an internal error)."""
-    from validation.fitting import executors
+    from scatterbench.validation.fitting import executors
 
     monkeypatch.setattr(executors, "SCHEDULER_TIMEOUT", 2)
     flags = ["--scheduler", "tcp://127.0.0.1:1"]

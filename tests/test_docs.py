@@ -20,8 +20,7 @@ from urllib.parse import unquote, urlsplit
 
 import pytest
 
-import models
-import validation
+from scatterbench import models, validation
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
@@ -42,13 +41,11 @@ def site(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("docs")
     src, out = tmp / "docs", tmp / "html"
     shutil.copytree(DOCS, src, ignore=shutil.ignore_patterns(*GENERATED))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
     start = time.perf_counter()
     proc = subprocess.run(
         [sys.executable, "-m", "sphinx", "-W", "-b", "html", "-q", str(src), str(out)],
         capture_output=True,
         text=True,
-        env=env,
         timeout=1200,
     )
     seconds = time.perf_counter() - start
@@ -69,7 +66,7 @@ def test_api_reference_covers_every_public_name(site):
     out, _ = site
     generated = out / "api" / "generated"
     for cls in models.Model.registry:  # every model class has its page, with its parameter table
-        page = generated / f"models.{cls.__name__}.html"
+        page = generated / f"scatterbench.models.{cls.__name__}.html"
         assert page.is_file(), cls.__name__
         text = page.read_text(encoding="utf-8")
         if cls is not models.Sum:
@@ -77,8 +74,8 @@ def test_api_reference_covers_every_public_name(site):
         for p in cls.parameters():
             assert p.name in text, (cls.__name__, p.name)
     for name in models.__all__:
-        assert (generated / f"models.{name}.html").is_file(), name
-    pages = "".join(p.read_text(encoding="utf-8") for p in generated.glob("validation.*.html"))
+        assert (generated / f"scatterbench.models.{name}.html").is_file(), name
+    pages = "".join(p.read_text(encoding="utf-8") for p in generated.glob("scatterbench.validation.*.html"))
     for name in validation.__all__:
         obj = getattr(validation, name)
         assert f'id="{obj.__module__}.{name}"' in pages, name

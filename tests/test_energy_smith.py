@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models.shadowing import smith_lambda
-from validation.checks import registry
-from validation.checks.registry import CheckContext
-from validation.checks.shadowing import AlbedoCurve, conductor_albedo_curves
-from validation.numerics.energy import TAIL_TOL, exposed_reflectance, hit_fraction, tail_radius
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.models.shadowing import smith_lambda
+from scatterbench.validation.checks import registry
+from scatterbench.validation.checks.registry import CheckContext
+from scatterbench.validation.checks.shadowing import AlbedoCurve, conductor_albedo_curves
+from scatterbench.validation.numerics.energy import TAIL_TOL, exposed_reflectance, hit_fraction, tail_radius
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 SLOPES = [
     models.GGXSlopes(1e-4),

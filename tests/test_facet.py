@@ -5,10 +5,9 @@ import math
 import numpy as np
 import pytest
 
-import models
-import references
-from validation.numerics.flat import flat_coated_reflectance
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models, references
+from scatterbench.validation.numerics.flat import flat_coated_reflectance
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 
 def test_scatmech_reference_set_is_broad():

@@ -8,14 +8,13 @@ import math
 import numpy as np
 import pytest
 
-import models
-import references
-from models import modelset, scene
-from models.scene import binding
-from validation.fitting.datafile import load_data
-from validation.fitting.fitspec import fitspec_from
-from validation.fitting.likelihood import Likelihood
-from validation.fitting.recovery import subsample
+from scatterbench import models, references
+from scatterbench.models import modelset, scene
+from scatterbench.models.scene import binding
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.recovery import subsample
 
 PEARL = references.scene_path("pearlescent_mica_tio2.toml")
 THICKNESS = "substrate.film.layers[0].thickness_nm"

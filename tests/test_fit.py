@@ -7,17 +7,17 @@ import os
 import numpy as np
 import pytest
 
-import references
-from models import scene
-from validation.checks.fitting import InterruptAfter
-from validation.cli import main
-from validation.fitting.datafile import load_data
-from validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor
-from validation.fitting.fit import fingerprint, run_fit
-from validation.fitting.fitspec import FitSpecError, fitspec_from, parse_free
-from validation.fitting.likelihood import Likelihood
-from validation.fitting.recovery import subsample
-from validation.fitting.sampling import (
+from scatterbench import references
+from scatterbench.models import scene
+from scatterbench.validation.checks.fitting import InterruptAfter
+from scatterbench.validation.cli import main
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor
+from scatterbench.validation.fitting.fit import fingerprint, run_fit
+from scatterbench.validation.fitting.fitspec import FitSpecError, fitspec_from, parse_free
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.recovery import subsample
+from scatterbench.validation.fitting.sampling import (
     ChainSettings,
     CheckpointBackend,
     CheckpointError,
@@ -85,7 +85,7 @@ def test_scene_fit_table_and_log_prior_bounds():
 def test_masks_near_specular_and_boxes(coated, data):
     spec = fitspec_from(coated, ["sigma:0.01:1:log"], ["brdf=0.05"], near_specular_deg=5.0)
     keep = spec.mask(data)
-    from validation.fitting.fitspec import specular_distance
+    from scatterbench.validation.fitting.fitspec import specular_distance
 
     d = np.degrees(specular_distance(data.theta_i, data.theta_r, data.phi_r))
     assert np.array_equal(keep, d > 5.0) and 0 < (~keep).sum() < 40
@@ -236,7 +236,7 @@ def test_walkers_the_scene_refuses_get_minus_inf_and_leave_the_others_unchanged(
 def test_vectorized_sampler_equals_the_per_walker_one(coated, data):
     """emcee with vectorize=True (the likelihood's batch) runs the chain a per-walker
     log-probability runs, bit for bit."""
-    from validation.fitting.sampling import vectorized
+    from scatterbench.validation.fitting.sampling import vectorized
 
     lik = _small(coated, data, 20)
 
@@ -522,7 +522,7 @@ def test_the_data_sidecar_sets_the_aperture_and_the_choice_is_fixed_for_the_fit(
     would choose a coarser one, so ln L is smooth."""
     import dataclasses
 
-    import models
+    from scatterbench import models
 
     spec = fitspec_from(coated, ["sigma:0.01:1:log"], ["brdf=0.05"])
     d = subsample(data, 20)

@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-import models as S
-from models import float32_domain as fd
-from models.evaluation import raw_float32
-from models.kernels import common, drive
-from models.params import INDEX_MIN
-from validation.checks.common import random_geometries
-from validation.studies import tradeoff
+from scatterbench import models as S
+from scatterbench.models import float32_domain as fd
+from scatterbench.models.evaluation import raw_float32
+from scatterbench.models.kernels import common, drive
+from scatterbench.models.params import INDEX_MIN
+from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.studies import tradeoff
 
 G, X = S.GaussianSlopes, S.ExponentialSlopes
 TOP = math.radians(89.0)  # the bound is stated for polar angles up to 89 deg
@@ -183,7 +183,7 @@ def test_the_sine_error_of_the_kernels_is_the_stated_one():
     assert fd.SINE / 2 < err <= fd.SINE
 
 
-#: the float32 kernels' sine error (:func:`models.kernels.common.polar`): float64's
+#: the float32 kernels' sine error (:func:`scatterbench.models.kernels.common.polar`): float64's
 #: ``sqrt(1 - cos^2)`` is off by up to ``2^-26`` near normal incidence, rounding to float32
 #: adds ``EPS / 2``, a coating's Snell sine ``s / n`` another ``EPS / 2``
 KERNEL_SINE = fd.EPS + 2.0**-26

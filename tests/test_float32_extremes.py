@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models.evaluation import raw_float32
-from models.params import INDEX_MAX, INDEX_MIN
-from validation.checks.common import random_geometries
+from scatterbench import models
+from scatterbench.models.evaluation import raw_float32
+from scatterbench.models.params import INDEX_MAX, INDEX_MIN
+from scatterbench.validation.checks.common import random_geometries
 
 S = models
 HALF = 0.5 * math.pi

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from models.fresnel import (
+from scatterbench.models.fresnel import (
     critical_angle,
     fresnel_coefficients,
     fresnel_reflectance,

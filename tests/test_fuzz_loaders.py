@@ -15,11 +15,17 @@ from fuzz_kit import FUZZ, both_outcomes, mostly
 from hypothesis import given
 from hypothesis import strategies as st
 
-import references
-from models import scene
-from models.scene import SceneError
-from validation.fitting.datafile import COLUMNS, DataFileError, Dataset, load_data
-from validation.fitting.fitspec import FitSpec, FitSpecError, fitspec_from, parse_exclude, parse_free
+from scatterbench import references
+from scatterbench.models import scene
+from scatterbench.models.scene import SceneError
+from scatterbench.validation.fitting.datafile import COLUMNS, DataFileError, Dataset, load_data
+from scatterbench.validation.fitting.fitspec import (
+    FitSpec,
+    FitSpecError,
+    fitspec_from,
+    parse_exclude,
+    parse_free,
+)
 
 # ----------------------------------------------------------------------------- values a file may hold
 _scalars = st.one_of(

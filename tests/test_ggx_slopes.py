@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-import models
-from models.geometry import incident_direction, scattered_direction
-from validation.checks.seed000 import slope_conversion_errors, slope_normalization_errors
+from scatterbench import models
+from scatterbench.models.geometry import incident_direction, scattered_direction
+from scatterbench.validation.checks.seed000 import slope_conversion_errors, slope_normalization_errors
 
 DISTRIBUTIONS = [
     models.GGXSlopes(alpha=0.01),

@@ -6,10 +6,10 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-import models
-from models.base import Model
-from validation.numerics.energy import exposed_reflectance
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.models.base import Model
+from scatterbench.validation.numerics.energy import exposed_reflectance
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,7 @@ def test_anisotropic_uses_full_azimuth():
     assert not m.mirror_symmetric
     r = integrated_reflectance(m, 0.3, tol=1e-5)
     # perfect conductor, modest angle: every illuminated facet reflects upward -> close to H
-    from validation.numerics.energy import hit_fraction
+    from scatterbench.validation.numerics.energy import hit_fraction
 
     assert r.value <= hit_fraction(s, 0.3) + r.error
     assert r.value > 0.99
@@ -142,7 +142,7 @@ def test_the_rule_is_exact_to_degree_seven():
     """The integrator's rule (models.cubature's Genz-Malik, degree 7): every monomial u^a v^b
     with a + b <= 7 integrated exactly on one region, degree 8 not (its embedded estimate then
     reports the difference)."""
-    from models import cubature
+    from scatterbench.models import cubature
 
     def one_region(a, b):
         res = cubature.adaptive(
@@ -164,7 +164,7 @@ def test_rows_integrated_together_give_each_row_s_bits_alone():
     leaves the loop (its figures kept): each row's value, error, region count, cap flag and
     evaluations are those it gets integrated alone, bit for bit, whichever rows share the
     call, finish first, stop at the cap or hold a NaN."""
-    from models import cubature
+    from scatterbench.models import cubature
 
     # per row: a peak of width 10^-s at (0.3, 0.6), so the rows need very different refinement
     sharp = np.array([0.5, 1.0, 2.0, 3.0, 1.5])
@@ -210,7 +210,7 @@ def _cosine_reference(model, theta_i, tol):
     over ``(cos theta_r, phi_r)`` (``M00 c dc dphi``), a variable in which a lobe at the
     horizon is not squeezed as in ``sin^2``, on cells refined geometrically around the lobe
     (azimuthal width ``2 alpha cos(theta_i) / sin(theta_r)``, a facet's sideways tilt)."""
-    from models import cubature
+    from scatterbench.models import cubature
 
     tc, pc, w = model.lobe(theta_i)
 
@@ -267,7 +267,7 @@ def test_near_specular_lobes_at_the_ends_are_honest(model, theta_i):
 def test_lobe_cells_stay_bounded_for_any_width(width):
     """Breakpoints for a lobe of any width: at most two per doubling (the cap of 64), and
     reaching both ends of the domain whenever the width allows it (1e-16 and 1e-3 do)."""
-    from validation.numerics.integrate import MAX_DOUBLINGS, _breakpoints
+    from scatterbench.validation.numerics.integrate import MAX_DOUBLINGS, _breakpoints
 
     pts = _breakpoints(0.3, width, 0.0, 1.0)
     assert pts.size <= 2 * MAX_DOUBLINGS + 3 and pts[0] == 0.0 and pts[-1] == 1.0

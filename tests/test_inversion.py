@@ -7,13 +7,12 @@ import os
 import numpy as np
 import pytest
 
-import models
-import references
-from models import scene
-from validation.cli import main
-from validation.fitting.datafile import Dataset, load_data
-from validation.fitting.inversion import UnitSlopes, bootstrap, fit_curve, invert, probed_slopes
-from validation.fitting.likelihood import scene_for_data
+from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.validation.cli import main
+from scatterbench.validation.fitting.datafile import Dataset, load_data
+from scatterbench.validation.fitting.inversion import UnitSlopes, bootstrap, fit_curve, invert, probed_slopes
+from scatterbench.validation.fitting.likelihood import scene_for_data
 
 DATA = references.data_path("scatmech_flake_measurement.csv")
 COATED = references.scene_path("aluminium_flakes_clearcoat.toml")

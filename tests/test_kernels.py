@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models import kernel_specs
-from models.evaluation import backend
-from validation.checks.common import extreme_geometries, random_geometries
-from validation.checks.conformance_checks import _relative as relative_per_geometry
+from scatterbench import models
+from scatterbench.models import kernel_specs
+from scatterbench.models.evaluation import backend
+from scatterbench.validation.checks.common import extreme_geometries, random_geometries
+from scatterbench.validation.checks.conformance_checks import _relative as relative_per_geometry
 
 AL = 1.37 + 7.62j
 TOL = 1e-12
@@ -159,7 +159,7 @@ def test_model_sets_in_the_kernels():
 def _perturbed_set(model, rng, w=4):
     """``model`` as a set of ``w`` models, each real parameter scaled by a factor in [0.9, 1]
     and each finite index's real part by one in [1, 1.1] (staying in range), shape ``(w, 1)``."""
-    from models import modelset
+    from scatterbench.models import modelset
 
     leaves = {}
     for path, (v, kind) in modelset.scalar_leaves(model).items():
@@ -182,7 +182,7 @@ def _perturbed_set(model, rng, w=4):
 def test_random_model_sets_equal_the_numpy_reference_and_their_elements(model):
     """A set of every kernel's models (random parameters) against numpy within 1e-12, and
     each element equal, bit for bit, to the single model with its values."""
-    from models import modelset
+    from scatterbench.models import modelset
 
     rng = np.random.default_rng(3)
     mset, leaves = _perturbed_set(model, rng)
@@ -245,7 +245,7 @@ def test_float32_kernels_and_their_error():
 def test_cache_directory_is_writable_and_keyed_by_the_sources(tmp_path, monkeypatch):
     import os
 
-    from models import kernels
+    from scatterbench.models import kernels
 
     d = kernels.cache_dir()
     assert os.path.basename(d) == f"scatterbench-{kernels._source_hash()}"
@@ -270,8 +270,8 @@ def test_one_compiled_specialization_per_entry_and_precision():
     """Read-only angles, a small call, a scalar call and a large one reach each entry point
     with the same argument types (no read-only array type, no ``Literal[int](0)``): each
     other type compiled every kernel again, ~10 s on a cold cache
-    (:meth:`models.kernels.Compiled.call`, :func:`models.kernels.drive.run_one`)."""
-    from models.kernels import drive, vector
+    (:meth:`scatterbench.models.kernels.Compiled.call`, :func:`scatterbench.models.kernels.drive.run_one`)."""
+    from scatterbench.models.kernels import drive, vector
 
     frozen = np.linspace(0.1, 1.2, 2048)
     frozen.flags.writeable = False

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models import smooth_interface
+from scatterbench import models
+from scatterbench.models import smooth_interface
 
 
 def test_diffuse_subsurface_set_runs_one_quadrature_per_distinct_coating(monkeypatch):

@@ -5,8 +5,8 @@ import re
 
 import pytest
 
-import models
-from models.params import SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN
+from scatterbench import models
+from scatterbench.models.params import SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN
 
 RANGE = "^" + re.escape(f"m must be a finite real number in [{SLOPE_WIDTH_MIN:g}, {SLOPE_WIDTH_MAX:g}]; got ")
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-import models
+from scatterbench import models
 
 
 @pytest.mark.parametrize(

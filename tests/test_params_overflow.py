@@ -2,8 +2,8 @@
 
 import pytest
 
-import models
-from models.params import check_real
+from scatterbench import models
+from scatterbench.models.params import check_real
 
 
 @pytest.mark.parametrize("big", [10**400, -(10**400)])

@@ -13,11 +13,18 @@ import warnings
 import numpy as np
 import pytest
 
-import models
-from models import slopes as S
-from models.params import INDEX_MAX, INDEX_MIN, SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN, check_index, check_real
-from models.stroke_slopes import StrokeSlopes
-from validation.studies import stability
+from scatterbench import models
+from scatterbench.models import slopes as S
+from scatterbench.models.params import (
+    INDEX_MAX,
+    INDEX_MIN,
+    SLOPE_WIDTH_MAX,
+    SLOPE_WIDTH_MIN,
+    check_index,
+    check_real,
+)
+from scatterbench.models.stroke_slopes import StrokeSlopes
+from scatterbench.validation.studies import stability
 
 _TI = np.array([0.0, 0.3, 0.3, 1.2, math.pi / 2 - 1e-9])
 _TR = np.array([0.0, 0.3, 0.5, 1.2, 0.3])

@@ -12,8 +12,8 @@ import types
 import numpy as np
 import pytest
 
-import models
-from validation.checks.conformance_scatmech import scatmech_tolerance
+from scatterbench import models
+from scatterbench.validation.checks.conformance_scatmech import scatmech_tolerance
 
 #: how far Mitsuba may differ: float32 on its side (SCATMECH's limits are the registry's own,
 #: validation.checks.conformance_scatmech.SCATMECH_TOL)

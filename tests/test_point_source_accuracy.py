@@ -9,10 +9,10 @@ import warnings
 import numpy as np
 import pytest
 
-import models
-import models.point_source as point_source
-from models import cubature
-from models.point_source import AUTO_FACTOR, AccuracyWarning
+import scatterbench.models.point_source as point_source
+from scatterbench import models
+from scatterbench.models import cubature
+from scatterbench.models.point_source import AUTO_FACTOR, AccuracyWarning
 
 S = models
 #: the references are refined this much further than the tolerance under test
@@ -155,7 +155,7 @@ def test_a_model_that_cannot_rotate_by_an_array_is_rotated_node_by_node():
     1e-12, with the same evaluations), refined to ``tol``, and within ``tol`` of a reference
     refined 100 times further.  The lobe is narrow against the spread: the cubature, not the
     first try, settles most geometries."""
-    from validation.checks.conformance import as_model
+    from scatterbench.validation.checks.conformance import as_model
 
     inner = S.FacetBRDF(slopes=S.AnisotropicGaussianSlopes(0.05, 0.08, 0.4), substrate=2.29 + 3.37j)
     plain = S.PointSourceBRDF(model=inner, distance=3.0)

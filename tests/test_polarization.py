@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from models.polarization import (
+from scatterbench.models.polarization import (
     coherency_eigenvalues,
     ellipsometric,
     is_physical,
@@ -77,7 +77,7 @@ def test_stokes_takes_names_angles_and_real_vectors():
 
 def test_a_model_refuses_a_nan_incident_angle():
     """``scattered_stokes`` goes through :func:`stokes`: no all-NaN result from 'linear:nan'."""
-    import models
+    from scatterbench import models
 
     with pytest.raises(ValueError, match="polarization linear:<deg>"):
         models.FacetBRDF().scattered_stokes(0.5, 0.5, 0.0, "linear:nan")

@@ -6,9 +6,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import models
-from models.polarization import coherency_eigenvalues
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench import models
+from scatterbench.models.polarization import coherency_eigenvalues
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 angle = st.floats(0.0, math.radians(89.99))
 azimuth = st.floats(-2 * math.pi, 2 * math.pi)

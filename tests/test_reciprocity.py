@@ -5,10 +5,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import models
-from models.base import Model
-from validation.checks.common import facet_suite
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench import models
+from scatterbench.models.base import Model
+from scatterbench.validation.checks.common import facet_suite
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 
 def test_facet_models_are_reciprocal(rng):
@@ -88,8 +88,8 @@ def test_the_reversed_paths_of_a_model_set_equal_those_built_one_by_one():
     """An anisotropic model's reversed paths need the sample turned by pi - phi_r per geometry:
     one model set of the turns when ``rotated`` takes an array, else one model per geometry;
     both give the same bits (Mueller and Jones), and the set is what the shipped models take."""
-    from models.base import rotated_set
-    from validation.numerics.reciprocity import _reversed
+    from scatterbench.models.base import rotated_set
+    from scatterbench.validation.numerics.reciprocity import _reversed
 
     s = models.AnisotropicGGXSlopes(alpha_x=0.05, alpha_y=0.3, rotation=0.4)
     m = models.SubsurfaceFacetBRDF(slopes=s, coating=1.5, substrate=1.37 + 7.62j)

@@ -6,16 +6,16 @@ import os
 import numpy as np
 import pytest
 
-import references
-from models import scene
-from validation.cli import main
-from validation.fitting.compare import compare_fits, seed003_pairing
-from validation.fitting.datafile import load_data
-from validation.fitting.executors import ProcessExecutor
-from validation.fitting.fitspec import fitspec_from
-from validation.fitting.likelihood import Likelihood
-from validation.fitting.recovery import recovery_study, subsample
-from validation.fitting.settings import ChainSettings
+from scatterbench import references
+from scatterbench.models import scene
+from scatterbench.validation.cli import main
+from scatterbench.validation.fitting.compare import compare_fits, seed003_pairing
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.executors import ProcessExecutor
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.recovery import recovery_study, subsample
+from scatterbench.validation.fitting.settings import ChainSettings
 
 COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")

@@ -15,15 +15,15 @@ import threading
 import numpy as np
 import pytest
 
-import references
-from models import scene
-from validation.atomic import LockHeld, atomic_write_json, file_lock, strict_json
-from validation.cli import main
-from validation.fitting.datafile import load_data, write_data
-from validation.fitting.fitspec import FitSpecError, fitspec_from
-from validation.fitting.likelihood import Likelihood
-from validation.report import nightly
-from validation.studies.scenes import P_FLOOR, _plot_scan, scan, scene_csv
+from scatterbench import references
+from scatterbench.models import scene
+from scatterbench.validation.atomic import LockHeld, atomic_write_json, file_lock, strict_json
+from scatterbench.validation.cli import main
+from scatterbench.validation.fitting.datafile import load_data, write_data
+from scatterbench.validation.fitting.fitspec import FitSpecError, fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.report import nightly
+from scatterbench.validation.studies.scenes import P_FLOOR, _plot_scan, scan, scene_csv
 
 COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")
@@ -215,7 +215,7 @@ def test_a_corrupt_previous_night_is_said_and_the_one_before_is_compared(tmp_pat
 
 
 def test_report_says_when_its_previous_results_cannot_be_read(tmp_path, capsys, monkeypatch):
-    import validation.report.build as build
+    import scatterbench.validation.report.build as build
 
     out = tmp_path / "r"
     out.mkdir()

@@ -12,8 +12,9 @@ import sys
 import markupsafe
 import pytest
 
-import models.facet
-from validation.report import build_report, nightly
+import scatterbench.models.facet as facet
+from scatterbench import models
+from scatterbench.validation.report import build_report, nightly
 
 
 def _cells(page, key):
@@ -71,13 +72,13 @@ def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):
     assert os.path.realpath(os.path.join(hist, "latest")) == os.path.realpath(run1)
 
     # Break the model: flip the sign of the facet's s reflection coefficient.
-    real = models.facet.reflection_rs_k
+    real = facet.reflection_rs_k
 
     def broken(c, m):
         rs, k = real(c, m)
         return -rs, k
 
-    monkeypatch.setattr(models.facet, "reflection_rs_k", broken)
+    monkeypatch.setattr(facet, "reflection_rs_k", broken)
     with models.backend("numpy"):  # the patched function is the numpy path's (kernels: models.kernels)
         code, reg, run2, _ = nightly(hist, stamp="2026-01-02T000000Z", **kw)
     assert code != 0 and reg
@@ -87,7 +88,7 @@ def test_nightly_history_regression_and_kill(tmp_path, monkeypatch):
         res2 = json.load(fh)
     red = [c["name"] for c in res2["checks"] if c["status"] == "fail"]
     assert any("SCATMECH" in n for n in red)
-    monkeypatch.setattr(models.facet, "reflection_rs_k", real)
+    monkeypatch.setattr(facet, "reflection_rs_k", real)
 
     # A run killed before its commit point leaves latest and the history untouched.
     before = sorted(os.listdir(os.path.join(hist, "runs")))
@@ -134,7 +135,7 @@ def _reachable_names(tree, start):
 def test_sections_compute_without_drawing_and_functions_are_short():
     """Each section module's compute (and every helper it uses) neither draws nor tabulates;
     no function of the report package is longer than 80 lines."""
-    from validation.report import sections
+    from scatterbench.validation.report import sections
 
     root = pathlib.Path(sections.__file__).parent.parent
     for spec in sections.SECTIONS:
@@ -154,8 +155,8 @@ def test_section_data_is_frozen_and_renders_the_reported_numbers(quick_report):
     numbers results.json holds (sections whose work the checks already did: cheap to redo)."""
     import matplotlib.pyplot as plt
 
-    from validation.report import sections
-    from validation.report.core import Section
+    from scatterbench.validation.report import sections
+    from scatterbench.validation.report.core import Section
 
     _, results, ctx = quick_report
     specs = {s.id: s for s in sections.SECTIONS}
@@ -177,9 +178,9 @@ def test_stability_findings_grouped_by_model_kind_and_verdict():
     """One row per model x kind x verdict: the counts add up to every finding, the worst is the
     group's largest magnitude (with its parameters and geometry), each reason is shown once per
     group, not once per finding, and every finding stays in results.json."""
-    from validation.report.core import Section, render_html
-    from validation.report.sections import stability
-    from validation.studies.stability import Finding
+    from scatterbench.validation.report.core import Section, render_html
+    from scatterbench.validation.report.sections import stability
+    from scatterbench.validation.studies.stability import Finding
 
     def finding(model, kind, value, k):
         return Finding(model, f"{model}(sigma={k})", kind, value, f"theta_i = {k} deg", {"value": value})
@@ -230,10 +231,10 @@ def test_speed_section_shows_the_peer_timings_as_measured():
     """The peers' table is references/data/peer_timings.json (benchmarks/peers.py), with the run
     that measured it (date, machine, load, threads) and ratios from its own numbers; nothing
     quoted from elsewhere, no per-call figure set against a per-geometry one."""
-    import references
-    from validation.report.core import Section
-    from validation.report.sections import speed
-    from validation.studies.tradeoff import KnobResult, Point
+    from scatterbench import references
+    from scatterbench.validation.report.core import Section
+    from scatterbench.validation.report.sections import speed
+    from scatterbench.validation.studies.tradeoff import KnobResult, Point
 
     table = references.peer_timings()
     rows, run = speed._peers()

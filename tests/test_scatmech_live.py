@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-import models
+from scatterbench import models
 
 scm = pytest.importorskip("pySCATMECH.brdf")
 
@@ -55,8 +55,8 @@ def test_comparison_scenes_at_the_truth_reproduce_their_scatmech_generators(scen
     import os
     import sys
 
-    import references
-    from models import scene
+    from scatterbench import references
+    from scatterbench.models import scene
 
     sys.path.insert(0, os.path.join(os.path.dirname(references.__file__), "scripts"))
     import make_scatmech_paint_data as mk

@@ -8,10 +8,9 @@ import re
 import numpy as np
 import pytest
 
-import models
-import references
-from models import scene
-from validation.cli import main
+from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.validation.cli import main
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = references.scene_paths()
@@ -350,7 +349,7 @@ def test_cook_torrance_scene_convention_errors(extra_sub, message):
 
 
 def test_one_assembly_measures_once(monkeypatch):
-    from models.scene import decisions
+    from scatterbench.models.scene import decisions
 
     calls = []
     real = decisions._deviation

@@ -11,11 +11,10 @@ import pytest
 from fuzz_kit import both_outcomes, mostly
 from hypothesis import strategies as st
 
-import models
-import references
-from models import scene
-from models.scene import SceneError
-from validation.fitting.fitspec import ALIASES
+from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.models.scene import SceneError
+from scatterbench.validation.fitting.fitspec import ALIASES
 
 ILL = 'name = "x"\n[illumination]\ntheta_i_deg = 30\nwavelength_nm = 550\n'
 GGX = '[substrate]\nindex = 1.5\ndistribution = "ggx"\nalpha = 0.1\n'

@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models.cook_torrance import fresnel_real_printed
-from validation.checks import seed001 as c
-from validation.numerics.energy import exposed_reflectance
-from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench import models
+from scatterbench.models.cook_torrance import fresnel_real_printed
+from scatterbench.validation.checks import seed001 as c
+from scatterbench.validation.numerics.energy import exposed_reflectance
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 IRON = 2.29 + 3.37j
 

@@ -5,10 +5,9 @@ import math
 import numpy as np
 import pytest
 
-import models
-import references
-from validation.checks import seed001 as c
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench import models, references
+from scatterbench.validation.checks import seed001 as c
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 BASE = c.energy_published(models.VarnishedCookTorranceBRDF())
 

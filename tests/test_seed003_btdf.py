@@ -5,16 +5,16 @@ import math
 import numpy as np
 import pytest
 
-import models
-from validation.checks import seed003 as c3
-from validation.checks.fig1 import (
+from scatterbench import models
+from scatterbench.validation.checks import seed003 as c3
+from scatterbench.validation.checks.fig1 import (
     EFFECTIVE_INDEX_DEG,
     effective_index,
     fit_effective_index,
     peak_angle,
     sin_mean_angles,
 )
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 
 def test_scatmech_btdf():

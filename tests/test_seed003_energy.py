@@ -5,9 +5,9 @@ import math
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import models
-from validation.checks import seed003 as c3
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.validation.checks import seed003 as c3
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 
 @settings(max_examples=10, deadline=None)

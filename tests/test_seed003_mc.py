@@ -5,11 +5,10 @@ import math
 import numpy as np
 import pytest
 
-import models
-import references
-from models import scene
-from models.geometry import incident_direction
-from validation.checks import seed003 as c3
+from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.models.geometry import incident_direction
+from scatterbench.validation.checks import seed003 as c3
 
 KW = dict(slopes=models.ExponentialSlopes(0.5), coating=1.5, phase=models.HenyeyGreenstein(0.3), rho=0.3)
 G = c3._GEOM

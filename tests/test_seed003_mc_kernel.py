@@ -10,8 +10,8 @@ import os
 import numpy as np
 import pytest
 
-import models
-from models.kernels import montecarlo
+from scatterbench import models
+from scatterbench.models.kernels import montecarlo
 
 _DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 _spec = importlib.util.spec_from_file_location(

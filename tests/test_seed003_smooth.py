@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-import models
-from validation.checks import seed003 as c3
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.validation.checks import seed003 as c3
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 
 @pytest.mark.parametrize("g", [-0.95, -0.5, 0.0, 0.3, 0.8, 0.95])

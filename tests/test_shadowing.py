@@ -8,9 +8,8 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-import models
-import validation
-from models.shadowing import (
+from scatterbench import models, validation
+from scatterbench.models.shadowing import (
     LambdaTable,
     lambda_direct,
     lambda_gaussian,
@@ -19,7 +18,7 @@ from models.shadowing import (
     smith_g1,
     smith_lambda,
 )
-from validation.checks.common import random_geometries
+from scatterbench.validation.checks.common import random_geometries
 
 TABLE_TOL = 1e-10
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-import models
-from validation.checks.common import slope_conversion_errors, slope_normalization_errors
+from scatterbench import models
+from scatterbench.validation.checks.common import slope_conversion_errors, slope_normalization_errors
 
 DISTS = [
     models.ExponentialSlopes(sigma=0.2, coverage=0.8),

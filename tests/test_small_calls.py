@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-import models
-from models import evaluation
+from scatterbench import models
+from scatterbench.models import evaluation
 
 MODELS = [
     models.FacetBRDF(slopes=models.GaussianSlopes(0.3)),

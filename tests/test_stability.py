@@ -6,10 +6,16 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-import models
-from models.base import Model
-from models.params import param
-from validation.studies.stability import classify, edge_geometries, edge_instances, load_accepted, sweep
+from scatterbench import models
+from scatterbench.models.base import Model
+from scatterbench.models.params import param
+from scatterbench.validation.studies.stability import (
+    classify,
+    edge_geometries,
+    edge_instances,
+    load_accepted,
+    sweep,
+)
 
 
 @pytest.fixture(scope="module")

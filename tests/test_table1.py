@@ -2,8 +2,8 @@
 
 import pytest
 
-import references
-from validation.checks.table1 import compute_table1, format_table1
+from scatterbench import references
+from scatterbench.validation.checks.table1 import compute_table1, format_table1
 
 
 @pytest.fixture(scope="module")

@@ -10,11 +10,10 @@ import math
 import numpy as np
 import pytest
 
-import models
-import references
-from models.fresnel import fresnel_coefficients
-from models.thin_film import FilmStack, TabulatedIndex
-from validation.checks.common import random_geometries
+from scatterbench import models, references
+from scatterbench.models.fresnel import fresnel_coefficients
+from scatterbench.models.thin_film import FilmStack, TabulatedIndex
+from scatterbench.validation.checks.common import random_geometries
 
 # Ours and tmm are both float64 transfer-matrix products over at most 4 films with |r|, |t|
 # <= 2.11 in the 400 cases: they differ by round-off, measured worst 6.2e-14 (~280 eps, a
@@ -134,7 +133,7 @@ def test_zero_thickness_film_is_the_bare_interface(n0, film, sub):
     """Both polarizations, phases included (TIR beyond 53 deg for 1.5 -> 1.2): the stack
     (which leaves zero-thickness films out) and the recursion summing such a film, which
     must give the same by the identity (r01 + r12) / (1 + r01 r12) = r02."""
-    from models.thin_film import _bottom, _rouard, _w
+    from scatterbench.models.thin_film import _bottom, _rouard, _w
 
     c = np.cos(np.linspace(0, math.pi / 2, 181))[:-1]  # the recursion is 0/0 at exact grazing
     got = FilmStack(layers=((film, 0.0),), substrate=sub, wavelength_nm=600.0).coefficients(c, n0)

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-import models
-from validation.atomic import atomic_write_json
-from validation.cli import main
-from validation.studies import tradeoff
-from validation.studies.tradeoff import (
+from scatterbench import models
+from scatterbench.validation.atomic import atomic_write_json
+from scatterbench.validation.cli import main
+from scatterbench.validation.studies import tradeoff
+from scatterbench.validation.studies.tradeoff import (
     MIN_BATCHES,
     MIN_WORK,
     KnobResult,
@@ -104,7 +104,7 @@ def test_atomic_write_keeps_previous_on_failure(tmp_path):
     atomic_write_json(p, {"a": 1})
     with pytest.raises(TypeError):
         atomic_write_json(p, {"a": object()})  # not serializable
-    from validation.atomic import _temp_beside
+    from scatterbench.validation.atomic import _temp_beside
 
     with pytest.raises(RuntimeError):
         with _temp_beside(p) as tmp:
@@ -127,7 +127,7 @@ def test_every_knob_has_an_independent_reference_and_improves(results):
 
 
 def test_scene_tol_picks_settings_that_meet_it(tmp_path, capsys):
-    import references
+    from scatterbench import references
 
     path = [p for p in references.scene_paths() if "point_source" in p][0]
     assert main(["scene", path, "--out", str(tmp_path), "--tol", "1e-6"]) == 0
@@ -249,7 +249,7 @@ def test_precision_knob_is_unavailable_with_its_reason_without_a_float32_kernel(
 
 
 def test_scene_precision_is_decided_and_measured_on_the_scenes_model(monkeypatch):
-    from validation.studies import scenes
+    from scatterbench.validation.studies import scenes
 
     notes = []
     assert scenes._choose_precision(NO_KERNEL[0], 1e-3, notes) == "float64"

@@ -1,5 +1,5 @@
-"""The vectorized loops (:mod:`models.kernels.vector`) and their call-free math
-(:mod:`models.kernels.vector_math`): the same bits as the scalar loop, compiled to SIMD
+"""The vectorized loops (:mod:`scatterbench.models.kernels.vector`) and their call-free math
+(:mod:`scatterbench.models.kernels.vector_math`): the same bits as the scalar loop, compiled to SIMD
 instructions, and the polynomials within 2 ulp of the C library."""
 
 import math
@@ -12,9 +12,9 @@ import pytest
 from numba import njit
 from test_kernels import CONFIGS, _geometries
 
-import models
-from models.kernels import Compiled, drive, vector
-from models.kernels.vector_math import REDUCED_MAX, atan2, exp_neg, hypot, sincos, sqrt
+from scatterbench import models
+from scatterbench.models.kernels import Compiled, drive, vector
+from scatterbench.models.kernels.vector_math import REDUCED_MAX, atan2, exp_neg, hypot, sincos, sqrt
 
 #: test_kernels' configurations, and Cook-Torrance under strokes (its azimuth's cosine and
 #: sine are parameter rows)
@@ -82,7 +82,7 @@ def test_vector_loop_model_sets_and_broadcast_angles(model):
 
 
 def test_models_take_the_vector_loop_and_agree_with_numpy():
-    """Large calls of a vectorized model run :mod:`~models.kernels.vector` and stay within
+    """Large calls of a vectorized model run :mod:`~scatterbench.models.kernels.vector` and stay within
     test_kernels' 1e-12 of the numpy reference (relative to M00)."""
     from test_kernels import TOL, _relative
 
@@ -96,8 +96,9 @@ def test_models_take_the_vector_loop_and_agree_with_numpy():
 
 _PROBE = """
 import re
-import numpy as np, models
-from models.kernels import Compiled, drive, vector
+import numpy as np
+from scatterbench import models
+from scatterbench.models.kernels import Compiled, drive, vector
 for m in (models.FacetBRDF(), models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
     Compiled(m, *m._kernel_spec()).run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
 drive.run(0, np.zeros(4), np.zeros(4), np.zeros(4), np.ones((drive.PARAM_ROWS, 1)),
@@ -113,7 +114,7 @@ for name, fn in (("lanes", vector.lanes), ("scalar", drive.run_range)):
 # the next process, which called them instead of inlining them, and its Cook loops stayed
 # scalar (6 vector loops instead of 8; 0.12 instead of 0.065 us per geometry)
 _EARLIER = """
-from models.kernels import common, cook
+from scatterbench.models.kernels import common, cook
 cook.fresnel_average(0.5, 1.5, 0.1, False)
 common.stroke_d(0.1, 0.2, 0.9, 0.3, 0.3, 1.0, 0.0)
 """
@@ -122,11 +123,11 @@ common.stroke_d(0.1, 0.2, 0.9, 0.3, 0.3, 1.0, 0.0)
 def test_the_lanes_are_vectorized_loops(tmp_path):
     """In a process that compiles the vector loop (its IR is inspected: a function loaded
     from the cache has none), after an earlier process filled the cache with some of the
-    kernels' helpers: :func:`models.kernels.vector.lanes` holds LLVM's vectorized loops
+    kernels' helpers: :func:`scatterbench.models.kernels.vector.lanes` holds LLVM's vectorized loops
     (their ``vector.body`` blocks, on ``<N x double>`` values), one per facet slope kind,
     single scattering, diffuse and Cook-Torrance loop; the scalar loop of
-    :mod:`~models.kernels.drive` has none.  Fails when a change puts a call or an exception
-    back in a kernel the vector path takes, or caches a helper again (:mod:`models.kernels`)."""
+    :mod:`~scatterbench.models.kernels.drive` has none.  Fails when a change puts a call or an exception
+    back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     subprocess.run([sys.executable, "-c", _EARLIER], env=env, check=True)
     res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
@@ -211,15 +212,15 @@ def test_hypot_within_two_ulp(scale):
 
 
 def test_only_the_entry_points_are_cached():
-    """Every numba function of :mod:`models.kernels` but the entry points Python calls is
-    compiled without the on-disk cache (the rule and its reason: :mod:`models.kernels`), and
-    every entry caches in :func:`models.kernels.cache_dir`."""
+    """Every numba function of :mod:`scatterbench.models.kernels` but the entry points Python calls is
+    compiled without the on-disk cache (the rule and its reason: :mod:`scatterbench.models.kernels`), and
+    every entry caches in :func:`scatterbench.models.kernels.cache_dir`."""
     import importlib
     import pkgutil
 
     from numba.core.registry import CPUDispatcher
 
-    import models.kernels
+    import scatterbench.models.kernels as kernels
 
     entries = {
         "drive": {"run", "run_parallel", "run_checked", "run_one", "angles_ok"},
@@ -230,8 +231,8 @@ def test_only_the_entry_points_are_cached():
     }
     seen = 0
     # every module of the package, so that a new one is held to the rule too
-    for name in (info.name for info in pkgutil.iter_modules(models.kernels.__path__)):
-        mod = importlib.import_module(f"models.kernels.{name}")
+    for name in (info.name for info in pkgutil.iter_modules(kernels.__path__)):
+        mod = importlib.import_module(f"scatterbench.models.kernels.{name}")
         for attr, fn in vars(mod).items():
             if isinstance(fn, CPUDispatcher) and fn.py_func.__module__ == mod.__name__:
                 seen += 1

@@ -5,31 +5,31 @@ and returns ``(..., 4, 4)`` Mueller matrices in 1/sr, in the psps basis of DESIG
 model; it need not import scatterbench.  The kit runs every conformance check on it and
 names what fails, with the measured value, the limit and the worst geometry::
 
-    from validation.testing import check_model
+    from scatterbench.validation.testing import check_model
     report = check_model(MyBRDF())
     print(report)            # the table; report.passed, report.results
 
 and in a test suite, one test per (model, check)::
 
-    from validation.testing import parametrize_with_checks
+    from scatterbench.validation.testing import parametrize_with_checks
 
     @parametrize_with_checks([MyBRDF(), MyBRDF(roughness=0.5)])
     def test_conformance(model, check):
         check(model)
 
-The checks (:func:`validation.checks.conformance.conformance_checks`): ``broadcasting``
+The checks (:func:`scatterbench.validation.checks.conformance.conformance_checks`): ``broadcasting``
 (scalar, 0-d, array, broadcast and chunked calls agree), ``dtypes`` (float32 and integer
 angles), ``out_argument`` (``out=``, if ``mueller`` takes one), ``finite`` and
 ``nonnegative`` (M00 >= 0) on a grid of extreme geometries, ``realizable`` (coherency
 eigenvalues), ``reciprocity`` (M00, Mueller and, with ``jones``, Jones), ``energy`` (integrated reflectance at a
 ladder of incidences), ``determinism`` (the same seed gives the same numbers),
-``pickle``, ``parameter_extremes`` (a :class:`models.Model`'s declared parameters at their
+``pickle``, ``parameter_extremes`` (a :class:`scatterbench.models.Model`'s declared parameters at their
 edges) and ``scatmech`` (agreement with an equivalent SCATMECH model).  A check that needs
 a capability the model does not have is skipped with a note, not failed.
 
 Optional attributes a model may set (:data:`ATTRIBUTES`): ``reciprocal``, ``energy_bound``,
 ``stochastic``, ``seed``, ``scatmech``, ``transmission``, ``jones``, ``rotated``, ``lobe``,
-``mirror_symmetric``.  A :class:`models.Model` subclass has most of them already.
+``mirror_symmetric``.  A :class:`scatterbench.models.Model` subclass has most of them already.
 
 Models other packages register in the ``scatterbench.models`` entry-point group
 (:func:`contributed_models`) appear in ``scatterbench models``, the stability sweep and the
@@ -41,8 +41,13 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 
-from validation.checks.conformance import ATTRIBUTES, ModelCheck, conformance_checks, run_model_checks
-from validation.checks.registry import CheckContext, check_record, tally
+from scatterbench.validation.checks.conformance import (
+    ATTRIBUTES,
+    ModelCheck,
+    conformance_checks,
+    run_model_checks,
+)
+from scatterbench.validation.checks.registry import CheckContext, check_record, tally
 
 __all__ = [
     "ATTRIBUTES",
@@ -140,8 +145,8 @@ def check_model(model, *, checks=None, quick=False, label=None, ctx=None) -> Mod
 
     Examples
     --------
-    >>> import models
-    >>> from validation.testing import check_model
+    >>> from scatterbench import models
+    >>> from scatterbench.validation.testing import check_model
     >>> report = check_model(models.FacetBRDF(), checks=["reciprocity"])
     >>> [(r.name, r.status) for r in report.results]
     [('reciprocity: M00', 'pass'), ('reciprocity: Mueller', 'pass'), ('reciprocity: Jones', 'pass')]
@@ -300,8 +305,8 @@ def contributed_models() -> list[Contributed]:
 
 def format_contributed(contributed=None) -> str:
     """The contributed models as ``scatterbench models`` lists them: entry name, ``module:attr``,
-    distribution, and the model's parameters (a :class:`models.Model`) or docstring summary."""
-    import models
+    distribution, and the model's parameters (a :class:`scatterbench.models.Model`) or docstring summary."""
+    from scatterbench import models
 
     entries = contributed_models() if contributed is None else contributed
     lines = [f"\nContributed models (entry-point group {ENTRY_POINT_GROUP}): {len(entries) or 'none'}"]
@@ -334,8 +339,8 @@ def shipped_models() -> list[tuple[str, object]]:
     normalization, ``FacetBTDF``'s Eq. 37), the kit reports a finding with the reason
     ``accepted_findings.toml`` gives.
     """
-    import models
-    from validation.studies.stability import edge_instances
+    from scatterbench import models
+    from scatterbench.validation.studies.stability import edge_instances
 
     cheaper = {
         "RoughDiffuseBRDF": {"pairs": 20},

@@ -1,7 +1,7 @@
 """Sphinx helpers for the scatterbench site.
 
 * Every model class page (``models.Model`` subclasses) gets its declared-parameter table,
-  generated from :meth:`models.params.Declared.parameters` (so it follows the code), and the
+  generated from :meth:`scatterbench.models.params.Declared.parameters` (so it follows the code), and the
   paper equations and SCATMECH / Mitsuba 3 models it corresponds to (:data:`CORRESPONDENCE`).
 * ``.. sb-model-table::`` renders that correspondence for every model as one table.
 
@@ -57,7 +57,7 @@ CORRESPONDENCE = {
 
 
 def _model_classes():
-    import models
+    from scatterbench import models
 
     return list(models.Model.registry)
 
@@ -78,7 +78,7 @@ def _param_table(cls):
 
 
 def _append_model_info(app, what, name, obj, options, lines):
-    import models
+    from scatterbench import models
 
     if what != "class" or obj not in models.Model.registry:
         return  # scatterbench's own model classes only (contributed ones document themselves)
@@ -104,7 +104,7 @@ class ModelTable(SphinxDirective):
         for c in _model_classes():
             if c.__name__ in CORRESPONDENCE:
                 paper, scatmech, mitsuba = CORRESPONDENCE[c.__name__]
-                rows += [f"   * - :class:`models.{c.__name__}`", f"     - {paper}"]
+                rows += [f"   * - :class:`scatterbench.models.{c.__name__}`", f"     - {paper}"]
                 rows += [f"     - {scatmech}", f"     - {mitsuba}"]
         node = nodes.container()
         self.state.nested_parse(StringList(rows), self.content_offset, node)

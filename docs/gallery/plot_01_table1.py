@@ -5,8 +5,8 @@ Seed 000 Table I beside the paper
 The 27 integrated reflectances of Table I (Germer and Marx): aluminium flakes,
 silicon and a perfect conductor under coatings of index 1.0, 1.5 and 2.0, with
 exponential slopes of rms slope 0, 0.1 and 0.2, at 60 deg incidence. Each entry
-is :func:`validation.integrated_reflectance` of
-:class:`models.SubsurfaceFacetBRDF` (the flat column is the closed form), computed
+is :func:`scatterbench.validation.integrated_reflectance` of
+:class:`scatterbench.models.SubsurfaceFacetBRDF` (the flat column is the closed form), computed
 by the same function the Table I check and ``scatterbench table1`` use, and set
 beside the printed value and an independent calculation (SCATMECH's model
 integrated over facet slopes, or the model's own integral at sigma = 1e-3).
@@ -15,7 +15,7 @@ integrated over facet slopes, or the model's own integral at sigma = 1e-3).
 import matplotlib.pyplot as plt
 import numpy as np
 
-from validation.checks import table1
+from scatterbench.validation.checks import table1
 
 rows, seconds = table1.compute_table1()
 print(table1.format_table1(rows))

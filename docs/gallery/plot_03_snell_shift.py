@@ -2,12 +2,12 @@
 Seed 003 Fig. 1: the Snell shift of facet transmission
 ======================================================
 
-The in-plane BTDF of :class:`models.FacetBTDF` (Gaussian slopes, n = 1.5) at
+The in-plane BTDF of :class:`scatterbench.models.FacetBTDF` (Gaussian slopes, n = 1.5) at
 60 deg incidence peaks near the Snell angle for narrow slope distributions and
 moves toward the incident direction as they widen; the BTDF-weighted mean
 transmitted angle follows ``sin(theta_t) = sin(theta_i) / n_eff`` with an
 effective index below n. The peak and ``n_eff`` are computed by the functions of
-the Fig. 1 check (:mod:`validation.checks.fig1`), for three of its sigmas.
+the Fig. 1 check (:mod:`scatterbench.validation.checks.fig1`), for three of its sigmas.
 """
 
 import math
@@ -15,9 +15,9 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
-import models
-from models.geometry import signed_inplane
-from validation.checks.fig1 import N_INDEX, THETA_I, effective_index, peak_angle
+from scatterbench import models
+from scatterbench.models.geometry import signed_inplane
+from scatterbench.validation.checks.fig1 import N_INDEX, THETA_I, effective_index, peak_angle
 
 sigmas = (0.05, 0.3, 1.0)
 snell = math.degrees(math.asin(math.sin(THETA_I) / N_INDEX))

@@ -4,19 +4,23 @@ Seed 001: published versus energy-normalized Cook-Torrance, and the point source
 
 Eq. 7-8 of Hébert, Emmel and Hersch have no ``1/pi`` in D and no 4 in the
 denominator: the published BRDF is exactly 4 pi times the energy-normalized
-one, so its albedo exceeds 1. :class:`models.CookTorranceBRDF` keeps both
+one, so its albedo exceeds 1. :class:`scatterbench.models.CookTorranceBRDF` keeps both
 (``convention="paper"`` and ``"corrected"``). The published albedos are the seed 001
-check's (:func:`validation.checks.seed001.published_albedos`), the energy-normalized
-ones the report section's (:func:`validation.report.sections.seed001.ct_albedo_rows`),
+check's (:func:`scatterbench.validation.checks.seed001.published_albedos`), the energy-normalized
+ones the report section's (:func:`scatterbench.validation.report.sections.seed001.ct_albedo_rows`),
 for the paper's iron plate (m = 0.03, iron ``2.29+3.37i``, Blinn shadowing).
 """
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-import references
-from validation.checks.seed001 import iron_plate_models, point_source_collimated_error, published_albedos
-from validation.report.sections.seed001 import ct_albedo_rows, point_source_scan
+from scatterbench import references
+from scatterbench.validation.checks.seed001 import (
+    iron_plate_models,
+    point_source_collimated_error,
+    published_albedos,
+)
+from scatterbench.validation.report.sections.seed001 import ct_albedo_rows, point_source_scan
 
 published = published_albedos()
 rows = ct_albedo_rows(published)  # the report section's table: the energy-normalized albedos beside them
@@ -40,10 +44,10 @@ fig.tight_layout()
 
 # %%
 # The point-source effect. The iron plate under a point source whose disc
-# spans the printed incidence range (:func:`models.point_source_geometry`),
-# in-plane, beside the collimated BRDF (:class:`models.PointSourceBRDF`, the
+# spans the printed incidence range (:func:`scatterbench.models.point_source_geometry`),
+# in-plane, beside the collimated BRDF (:class:`scatterbench.models.PointSourceBRDF`, the
 # exact superposition of Eq. 28; the report section's scan,
-# :func:`validation.report.sections.seed001.point_source_scan`).
+# :func:`scatterbench.validation.report.sections.seed001.point_source_scan`).
 _, varnished = iron_plate_models()  # references.IRON_PLATE under its varnish, as printed
 lo, hi = references.IRON_PLATE["incidence_ranges_deg"][0]
 scan, _ = point_source_scan(varnished, lo, hi)  # the report section's scan

@@ -2,9 +2,9 @@
 The speed/accuracy trade: measured Pareto curves
 ================================================
 
-For each accuracy knob, :func:`validation.studies.tradeoff.study` evaluates a
+For each accuracy knob, :func:`scatterbench.validation.studies.tradeoff.study` evaluates a
 quantity at every setting, times it, and measures its error against an
-independent reference; :func:`~validation.studies.tradeoff.pareto` keeps the
+independent reference; :func:`~scatterbench.validation.studies.tradeoff.pareto` keeps the
 settings that no other setting beats on both cost and error. Quick settings
 (``scatterbench tradeoff --quick``). The seconds depend on the machine that
 built this page.
@@ -12,7 +12,7 @@ built this page.
 
 import matplotlib.pyplot as plt
 
-from validation.studies.tradeoff import choose, pareto, study
+from scatterbench.validation.studies.tradeoff import choose, pareto, study
 
 results = study(quick=True)
 fig, axes = plt.subplots(1, len(results), figsize=(4 * len(results), 3.6), squeeze=False)

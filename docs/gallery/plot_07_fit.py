@@ -13,13 +13,13 @@ intervals are indicative only; ``scatterbench fit`` runs to convergence.
 
 import matplotlib.pyplot as plt
 
-import references
-from models import scene
-from validation.fitting.datafile import load_data
-from validation.fitting.fit import corner_figure, predictive, predictive_figure, run_fit
-from validation.fitting.fitspec import fitspec_from
-from validation.fitting.likelihood import Likelihood
-from validation.fitting.settings import ChainSettings
+from scatterbench import references
+from scatterbench.models import scene
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.fit import corner_figure, predictive, predictive_figure, run_fit
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.settings import ChainSettings
 
 sc = scene.load(references.scene_path("aluminium_flakes_fit.toml"))
 data = load_data(references.data_path("scatmech_flake_measurement.csv"))

@@ -1,18 +1,18 @@
 """Compiled kernels: fused float64 (and float32) loops for the closed-form models (numba).
 
 One function per model evaluates one geometry in real arithmetic, with no temporaries
-(:mod:`~models.kernels.facet`, :mod:`~models.kernels.volume`, :mod:`~models.kernels.cook`,
-:mod:`~models.kernels.maxwell`, sharing :mod:`~models.kernels.common`);
-:mod:`~models.kernels.drive` loops it over flat arrays, serially for small calls and over
+(:mod:`~scatterbench.models.kernels.facet`, :mod:`~scatterbench.models.kernels.volume`, :mod:`~scatterbench.models.kernels.cook`,
+:mod:`~scatterbench.models.kernels.maxwell`, sharing :mod:`~scatterbench.models.kernels.common`);
+:mod:`~scatterbench.models.kernels.drive` loops it over flat arrays, serially for small calls and over
 the cores (``prange``) from :data:`PARALLEL_MIN` geometries on, writing the element-major
 ``(16, N)`` result directly.  Parameters are per element (a model set) or shared, so a
 likelihood evaluates all walkers of an emcee step in one call.  Float64 calls of the models
-whose kernels have no C library call left (:func:`~models.kernels.vector.vectorized`: the
+whose kernels have no C library call left (:func:`~scatterbench.models.kernels.vector.vectorized`: the
 facet reflection models and Maxwell-Beard with exponential, Gaussian or GGX slopes and no
 shadowing, single scattering, the diffuse subsurface, both Cook-Torrance forms without Smith
 shadowing) run
-:mod:`~models.kernels.vector`'s loops instead, which
-compile to SIMD instructions (:mod:`~models.kernels.vector_math`: polynomial cosines, sines,
+:mod:`~scatterbench.models.kernels.vector`'s loops instead, which
+compile to SIMD instructions (:mod:`~scatterbench.models.kernels.vector_math`: polynomial cosines, sines,
 exponentials and arctangents) and give the scalar loop's bits.
 
 The numpy implementation of every model stays the reference (``with models.backend("numpy")``);
@@ -27,10 +27,10 @@ edit to a shared helper recompiles the kernels that inline it (numba alone only 
 changes to the file of the function itself).
 
 Only the entry points that Python calls are cached (``run``, ``run_parallel``,
-``run_checked``, ``run_one`` and ``angles_ok`` of :mod:`~models.kernels.drive`, the first
-three of :mod:`~models.kernels.vector`, :mod:`~models.kernels.montecarlo`'s
-``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~models.kernels.aperture`'s
-``nodes`` and ``rotate_sum``, and :mod:`~models.kernels.disc`'s ``points``); a cached entry
+``run_checked``, ``run_one`` and ``angles_ok`` of :mod:`~scatterbench.models.kernels.drive`, the first
+three of :mod:`~scatterbench.models.kernels.vector`, :mod:`~scatterbench.models.kernels.montecarlo`'s
+``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~scatterbench.models.kernels.aperture`'s
+``nodes`` and ``rotate_sum``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``); a cached entry
 holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached
 function as object code, without the LLVM IR that inlining needs: an entry compiled in a
@@ -62,7 +62,7 @@ __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 #: ``fit`` command of ``benchmarks/fit_speed.py``, best of three runs each, 2 cores); small
 #: calls (<= 100 geometries) stay serial
 PARALLEL_MIN = 1024
-#: geometries from which a small call of a vectorized model takes :mod:`~models.kernels.vector`
+#: geometries from which a small call of a vectorized model takes :mod:`~scatterbench.models.kernels.vector`
 #: (below: the scalar loop, which needs no scratch)
 VECTOR_MIN = 16
 _HALF_PI = 0.5 * math.pi
@@ -137,7 +137,7 @@ class Compiled:
         The model (a single model, or a chunk of a model set whose array parameters are
         flat, one element per geometry).
     code : str
-        The kernel (:data:`models.kernels.drive.CODES`).
+        The kernel (:data:`scatterbench.models.kernels.drive.CODES`).
     rows : sequence
         The kernel's parameter rows in order: floats, or flat arrays of one length.
     options : sequence of int
@@ -201,9 +201,9 @@ class Compiled:
             out[:, sl] = buf
 
     def fast(self, theta_i, theta_r, phi_r, rows, precision="float64", out=None):
-        """The small-call path: up to :data:`models.evaluation.KERNEL_CHUNK` geometries given
+        """The small-call path: up to :data:`scatterbench.models.evaluation.KERNEL_CHUNK` geometries given
         as floats, ints, lists or float64/integer arrays that broadcast
-        (:func:`models.evaluation.small_angles`), evaluated in ``precision`` (``"float64"`` or
+        (:func:`scatterbench.models.evaluation.small_angles`), evaluated in ``precision`` (``"float64"`` or
         ``"float32"``), into ``out`` when given (a C-contiguous ``(rows, N)`` ndarray of that
         dtype); ``None`` for anything else or a bad angle (the general path then raises the
         error naming it)."""

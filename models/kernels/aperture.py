@@ -1,10 +1,10 @@
-"""The node algebra of :class:`models.DetectorAperture`, compiled: the quadrature nodes'
-directions, weights and analyzer rotations (:meth:`models.aperture._Frame.nodes`, the numpy
+"""The node algebra of :class:`scatterbench.models.DetectorAperture`, compiled: the quadrature nodes'
+directions, weights and analyzer rotations (:meth:`scatterbench.models.aperture._Frame.nodes`, the numpy
 reference the tests hold this to), and the weighted sum of the inner model's rotated
-matrices (:func:`models.aperture._rotate_rows_and_sum`).
+matrices (:func:`scatterbench.models.aperture._rotate_rows_and_sum`).
 
 Both run node-major (flat index ``k * n + g`` for node ``k`` of geometry ``g``), so the loop
-over geometries is innermost: it has no C library call (:func:`~models.kernels.vector_math.atan2`,
+over geometries is innermost: it has no C library call (:func:`~scatterbench.models.kernels.vector_math.atan2`,
 the ``sqrt`` intrinsic) and no reduction, and LLVM runs it on SIMD lanes; the per-geometry
 cosines and sines are taken once, before it.  The sum adds the nodes in order, as a loop over
 ``k`` in which every geometry's accumulators are updated at once.
@@ -24,7 +24,7 @@ def _double_angle(c, s):
     """``(cos 2x, sin 2x)`` of the angle of ``(c, s)``, both scaled first by the power of two
     that brings the larger near 1 (squares that would underflow near the normal: exact, and
     no division); ``(1, 0)`` for ``c = s = 0``, a node on the normal
-    (:func:`models.aperture._double_angle_scaled`)."""
+    (:func:`scatterbench.models.aperture._double_angle_scaled`)."""
     big = max(abs(c), abs(s))
     on_axis = big == 0.0
     scale = inverse_binade(1.0 if on_axis else big)

@@ -1,12 +1,12 @@
 """Scalar building blocks of the compiled kernels (numba; not cached themselves: the
-entries that inline them are, :mod:`models.kernels`).
+entries that inline them are, :mod:`scatterbench.models.kernels`).
 
 Every function here works on one geometry's scalars in real arithmetic, in the precision
 of its arguments: constants are written ``T(c)`` with ``T = type(x)`` so that the float32
 kernels compute in float32 and the float64 ones exactly as written.  Complex numbers are
 ``(re, im)`` pairs.  The formulas mirror the numpy implementation they are tested against
-(:mod:`models.fresnel`, :mod:`models.slopes`, :mod:`models.shadowing`,
-:func:`models.polarization.mueller16_from_jones`); comments say where they differ.
+(:mod:`scatterbench.models.fresnel`, :mod:`scatterbench.models.slopes`, :mod:`scatterbench.models.shadowing`,
+:func:`scatterbench.models.polarization.mueller16_from_jones`); comments say where they differ.
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ def polar_from(c, t):
 
 @njit(error_model="numpy", inline="always")
 def azimuth(p):
-    """``(cos p, sin p)`` of an azimuth (float64; :func:`~models.kernels.vector_math.sincos`,
+    """``(cos p, sin p)`` of an azimuth (float64; :func:`~scatterbench.models.kernels.vector_math.sincos`,
     the C library beyond its range)."""
     if abs(p) <= REDUCED_MAX:
         s, c = sincos(p)
@@ -132,7 +132,7 @@ def cdiv(a, b, c, d):
 def refraction_w(c, mr, mi):
     """``m^2`` and ``w = m cos(theta_t) = sqrt(m^2 - 1 + c^2)`` (principal branch) as
     ``(re, im)`` pairs, for cosine ``c`` and relative index ``m = mr + i mi``
-    (:mod:`models.fresnel`'s ``w``)."""
+    (:mod:`scatterbench.models.fresnel`'s ``w``)."""
     T = type(c)
     m2r = mr * mr - mi * mi
     m2i = mr * mi + mi * mr
@@ -143,7 +143,7 @@ def refraction_w(c, mr, mi):
 @njit(error_model="numpy", forceinline=True)
 def rs_k(c, mr, mi, pec):
     """``r_s`` and ``K = (r_s + r_p) / sin^2`` at cosine ``c`` for relative index ``m = mr + i mi``
-    (:func:`models.fresnel.reflection_rs_k`); ``pec``: a perfect conductor."""
+    (:func:`scatterbench.models.fresnel.reflection_rs_k`); ``pec``: a perfect conductor."""
     T = type(c)
     if pec:
         return T(-1.0), T(0.0), T(0.0), T(0.0)
@@ -162,14 +162,14 @@ def rs_k(c, mr, mi, pec):
 @njit(error_model="numpy", forceinline=True)
 def coating_cos(c, n):
     """Cosine of the refracted angle in a non-absorbing coating ``n`` from the external cosine
-    ``c`` (:func:`models.fresnel.coating_cos`: no cancellation near grazing)."""
+    ``c`` (:func:`scatterbench.models.fresnel.coating_cos`: no cancellation near grazing)."""
     T = type(c)
     return sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)
 
 
 @njit(error_model="numpy", forceinline=True)
 def coating_t(c, n):
-    """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`models.fresnel.coating_transmission`)."""
+    """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`scatterbench.models.fresnel.coating_transmission`)."""
     T = type(c)
     w = sqrt(n * n - T(1.0) + c * c)
     return T(2.0) * c / (c + w), T(2.0) * n * c / (n * n * c + w)
@@ -178,7 +178,7 @@ def coating_t(c, n):
 @njit(error_model="numpy", forceinline=True)
 def dielectric_transmittance(c, n):
     """``1 - F`` for natural light at cosine ``c`` entering a non-absorbing ``n >= 1``
-    (:func:`models.kernels.cook.fresnel_average` of a real index, in real arithmetic:
+    (:func:`scatterbench.models.kernels.cook.fresnel_average` of a real index, in real arithmetic:
     ``w = sqrt(n^2 - 1 + c^2)`` is real, so neither the complex root nor the complex
     divisions, whose branches a vector loop computes both of, are needed: with them LLVM's
     cost model kept the varnished Cook-Torrance loop scalar)."""
@@ -224,7 +224,7 @@ def p3(kind, zx, zy, sx, sy, rot, cov):
 @njit(error_model="numpy", forceinline=True)
 def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     """``exp(-tan^2 alpha / m(beta)^2) / m(beta)^2`` for a bisector ``h`` (seed 001 Eq. 8, 19;
-    :func:`models.stroke_slopes.stroke_d`); ``c``, ``s``: cosine and sine of the strokes' azimuth."""
+    :func:`scatterbench.models.stroke_slopes.stroke_d`); ``c``, ``s``: cosine and sine of the strokes' azimuth."""
     T = type(hx)
     a2 = T(1.0) / (m_par * m_par)
     if m_par == m_perp:
@@ -256,7 +256,7 @@ def lam_unit(kind, mu):
 
 @njit(error_model="numpy")
 def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
-    """Smith ``Lambda`` (:func:`models.shadowing.smith_lambda`) of the Gaussian and GGX
+    """Smith ``Lambda`` (:func:`scatterbench.models.shadowing.smith_lambda`) of the Gaussian and GGX
     families, isotropic or elliptical, for a direction (cosine, sine, azimuth)."""
     T = type(c)
     mu = abs(c) / s if s > T(0.0) else T(math.inf)
@@ -285,7 +285,7 @@ def smith_g(shadowing, kind, di, dio, sx, sy, rot):
 @njit(error_model="numpy", inline="always")
 def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     """The 16 Mueller elements (row-major) of a Jones matrix (Bohren & Huffman, as
-    :func:`models.polarization.mueller16_from_jones`)."""
+    :func:`scatterbench.models.polarization.mueller16_from_jones`)."""
     T = type(ssr)
     half = T(0.5)
     nss = ssr * ssr + ssi * ssi

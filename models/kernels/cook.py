@@ -1,6 +1,6 @@
-"""Cook-Torrance kernels (seed 001 Eq. 7-24): :class:`models.CookTorranceBRDF` and
-:class:`models.VarnishedCookTorranceBRDF`, one geometry per call, as
-:mod:`models.cook_torrance` and :mod:`models.varnished` compute them."""
+"""Cook-Torrance kernels (seed 001 Eq. 7-24): :class:`scatterbench.models.CookTorranceBRDF` and
+:class:`scatterbench.models.VarnishedCookTorranceBRDF`, one geometry per call, as
+:mod:`scatterbench.models.cook_torrance` and :mod:`scatterbench.models.varnished` compute them."""
 
 from __future__ import annotations
 
@@ -26,14 +26,14 @@ from .vector_math import sqrt
 #: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
 COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
 #: and the stroke azimuth's cosine and sine, taken once per model (no C library call per
-#: geometry: :mod:`models.kernels.vector` runs the loop on SIMD lanes)
+#: geometry: :mod:`scatterbench.models.kernels.vector` runs the loop on SIMD lanes)
 COOK_ROWS += ("stroke_cos", "stroke_sin")
 
 
 @njit(error_model="numpy")
 def fresnel_average(c, mr, mi, pec):
     """Natural-light reflectance ``(|r_s|^2 + |r_p|^2) / 2`` at cosine ``c`` for relative index
-    ``mr + i mi`` (:func:`models.cook_torrance.fresnel_average`)."""
+    ``mr + i mi`` (:func:`scatterbench.models.cook_torrance.fresnel_average`)."""
     T = type(c)
     if T(1e-300) > T(0.0):
         # float64: the perfect conductor and m = 1 (whose denominators vanish at grazing) are
@@ -65,10 +65,10 @@ def fresnel_average(c, mr, mi, pec):
 
 @njit(error_model="numpy", inline="always")
 def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
-    """``D G F`` of Eq. 7 (:func:`models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
+    """``D G F`` of Eq. 7 (:func:`scatterbench.models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
     and sines ``si``, ``sr``;
-    ``shadowing``: a code of :data:`models.kernel_specs.COOK_SHADOWING`.  Smith's ``G`` is that of
-    :func:`models.cook_torrance.smith_slopes`: the Gaussian of width ``m`` (equal ``m``
+    ``shadowing``: a code of :data:`scatterbench.models.kernel_specs.COOK_SHADOWING`.  Smith's ``G`` is that of
+    :func:`scatterbench.models.cook_torrance.smith_slopes`: the Gaussian of width ``m`` (equal ``m``
     values), else the anisotropic Gaussian ``(m_par, m_perp)`` rotated by the strokes' azimuth."""
     T = type(ci)
     hx = sr * cp - si
@@ -93,7 +93,7 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
 @njit(error_model="numpy", inline="always")
 def cook(geo, p, o):
     """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
-    convention, ``o[2]``: the shadowing (:data:`models.kernel_specs.COOK_SHADOWING`)."""
+    convention, ``o[2]``: the shadowing (:data:`scatterbench.models.kernel_specs.COOK_SHADOWING`)."""
     ti, tr, _, cp, sp = geo
     T = type(ti)
     half_pi = T(0.5 * math.pi)

@@ -1,7 +1,7 @@
-"""Facet kernels: reflection by facets under a smooth coating (seed 000; :class:`models.FacetBRDF`,
-:class:`models.SubsurfaceFacetBRDF`) and transmission into a rough dielectric (seed 003
-Sec. 2.4; :class:`models.FacetBTDF`), one geometry per call, as :mod:`models.facet` and
-:mod:`models.facet_btdf` compute them."""
+"""Facet kernels: reflection by facets under a smooth coating (seed 000; :class:`scatterbench.models.FacetBRDF`,
+:class:`scatterbench.models.SubsurfaceFacetBRDF`) and transmission into a rough dielectric (seed 003
+Sec. 2.4; :class:`scatterbench.models.FacetBTDF`), one geometry per call, as :mod:`scatterbench.models.facet` and
+:mod:`scatterbench.models.facet_btdf` compute them."""
 
 from __future__ import annotations
 
@@ -19,14 +19,14 @@ FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation",
 @njit(error_model="numpy", inline="always")
 def facet_jones(g, p, o):
     """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
-    Mueller matrix is the BRDF (:func:`models.facet.facet_jones`); ``g``: the geometry
-    (:func:`models.kernels.drive.geometry`)."""
+    Mueller matrix is the BRDF (:func:`scatterbench.models.facet.facet_jones`); ``g``: the geometry
+    (:func:`scatterbench.models.kernels.drive.geometry`)."""
     return facet_jones_at(g, polar(g[0]), polar(g[1]), p, o)
 
 
 @njit(error_model="numpy", inline="always")
 def facet_jones_at(g, pol_i, pol_r, p, o):
-    """:func:`facet_jones` given the polar angles' ``(cos, sin)`` (:func:`~models.kernels.common.polar`)."""
+    """:func:`facet_jones` given the polar angles' ``(cos, sin)`` (:func:`~scatterbench.models.kernels.common.polar`)."""
     ti, tr, _, cp, sp = g
     T = type(ti)
     n, sub_r, sub_i = p[0], p[1], p[2]
@@ -82,7 +82,7 @@ def facet_jones_at(g, pol_i, pol_r, p, o):
 
 @njit(error_model="numpy", inline="always")
 def facet(geo, p, o):
-    """:class:`models.FacetBRDF` and :class:`models.SubsurfaceFacetBRDF` at one geometry."""
+    """:class:`scatterbench.models.FacetBRDF` and :class:`scatterbench.models.SubsurfaceFacetBRDF` at one geometry."""
     a, b, c, d, e, f, g, h = facet_jones(geo, p, o)
     return mueller16(a, b, c, d, e, f, g, h)
 
@@ -104,7 +104,7 @@ def cross3(a, b):
 @njit(error_model="numpy")
 def transmission_factors(c, mr):
     """``t_s`` and ``(t_p - t_s) / sin^2`` of refraction at local cosine ``c`` into relative
-    index ``mr`` (zero beyond the critical angle), as :func:`models.facet_btdf.facet_transmission_jones`."""
+    index ``mr`` (zero beyond the critical angle), as :func:`scatterbench.models.facet_btdf.facet_transmission_jones`."""
     T = type(c)
     arg = mr * mr - T(1.0) + c * c
     if not arg > T(0.0):
@@ -153,7 +153,7 @@ def _btdf_element(ea, eb, v, a_in, a_out, cg, inv1, ts, delta):
 
 @njit(error_model="numpy", inline="always")
 def btdf(g, p, o):
-    """:class:`models.FacetBTDF` (``convention="paper"``) at one geometry."""
+    """:class:`scatterbench.models.FacetBTDF` (``convention="paper"``) at one geometry."""
     ti, tt, pt, _, _ = g
     T = type(ti)
     n = p[0]

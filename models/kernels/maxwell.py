@@ -1,6 +1,6 @@
-"""The Maxwell-Beard kernel (:class:`models.MaxwellBeardBRDF`): the facet term of
-:mod:`models.kernels.facet` times the shadowing/obscuration function, plus the Lambertian
-and volumetric terms, one geometry per call, as :mod:`models.maxwell_beard` computes them."""
+"""The Maxwell-Beard kernel (:class:`scatterbench.models.MaxwellBeardBRDF`): the facet term of
+:mod:`scatterbench.models.kernels.facet` times the shadowing/obscuration function, plus the Lambertian
+and volumetric terms, one geometry per call, as :mod:`scatterbench.models.maxwell_beard` computes them."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ MAXWELL_ROWS = FACET_ROWS + ("rho_d", "rho_v", "tau", "omega")
 
 @njit(error_model="numpy", inline="always")
 def shadow(si, ci, sr, cr, cp, sp, tau, omega):
-    """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`models.maxwell_beard.maxwell_beard_shadow`,
+    """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`scatterbench.models.maxwell_beard.maxwell_beard_shadow`,
     whose docstring derives the two ``atan2``) from the angles' sines and cosines."""
     T = type(si)
     hx, hy = sr * cp - si, sr * sp
@@ -37,7 +37,7 @@ def shadow(si, ci, sr, cr, cp, sp, tau, omega):
 def maxwell(geo, p, o):
     """Maxwell-Beard at one geometry; ``o[0]``: the slope kind, ``o[2]``: the facet Mueller
     matrix on the specular term.  No C library call: a loop over it runs on SIMD lanes
-    (:mod:`models.kernels.vector`)."""
+    (:mod:`scatterbench.models.kernels.vector`)."""
     ti, tr, _, cp, sp = geo
     T = type(ti)
     # the facet term takes the sines as sqrt(1 - cos^2) (:func:`polar`), the shadow the sines

@@ -1,6 +1,6 @@
-"""The Monte Carlo of :class:`models.RoughDiffuseBRDF` (seed 003 Sec. 2.5), compiled.
+"""The Monte Carlo of :class:`scatterbench.models.RoughDiffuseBRDF` (seed 003 Sec. 2.5), compiled.
 
-The numpy implementation (:meth:`models.RoughDiffuseBRDF._block`) evaluates every
+The numpy implementation (:meth:`scatterbench.models.RoughDiffuseBRDF._block`) evaluates every
 (geometry, facet pair) entry of a block as arrays and reduces them with ``mean`` and
 ``std``; here one loop per geometry walks the same facet pairs (the model's, drawn once
 from its seed: the random numbers are identical) and accumulates the mean and the spread
@@ -10,7 +10,7 @@ evaluated.  Where a geometry's estimates are so large that squares would overflo
 (``|x| >= safe``), the geometry is walked again with each element scaled by its largest
 magnitude, as the numpy path rescales its block.
 
-The facet refraction is :func:`models.kernels.facet.btdf_jones` (the FacetBTDF kernel's);
+The facet refraction is :func:`scatterbench.models.kernels.facet.btdf_jones` (the FacetBTDF kernel's);
 the tests hold this module to the numpy path within 1e-12 relative to ``M00``.
 """
 
@@ -35,7 +35,7 @@ _NO_BASIS = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 @njit(inline="always")
 def _ray_basis(k):
     """``(s, p)`` of ray ``k``: ``s = unit(z x k)``, ``+y`` along the z axis
-    (:func:`models.facet_btdf.ray_basis`)."""
+    (:func:`scatterbench.models.facet_btdf.ray_basis`)."""
     norm = math.sqrt(k[1] * k[1] + k[0] * k[0])
     if norm <= 1e-15:
         s = (0.0, 1.0, 0.0)
@@ -239,7 +239,7 @@ def estimate(ti, tr, pr, n_i, n_r, z, m, prm, safe, parallel):
 @njit(cache=True, parallel=True)
 def exit_transmittance(tr, pr, n_r, z, m, n):
     """``<w_r M_out[0, 0]>`` over the exit facets for flat directions ``(tr, pr)``
-    (:meth:`models.RoughDiffuseBRDF._exit_transmittance`; bases from :func:`_ray_basis`)."""
+    (:meth:`scatterbench.models.RoughDiffuseBRDF._exit_transmittance`; bases from :func:`_ray_basis`)."""
     out = np.empty(tr.size)
     for i in prange(tr.size):
         cr, sr, cp, sp = math.cos(tr[i]), math.sin(tr[i]), math.cos(pr[i]), math.sin(pr[i])

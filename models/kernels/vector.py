@@ -1,18 +1,18 @@
-"""The float64 loops that run on SIMD lanes: the kernels of :mod:`~models.kernels.drive`
+"""The float64 loops that run on SIMD lanes: the kernels of :mod:`~scatterbench.models.kernels.drive`
 over a block of geometries at a time, compiled so that the compiler vectorizes them.
 
-:func:`models.kernels.drive.run` calls a model's one-geometry function in a loop the
+:func:`scatterbench.models.kernels.drive.run` calls a model's one-geometry function in a loop the
 compiler keeps scalar: the function branches on the model and its options, calls the C
 library, and reads and writes several arrays the compiler must assume overlap.  Here, per
 block of :data:`VBLOCK` geometries:
 
 1. :func:`gather` copies the block's angles and parameters into one scratch
    array and takes the azimuths' cosines and sines there with the polynomial
-   :func:`~models.kernels.vector_math.sincos` (the C library beyond its range:
-   :func:`~models.kernels.common.azimuths`);
+   :func:`~scatterbench.models.kernels.vector_math.sincos` (the C library beyond its range:
+   :func:`~scatterbench.models.kernels.common.azimuths`);
 2. :func:`lanes` runs the kernel over the scratch: one loop per model and slope kind, with
    the code and options constants, so that the branches left are selects; no call remains
-   (the kernels use :mod:`~models.kernels.vector_math`, and ``error_model="numpy"`` lets a
+   (the kernels use :mod:`~scatterbench.models.kernels.vector_math`, and ``error_model="numpy"`` lets a
    division by zero give inf, as numpy's, instead of raising); all reads and writes are in
    the one scratch at fixed offsets, so no overlap test is needed;
 3. the block's result rows are copied to ``out``.
@@ -20,8 +20,8 @@ block of :data:`VBLOCK` geometries:
 The kernels are the same functions as the scalar loop's, so both give the same bits
 (``tests/test_vector_kernels.py``).  :func:`vectorized` says which models and options take this
 path.  The others keep C library calls that leave any loop scalar (FacetBTDF, Smith
-shadowing, anisotropic slopes, unit slopes); :class:`models.kernels.Compiled` runs them through
-:mod:`~models.kernels.drive`.
+shadowing, anisotropic slopes, unit slopes); :class:`scatterbench.models.kernels.Compiled` runs them through
+:mod:`~scatterbench.models.kernels.drive`.
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ def _row(sc, row, m):
 
 @njit(error_model="numpy", inline="always")
 def _geometry(sc, k):
-    """Geometry ``k`` of the scratch, as :func:`models.kernels.drive.geometry` gives it."""
+    """Geometry ``k`` of the scratch, as :func:`scatterbench.models.kernels.drive.geometry` gives it."""
     return _at(sc, _TI, k), _at(sc, _TR, k), _at(sc, _PR, k), _at(sc, _CP, k), _at(sc, _SP, k)
 
 
@@ -153,7 +153,7 @@ def _maxwell_lanes(sc, m, o):
 @njit(error_model="numpy")
 def gather(sc, ti, tr, pr, prm, lo, m):
     """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch: angles, the azimuth's
-    cosine and sine (:func:`~models.kernels.common.azimuths` over the block), and the
+    cosine and sine (:func:`~scatterbench.models.kernels.common.azimuths` over the block), and the
     parameters (a single model's repeated)."""
     a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
     for k in range(m):
@@ -181,7 +181,7 @@ def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
 
 @njit(cache=True, error_model="numpy")
 def run(code, ti, tr, pr, prm, iopt, out, start):
-    """:func:`models.kernels.drive.run` (same arguments, float64) on SIMD lanes."""
+    """:func:`scatterbench.models.kernels.drive.run` (same arguments, float64) on SIMD lanes."""
     n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
     # np.int64(0), not 0: numba gives a literal argument a specialization of its own
     # (Literal[int](0)), which compiled every kernel a second time
@@ -190,7 +190,7 @@ def run(code, ti, tr, pr, prm, iopt, out, start):
 
 @njit(cache=True, error_model="numpy")
 def run_checked(code, ti, tr, pr, prm, iopt, out):
-    """:func:`models.kernels.drive.run_checked` (same arguments, float64) on SIMD lanes."""
+    """:func:`scatterbench.models.kernels.drive.run_checked` (same arguments, float64) on SIMD lanes."""
     if not angles_ok(ti, tr, pr):
         return False
     run(code, ti, tr, pr, prm, iopt, out, np.int64(0))  # int64: see run
@@ -199,7 +199,7 @@ def run_checked(code, ti, tr, pr, prm, iopt, out):
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def run_parallel(code, ti, tr, pr, prm, iopt, out, start):
-    """:func:`run` with blocks of :data:`models.kernels.drive.BLOCK` geometries over the cores."""
+    """:func:`run` with blocks of :data:`scatterbench.models.kernels.drive.BLOCK` geometries over the cores."""
     n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
     for blk in prange((n + BLOCK - 1) // BLOCK):
         lo = blk * BLOCK

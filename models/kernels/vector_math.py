@@ -5,7 +5,7 @@ keeps any loop around it scalar: in the facet kernel those calls were a fifth of
 geometry's cost, and they stopped the whole loop from running on SIMD lanes.  The
 functions here are polynomials with no branch and no call, so a loop over geometries that
 uses them (and only arithmetic and ``sqrt`` besides) compiles to vector instructions
-(:mod:`models.kernels.vector`).
+(:mod:`scatterbench.models.kernels.vector`).
 
 :func:`sincos` uses Cody and Waite's reduction and Taylor series: ``x = k pi/2 + r`` with
 ``k`` the nearest integer to ``2x/pi`` and ``|r| <= pi/4``; ``pi/2`` is split in three
@@ -13,13 +13,13 @@ parts, the first two of 30 significant bits, so ``k * part`` is exact for ``|k| 
 and ``r`` is exact to about an ulp of ``x`` up to :data:`REDUCED_MAX`.  On ``|r| <= pi/4``
 the series of ``sin`` to ``r^17`` and of ``cos`` to ``r^16`` leave less than 1e-17 (the
 next terms).  Beyond :data:`REDUCED_MAX` (an azimuth of 1e6 rad) the result is wrong: the
-callers use the C library there (:func:`models.kernels.common.azimuth` for one value,
-:func:`models.kernels.common.azimuths` for an array).
+callers use the C library there (:func:`scatterbench.models.kernels.common.azimuth` for one value,
+:func:`scatterbench.models.kernels.common.azimuths` for an array).
 
 :func:`exp_neg` reduces ``-x = k ln 2 + r`` (``ln 2`` in two parts), ``|r| <= ln2 / 2``,
 takes the Taylor series of ``exp r`` to ``r^13`` (the next term: 4e-18) and scales by
 ``2^k`` built from its bits.  From ``x = 700`` on it is exactly zero, as the numpy path's
-:func:`models.slopes._exp_neg`.
+:func:`scatterbench.models.slopes._exp_neg`.
 
 
 :func:`atan2` takes ``t = min(|x|, |y|) / max(|x|, |y|)`` in [0, 1] and, above

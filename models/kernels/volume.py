@@ -1,6 +1,6 @@
 """Volume-scattering kernels under a smooth interface (seed 003 Sec. 2.2-2.3):
-:class:`models.SingleScatterBRDF` and :class:`models.DiffuseSubsurfaceBRDF`, one geometry per
-call, as :mod:`models.single_scatter` and :mod:`models.diffuse_subsurface` compute them."""
+:class:`scatterbench.models.SingleScatterBRDF` and :class:`scatterbench.models.DiffuseSubsurfaceBRDF`, one geometry per
+call, as :mod:`scatterbench.models.single_scatter` and :mod:`scatterbench.models.diffuse_subsurface` compute them."""
 
 from __future__ import annotations
 
@@ -18,8 +18,8 @@ DIFFUSE_ROWS = ("coating", "scale")
 
 @njit(error_model="numpy", forceinline=True)
 def amplitudes(c, s, n):
-    """``(sin_int, cos_int, a_s, a_p)`` of :func:`models.smooth_interface.interface_amplitudes`
-    for the external cosine and sine ``c``, ``s`` (:func:`models.kernels.common.polar`)."""
+    """``(sin_int, cos_int, a_s, a_p)`` of :func:`scatterbench.models.smooth_interface.interface_amplitudes`
+    for the external cosine and sine ``c``, ``s`` (:func:`scatterbench.models.kernels.common.polar`)."""
     T = type(c)
     # a few ulps of pi/2 from grazing is grazing (as the numpy path); float32's pi/2 is 1.2e-7
     # wide and rounds above pi/2 (a negative cosine).  T(1e-300) is 0 in float32.
@@ -38,7 +38,7 @@ def amplitudes(c, s, n):
 
 @njit(error_model="numpy", inline="always")
 def depolarized16(asi, api, asr, apr, scale):
-    """:func:`models.smooth_interface.depolarized_between`'s 16 elements."""
+    """:func:`scatterbench.models.smooth_interface.depolarized_between`'s 16 elements."""
     T = type(asi)
     half = T(0.5)
     a, b = asr * asr, apr * apr

@@ -7,12 +7,12 @@ returns the composite model holding only the mechanisms the scene declares,
 and ``Scene.mechanisms()`` says which ones and why; ``Scene.assemble()`` returns the
 model with the decisions it measured (point source, detector aperture) and why.
 
-One module per concern: :mod:`~models.scene.schema` (the tables and keys, validated),
-:mod:`~models.scene.table` (the one table from the names a file uses to model classes:
+One module per concern: :mod:`~scatterbench.models.scene.schema` (the tables and keys, validated),
+:mod:`~scatterbench.models.scene.table` (the one table from the names a file uses to model classes:
 its keys are the classes' declared parameters, ``*_deg`` in degrees, and the classes
-validate the values), :mod:`~models.scene.editing` (dotted keys for fits and sweeps),
-:mod:`~models.scene.assembly` (the mechanisms) and :mod:`~models.scene.decisions`
-(what is measured), with :class:`Scene` in :mod:`~models.scene.core`.
+validate the values), :mod:`~scatterbench.models.scene.editing` (dotted keys for fits and sweeps),
+:mod:`~scatterbench.models.scene.assembly` (the mechanisms) and :mod:`~scatterbench.models.scene.decisions`
+(what is measured), with :class:`Scene` in :mod:`~scatterbench.models.scene.core`.
 
 Schema (angles in degrees in files, as everywhere outside the Python API)::
 

@@ -1,9 +1,9 @@
 """Mechanism assembly: the models a validated scene declares, each with the reason it is there.
 
-The substrate's mechanism comes from its model's entry in :data:`models.scene.table.TABLE`
+The substrate's mechanism comes from its model's entry in :data:`scatterbench.models.scene.table.TABLE`
 (``facet``, ``cook-torrance``, ``maxwell-beard``); the coating's rough top surface and the
 volume scatterer (seed 003) follow.  Nothing here measures anything: that is
-:mod:`models.scene.decisions`.
+:mod:`scatterbench.models.scene.decisions`.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ which parameters of the built model each key sets and how (the value itself, in 
 a ``*_deg`` key, or the real or imaginary part of an index), by building the scene at two
 probe values per key and comparing the models' parameters.  :meth:`Binding.model` then sets
 those parameters directly, as arrays: one model set for all walkers of an emcee step
-(:mod:`models.modelset`), trusted, because the caller checked the values against bounds that
+(:mod:`scatterbench.models.modelset`), trusted, because the caller checked the values against bounds that
 were themselves checked to give valid scenes.
 
 Where the keys do more than set parameters (a structural change, a value the binding cannot

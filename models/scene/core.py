@@ -18,7 +18,7 @@ __all__ = ["Scene", "load", "loads", "from_dict"]
 
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene file (see :mod:`models.scene` for the schema).  Angles in radians."""
+    """A validated scene file (see :mod:`scatterbench.models.scene` for the schema).  Angles in radians."""
 
     name: str
     path: str

@@ -3,7 +3,7 @@
 The scene checks what is its own: the tables and keys that exist, which ones are
 required, and combinations (a ``[volume]`` needs a ``[coating]``, Maxwell-Beard stands
 alone).  Values that a model takes are validated by that model's declared parameters
-(:mod:`models.params`, through :mod:`models.scene.table`); every error is a
+(:mod:`scatterbench.models.params`, through :mod:`scatterbench.models.scene.table`); every error is a
 :class:`SceneError` naming the file, the key and the allowed values.
 """
 
@@ -130,7 +130,7 @@ def is_number(value) -> bool:
 
 
 def parse(data: dict, path: str) -> dict:
-    """The validated fields of :class:`models.scene.Scene` from the dict a TOML file parses to."""
+    """The validated fields of :class:`scatterbench.models.scene.Scene` from the dict a TOML file parses to."""
     _unknown(path, "", data, _TOP)
     name = data.get("name")
     if not isinstance(name, str) or not name.strip() or not name.isprintable():
@@ -279,7 +279,7 @@ def _distribution(path, section, table):
 
 
 def _built(path, section, name, table, **given):
-    """:func:`models.scene.table.build`, its errors naming the file and the key."""
+    """:func:`scatterbench.models.scene.table.build`, its errors naming the file and the key."""
     try:
         return build(name, table, **given)
     except KeyProblem as exc:
@@ -346,7 +346,7 @@ def _substrate(path, s, data, wavelength_nm):
 
 
 def _film(path, film, substrate, wavelength_nm):
-    """``[substrate.film]``: thin films on the substrate/flakes (:class:`models.FilmStack`)."""
+    """``[substrate.film]``: thin films on the substrate/flakes (:class:`scatterbench.models.FilmStack`)."""
     layers = _film_layers(path, "[substrate.film]", film, wavelength_nm)
     return _film_built(
         path, "[substrate.film]", FilmStack, layers=layers, substrate=substrate, wavelength_nm=wavelength_nm
@@ -385,7 +385,7 @@ def _film_layers(path, section, film, wavelength_nm):
 
 
 def _film_built(path, section, cls, **kw):
-    """``cls(**kw)`` (:class:`models.FilmStack` or :class:`models.Films`), which validates the
+    """``cls(**kw)`` (:class:`scatterbench.models.FilmStack` or :class:`scatterbench.models.Films`), which validates the
     values; its message names ``layers[j] index / thickness_nm``, the error the file's key."""
     try:
         return cls(**kw)
@@ -397,8 +397,8 @@ def _film_built(path, section, cls, **kw):
 
 def _coating_films_apply(path, out):
     """``[coating.film]`` only where a model takes films on the coating's top surface: facets
-    under it (:class:`models.SubsurfaceFacetBRDF`), a volume under a smooth interface
-    (:class:`models.SingleScatterBRDF`, :class:`models.DiffuseSubsurfaceBRDF`) and the rough
+    under it (:class:`scatterbench.models.SubsurfaceFacetBRDF`), a volume under a smooth interface
+    (:class:`scatterbench.models.SingleScatterBRDF`, :class:`scatterbench.models.DiffuseSubsurfaceBRDF`) and the rough
     top surface's own facet reflection; not seed 001's varnish model, nor the Monte Carlo
     model under a rough interface."""
     coating, sub, vol = out["coating"], out["substrate"], out["volume"]

@@ -4,9 +4,9 @@ A scene file names a slope distribution (``distribution = "gaussian"``, in ``[su
 and ``[coating.roughness]``) or a substrate model (``[substrate] model = "maxwell-beard"``).
 :data:`TABLE` maps each name to the class it stands for and the keys a file may give; a key
 is the class's declared parameter (or one of its old names, see
-:class:`models.params.Alias`), and a key ending in ``_deg`` is the parameter without the
+:class:`scatterbench.models.params.Alias`), and a key ending in ``_deg`` is the parameter without the
 suffix, given in degrees (the Python API is in radians).  The classes validate the values
-themselves (:mod:`models.params`); :func:`build` names the file's key when they refuse one.
+themselves (:mod:`scatterbench.models.params`); :func:`build` names the file's key when they refuse one.
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ class Entry:
     class's slopes (``"optional"``, ``"required"``) or is not used (``"ignored"``), ``alone``
     that the model has no interface, so no ``[coating]`` or ``[volume]`` may come with it,
     and ``mechanisms`` turns the validated ``[substrate]`` into mechanisms.  A key's value,
-    ``true``/``false`` included, is the class's to accept or refuse (:mod:`models.params`).
+    ``true``/``false`` included, is the class's to accept or refuse (:mod:`scatterbench.models.params`).
     """
 
     kind: str  # "distribution" or "model"

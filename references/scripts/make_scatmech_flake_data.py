@@ -40,11 +40,12 @@ import argparse
 import datetime
 import math
 import os
-import sys
 from importlib import metadata
 
 import numpy as np
 from pySCATMECH.brdf import BRDF_Model
+
+from scatterbench.validation.fitting.datafile import write_data  # the installed harness
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -131,8 +132,6 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=20261122)
     args = ap.parse_args(argv)
-    sys.path.insert(0, ROOT)
-    from validation.fitting.datafile import write_data
 
     model = BRDF_Model(
         "Subsurface_Facet_BRDF_Model",

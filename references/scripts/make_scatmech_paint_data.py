@@ -35,12 +35,13 @@ import argparse
 import datetime
 import math
 import os
-import sys
 from importlib import metadata
 
 import numpy as np
-from make_scatmech_flake_data import DATA, NOISE, ROOT, geometries, header, observe, provenance
+from make_scatmech_flake_data import DATA, NOISE, geometries, header, observe, provenance
 from pySCATMECH.brdf import BRDF_Model
+
+from scatterbench.validation.fitting.datafile import write_data  # the installed harness
 
 PAINT_TRUTH = {"coating.roughness.sigma": 0.05, "volume.g": 0.3, "volume.rho": 0.1, "coating.index": 1.5}
 MB_TRUTH = {
@@ -126,8 +127,6 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=20261123)
     args = ap.parse_args(argv)
-    sys.path.insert(0, ROOT)
-    from validation.fitting.datafile import write_data
 
     version = metadata.version("pySCATMECH")
     when = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d")

@@ -4,17 +4,17 @@ Run once with pySCATMECH installed.  Writes to ``../data``:
 
 * ``scatmech_seed003_diffuse.csv``: ``Diffuse_Subsurface_BRDF_Model``
   (``reflectance.table = rho``), n in [1.0, 2.5], rho in [0, 1]
-  -> :class:`models.DiffuseSubsurfaceBRDF`.
+  -> :class:`scatterbench.models.DiffuseSubsurfaceBRDF`.
 * ``scatmech_seed003_single.csv``: ``First_Diffuse_BRDF_Model`` with
   ``Unpolarized_Phase_Function`` around ``Henyey_Greenstein_Phase_Function``,
   no absorption (``phase_function.log_absorption = -1000``: exp(-1000) = 0),
-  g in [-0.95, 0.95] -> :class:`models.SingleScatterBRDF` with the depolarizing phase.
+  g in [-0.95, 0.95] -> :class:`scatterbench.models.SingleScatterBRDF` with the depolarizing phase.
 * ``scatmech_seed003_btdf.csv``: ``Facet_BRDF_Model`` ``type = 1``
   (transmission), Gaussian and exponential slopes, sigma in [0.05, 1],
-  substrate n in [1.1, 2.5] -> :class:`models.FacetBTDF`.
+  substrate n in [1.1, 2.5] -> :class:`scatterbench.models.FacetBTDF`.
 * ``scatmech_seed003_mb.csv``: ``Shadowed_Facet_BRDF_Model`` with
   ``Maxwell_Beard_Shadow_Function`` (tau, Omega), absorbing or transparent
-  substrates -> the specular term of :class:`models.MaxwellBeardBRDF`
+  substrates -> the specular term of :class:`scatterbench.models.MaxwellBeardBRDF`
   (``polarized=True``, ``rho_d = rho_v = 0``).
 
 Geometries are random: polar angles up to 85 deg, every azimuth (the BTDF's

@@ -15,7 +15,7 @@ thickness) on a real coating index in [1, 2.5], crossed down from the ambient (`
 the ambient 1, ``theta0`` the refracted angle ``asin(sin(theta0_down) / n)``).  These rows also
 carry tmm's power transmittances ``T_s``, ``T_p`` (empty in the "random" rows).
 
-tmm's conventions are those of :mod:`models.thin_film` (Born & Wolf): ``r_p``
+tmm's conventions are those of :mod:`scatterbench.models.thin_film` (Born & Wolf): ``r_p``
 with ``r_p = -r_s`` at normal incidence, ``t_p`` the ratio of the p components
 of the electric fields; ``n + ik`` with ``k >= 0`` absorbing.  The script
 stores tmm's numbers as they are; ``tests/test_thin_film.py`` compares.

@@ -13,7 +13,10 @@ import os
 
 import numpy as np
 
-import models
+try:
+    from scatterbench import models
+except ImportError:  # a checkout from before the one namespace (a0b9da6), on PYTHONPATH
+    import models
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PATH = os.path.join(HERE, "rough_diffuse_a0b9da6.npz")

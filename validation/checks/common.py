@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from scipy import integrate
 
-import models
+from scatterbench import models
 
 __all__ = [
     "random_geometries",

@@ -6,14 +6,14 @@ own models; the checks registered here with :func:`model_check` each test one pr
 They share :func:`.registry.judge` (the one place a measured value and its limit become a
 status) and :class:`.registry.Check` (as :class:`ModelCheck`, which adds the model and
 the worst geometry), and :class:`.registry.CheckContext` (the quick flag, the seed and the
-memo a report section shares).  :mod:`validation.testing` is the public entry
+memo a report section shares).  :mod:`scatterbench.validation.testing` is the public entry
 (``check_model``, ``parametrize_with_checks``); the checks are in
 :mod:`.conformance_checks` and :mod:`.conformance_scatmech`.
 
 What counts as a model (duck-typed): any object with ``mueller(theta_i, theta_r, phi_r)``
 that broadcasts numpy arrays (radians) and returns ``(..., 4, 4)`` Mueller matrices in the
 psps basis of DESIGN.md.  :func:`as_model` views such an object as a
-:class:`models.Model` for the integrator, the reciprocity relations and the stability
+:class:`scatterbench.models.Model` for the integrator, the reciprocity relations and the stability
 sweep, reading the optional attributes :data:`ATTRIBUTES` documents.
 
 A result's status is ``pass``, ``fail``, ``finding`` (outside its limit where a finding of
@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import models
-from models.params import param
+from scatterbench import models
+from scatterbench.models.params import param
 
 from .common import fp_warnings
 from .registry import Check, CheckContext, Finding, judge
@@ -230,7 +230,7 @@ def _check_conformant(name, value):
 
 @dataclass(frozen=True)
 class Conformant(models.Model):
-    """Any object with ``mueller(theta_i, theta_r, phi_r)``, seen as a :class:`models.Model`:
+    """Any object with ``mueller(theta_i, theta_r, phi_r)``, seen as a :class:`scatterbench.models.Model`:
     validated, broadcast and chunked angles, ``brdf``, and the optional attributes
     (:data:`ATTRIBUTES`) with the defaults the kit documents."""
 
@@ -272,7 +272,7 @@ class Conformant(models.Model):
 
 
 def as_model(obj):
-    """``obj`` itself if it is a :class:`models.Model`, else its :class:`Conformant` view."""
+    """``obj`` itself if it is a :class:`scatterbench.models.Model`, else its :class:`Conformant` view."""
     return obj if isinstance(obj, models.Model) else Conformant(model=obj)
 
 
@@ -303,9 +303,9 @@ def accepted_reason(model, kind, fields, accepted=None):
     entries ``accepted``) that explains a ``kind`` of finding with these numeric ``fields``
     on one of scatterbench's own models, else ``None``: only scatterbench's models carry
     accepted findings."""
-    from validation.studies import stability
+    from scatterbench.validation.studies import stability
 
-    if not type(model).__module__.startswith("models."):
+    if not type(model).__module__.startswith("scatterbench.models."):
         return None
     f = stability.Finding(
         type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields

@@ -17,9 +17,9 @@ import pickle
 
 import numpy as np
 
-import models
-from models.params import Declared
-from models.polarization import coherency_eigenvalues
+from scatterbench import models
+from scatterbench.models.params import Declared
+from scatterbench.models.polarization import coherency_eigenvalues
 
 from .common import extreme_geometries, random_geometries
 from .conformance import (
@@ -70,7 +70,7 @@ def kit_geometries(model):
     30, 60, 89.99, 90 deg; exact specular and retroreflection; phi 0, +-pi, pi/2, 1e-12),
     the stability sweep's edge geometries of ``model`` (critical angles of its declared
     indices +- 1e-9), and 200 seeded random interior ones."""
-    from validation.studies.stability import edge_geometries
+    from scatterbench.validation.studies.stability import edge_geometries
 
     parts = [extreme_geometries(), edge_geometries(model), random_geometries(200, seed=14, max_deg=89.0)]
     return tuple(np.concatenate(p) for p in zip(*parts, strict=True))
@@ -227,7 +227,7 @@ def _takes_out(model):
 
 
 @model_check(
-    tests="models.Model.mueller(..., out=): the (16, N) float64 element-major result is written into out"
+    tests="scatterbench.models.Model.mueller(..., out=): the (16, N) float64 element-major result is written into out"
 )
 def check_out_argument(model, ctx):
     if not _takes_out(model):
@@ -317,10 +317,10 @@ def check_realizable(model, ctx):
 
 
 def _reciprocity_errors(model, ctx):
-    """``(geometry, errors, note)``: :func:`validation.numerics.reciprocity.reciprocity_errors`
+    """``(geometry, errors, note)``: :func:`scatterbench.validation.numerics.reciprocity.reciprocity_errors`
     on the grid, kept where both paths are finite (non-finite values are the finite check's
     failure), with the geometries they belong to."""
-    from validation.numerics.reciprocity import reciprocity_errors
+    from scatterbench.validation.numerics.reciprocity import reciprocity_errors
 
     ti, tr, pr, M, J, _ = _grid(model, ctx)
     e = reciprocity_errors(as_model(model), ti, tr, pr, mueller=M, jones=J)
@@ -387,9 +387,9 @@ def _energy_bound(model):
 def _energy_reason(model, ti, r, bound):
     """The accepted finding (``(reason, condition)`` or ``None``) that explains the
     integrated reflectance ``r`` above ``bound`` at ``ti``, from the fields the stability
-    sweep gives its energy findings (:func:`validation.studies.stability.energy_fields`);
+    sweep gives its energy findings (:func:`scatterbench.validation.studies.stability.energy_fields`);
     the hit fraction (an integral) only when needed."""
-    from validation.studies.stability import energy_fields, load_accepted, model_hit_fraction
+    from scatterbench.validation.studies.stability import energy_fields, load_accepted, model_hit_fraction
 
     accepted = load_accepted()
     fields = energy_fields(model, ti, r.value, r.error, bound, hit=False)
@@ -400,7 +400,7 @@ def _energy_reason(model, ti, r, bound):
 
 
 def _energy_ladder(model, ctx):
-    from validation.numerics.integrate import integrated_reflectance
+    from scatterbench.validation.numerics.integrate import integrated_reflectance
 
     view = as_model(model)
     out = []
@@ -496,7 +496,7 @@ def check_pickle(model, ctx):
     slow=True,
 )
 def check_parameter_extremes(model, ctx):
-    from validation.studies.stability import classify, edge_instances, load_accepted, sweep_model
+    from scatterbench.validation.studies.stability import classify, edge_instances, load_accepted, sweep_model
 
     if not isinstance(model, Declared) or not type(model).parameters():
         return skipped(
@@ -507,7 +507,7 @@ def check_parameter_extremes(model, ctx):
     instances = edge_instances(model)
     for inst in instances:
         found += sweep_model(inst, energy=False)
-    own = type(model).__module__.startswith("models.")
+    own = type(model).__module__.startswith("scatterbench.models.")
     ok, bad = classify(found, load_accepted() if own else [])
     top = (bad or ok)[0][0] if found else None
     at = f"{top.params} at {top.where}" if top else ""

@@ -17,7 +17,7 @@ from functools import cache
 
 import numpy as np
 
-import references
+from scatterbench import references
 
 from .common import random_geometries
 from .conformance import claims, model_check, skipped, verdict, where
@@ -46,7 +46,7 @@ SCATMECH_ARITHMETIC = 3.2e-12
 EXPONENT_MAX = 622.0
 
 #: max ``|M - M_scatmech| / M00`` per SCATMECH model: one table for the registry's SCATMECH
-#: checks (:mod:`validation.checks.seed000`, :mod:`validation.checks.seed003`) and the kit's ``scatmech`` check
+#: checks (:mod:`scatterbench.validation.checks.seed000`, :mod:`scatterbench.validation.checks.seed003`) and the kit's ``scatmech`` check
 SCATMECH_TOL = {
     # a slope density exp(-x): the arithmetic's bound at the largest exponent compared (2.0e-9)
     "Facet_BRDF_Model": SCATMECH_ARITHMETIC * EXPONENT_MAX,

@@ -21,7 +21,7 @@ from functools import lru_cache
 
 import numpy as np
 
-import models
+from scatterbench import models
 
 __all__ = ["SIGMAS", "peak_angle", "mean_transmitted_angle", "effective_index", "fit_effective_index", "fig1"]
 

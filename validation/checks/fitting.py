@@ -8,7 +8,7 @@
 * seed 003's model comparison prefers the generating hypothesis on each data set.
 
 The recovery study and the model-comparison fits run once per run
-(:meth:`~validation.checks.registry.CheckContext.compute`); the report's
+(:meth:`~scatterbench.validation.checks.registry.CheckContext.compute`); the report's
 uncertainty and model-comparison sections draw the same computation
 (:func:`recovery_cells`, :func:`comparison_cases`) with the same settings.
 """
@@ -23,9 +23,8 @@ import tempfile
 
 import numpy as np
 
-import models
-import references
-from models.geometry import signed_inplane
+from scatterbench import models, references
+from scatterbench.models.geometry import signed_inplane
 
 from .registry import check, judge
 
@@ -52,7 +51,7 @@ def _synthetic(model):
         ]
     )
     inc = np.tile([1.0, 0.0, 1.0, 0.0], (len(g), 1))
-    from validation.fitting.datafile import Dataset
+    from scatterbench.validation.fitting.datafile import Dataset
 
     b = np.einsum("nij,nj->ni", model.mueller(g[:, 0], g[:, 1], g[:, 2]), inc)[:, 0]
     k = b > 0
@@ -61,7 +60,7 @@ def _synthetic(model):
 
 @check(paper="seed 000 Sec. 4 (slope distribution from the BRDF)")
 def check_inversion_round_trip(ctx):
-    from validation.fitting.inversion import fit_curve, invert
+    from scatterbench.validation.fitting.inversion import fit_curve, invert
 
     out = []
     for slopes in (models.ExponentialSlopes(0.1), models.GaussianSlopes(0.15, coverage=0.8)):
@@ -98,12 +97,17 @@ class InterruptAfter:
 
 @check(paper="fitting machinery (emcee checkpoints)")
 def check_resume_identity(ctx):
-    from models import scene
-    from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import fitspec_from
-    from validation.fitting.likelihood import Likelihood
-    from validation.fitting.recovery import subsample
-    from validation.fitting.sampling import ChainSettings, CheckpointBackend, initial_ball, run_chain
+    from scatterbench.models import scene
+    from scatterbench.validation.fitting.datafile import load_data
+    from scatterbench.validation.fitting.fitspec import fitspec_from
+    from scatterbench.validation.fitting.likelihood import Likelihood
+    from scatterbench.validation.fitting.recovery import subsample
+    from scatterbench.validation.fitting.sampling import (
+        ChainSettings,
+        CheckpointBackend,
+        initial_ball,
+        run_chain,
+    )
 
     sc = scene.load(
         os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
@@ -147,7 +151,7 @@ STUDY_WORKERS = 2
 def recovery_settings(quick, seed=0):
     """The recovery study's configuration (its chain a :class:`ChainSettings` with ``seed``):
     quick runs use that of tests/test_recovery.py."""
-    from validation.fitting.settings import ChainSettings
+    from scatterbench.validation.fitting.settings import ChainSettings
 
     if quick:
         return dict(
@@ -173,11 +177,11 @@ def recovery_settings(quick, seed=0):
 
 def _recovery(quick, seed, executor=None):
     """The recovery study of the run (on ``executor``, default: :func:`recovery_settings`' workers)."""
-    from models import scene as scene_mod
-    from validation.fitting.datafile import load_data
-    from validation.fitting.executors import make_executor
-    from validation.fitting.fitspec import fitspec_from
-    from validation.fitting.recovery import recovery_study
+    from scatterbench.models import scene as scene_mod
+    from scatterbench.validation.fitting.datafile import load_data
+    from scatterbench.validation.fitting.executors import make_executor
+    from scatterbench.validation.fitting.fitspec import fitspec_from
+    from scatterbench.validation.fitting.recovery import recovery_study
 
     rs = recovery_settings(quick, seed)
     sc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
@@ -198,7 +202,7 @@ def _recovery(quick, seed, executor=None):
 
 
 def recovery_cells(ctx):
-    """The recovery study's cells (:func:`validation.fitting.recovery.recovery_study`) for the
+    """The recovery study's cells (:func:`scatterbench.validation.fitting.recovery.recovery_study`) for the
     run's quick flag and seed, computed once per run."""
     return ctx.compute(_recovery, ctx.quick, ctx.seed)
 
@@ -227,7 +231,7 @@ STRONG_DBIC = 10.0
 def comparison_settings(quick):
     """Seed 003's model comparison, ``dict(rows, settings)``: quick runs use the configuration of
     tests/test_recovery.py (the same seed, so a test session fits it once)."""
-    from validation.fitting.settings import ChainSettings
+    from scatterbench.validation.fitting.settings import ChainSettings
 
     if quick:
         return dict(
@@ -243,8 +247,8 @@ def comparison_settings(quick):
 
 
 def _comparison(quick):
-    from validation.fitting.compare import seed003_pairing
-    from validation.fitting.executors import make_executor
+    from scatterbench.validation.fitting.compare import seed003_pairing
+    from scatterbench.validation.fitting.executors import make_executor
 
     # the full run's 8 fits on both cores: 63.1 s in-process, 34.3 s on 2 workers
     # (benchmarks/study_workers.py); the quick run's take seconds, less than starting workers
@@ -254,7 +258,7 @@ def _comparison(quick):
 
 
 def comparison_cases(ctx):
-    """:func:`validation.fitting.compare.seed003_pairing` with the run's settings, once per run."""
+    """:func:`scatterbench.validation.fitting.compare.seed003_pairing` with the run's settings, once per run."""
     return ctx.compute(_comparison, ctx.quick)
 
 

@@ -160,7 +160,7 @@ def check(*, paper, slow=False, findings=()):
         raise ValueError("paper must name the paper, equation or section the check tests")
 
     def register(fn):
-        cid = f"{fn.__module__.removeprefix('validation.checks.')}.{fn.__name__}"
+        cid = f"{fn.__module__.removeprefix('scatterbench.validation.checks.')}.{fn.__name__}"
         _CHECKS[cid] = CheckSpec(cid, fn, paper, bool(slow), tuple(findings))
         return fn
 
@@ -169,7 +169,7 @@ def check(*, paper, slow=False, findings=()):
 
 def registered(quick=False):
     """The registered checks in run order; ``quick`` leaves out the slow ones."""
-    import validation.checks  # noqa: F401  (importing the package registers every check module)
+    import scatterbench.validation.checks  # noqa: F401  (importing the package registers every check module)
 
     return [s for s in _CHECKS.values() if not (quick and s.slow)]
 
@@ -295,6 +295,6 @@ def text_section(fn):
 
 def texts():
     """The registered text sections, in order."""
-    import validation.checks  # noqa: F401
+    import scatterbench.validation.checks  # noqa: F401
 
     return list(_TEXTS)

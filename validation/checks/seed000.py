@@ -2,7 +2,7 @@
 
 Fresnel coefficients, slope distributions, SCATMECH agreement, reciprocity,
 realizability, extremes, Table I and energy; each registered with
-:func:`validation.checks.registry.check`.
+:func:`scatterbench.validation.checks.registry.check`.
 """
 
 from __future__ import annotations
@@ -11,11 +11,10 @@ import math
 
 import numpy as np
 
-import models
-import references
-from validation.numerics.energy import exposed_reflectance, hit_fraction
-from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench import models, references
+from scatterbench.validation.numerics.energy import exposed_reflectance, hit_fraction
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 from .common import (
     count_extremes,
@@ -92,9 +91,9 @@ def check_slope_conversions(ctx):
 # ----------------------------------------------------------------------------- SCATMECH
 def scatmech_facet_model(ref, i):
     """``(model, coating)``: scatterbench's counterpart of case ``i`` of the committed SCATMECH
-    facet references ``ref`` (:func:`references.scatmech_facet`) and the coating index it
-    reflects under: :class:`models.FacetBRDF` (coating 1) for SCATMECH's
-    ``Facet_BRDF_Model``, :class:`models.SubsurfaceFacetBRDF` with the case's coating for
+    facet references ``ref`` (:func:`scatterbench.references.scatmech_facet`) and the coating index it
+    reflects under: :class:`scatterbench.models.FacetBRDF` (coating 1) for SCATMECH's
+    ``Facet_BRDF_Model``, :class:`scatterbench.models.SubsurfaceFacetBRDF` with the case's coating for
     ``Subsurface_Facet_BRDF_Model`` (an overcoat of 1 included)."""
     cls = models.ExponentialSlopes if ref["sdf"][i] == "Exponential" else models.GaussianSlopes
     slopes = cls(sigma=float(ref["sigma"][i]))
@@ -215,7 +214,7 @@ TABLE1_ROUNDING = "Table I: entries within the printed rounding"
 @check(paper="seed 000 Table I", findings=(TABLE1_ROUNDING,))
 def check_table1(ctx, rows=None):
     """Table I against SCATMECH, the flat limit and the printed values (``rows``:
-    :func:`validation.checks.table1.compute_table1`'s, computed once per run)."""
+    :func:`scatterbench.validation.checks.table1.compute_table1`'s, computed once per run)."""
     rows = ctx.compute(compute_table1)[0] if rows is None else rows
     rough = [r for r in rows if r.sigma > 0]
     flat = [r for r in rows if r.sigma == 0]

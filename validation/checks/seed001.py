@@ -1,6 +1,6 @@
 """Checks of the seed 001 models (Hebert, Emmel & Hersch: varnished metal plates).
 
-Registered with :func:`validation.checks.registry.check`; the text sections
+Registered with :func:`scatterbench.validation.checks.registry.check`; the text sections
 print the varnish-vs-subsurface ratio map, the anisotropy comparison and the
 iron-plate preset.  The helpers are shared with ``tests/test_seed001_*.py``.
 """
@@ -11,13 +11,12 @@ import math
 
 import numpy as np
 
-import models
-import references
-from models.cook_torrance import fresnel_real_printed
-from models.facet import local_cosine
-from models.geometry import refracted_cos
-from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_error, reversed_mueller
+from scatterbench import models, references
+from scatterbench.models.cook_torrance import fresnel_real_printed
+from scatterbench.models.facet import local_cosine
+from scatterbench.models.geometry import refracted_cos
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 
 from .common import count_extremes, extreme_geometries, slope_normalization_errors
 from .common import random_geometries as _geoms
@@ -583,7 +582,7 @@ def point_source_collimated_error(distances=(1e2, 1e3, 1e4), method="exact", ti_
 
 def point_source_nonreciprocity(distances=(1.0, 10.0, 100.0), n=300, seed=7):
     """``{d: max relative |f - f_rev| over geometries carrying >= 1e-3 of the peak}`` for the
-    varnished iron plate, R = 1 (the reversed path from :mod:`validation.numerics.reciprocity`)."""
+    varnished iron plate, R = 1 (the reversed path from :mod:`scatterbench.validation.numerics.reciprocity`)."""
     base = energy_published(models.VarnishedCookTorranceBRDF())
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.4, (2, n))

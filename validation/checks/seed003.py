@@ -1,4 +1,4 @@
-"""Checks of the seed 003 models (diffuse paints), registered with :func:`~validation.checks.registry.check`.
+"""Checks of the seed 003 models (diffuse paints), registered with :func:`~scatterbench.validation.checks.registry.check`.
 
 SCATMECH agreement per model, the internal reflectance average, unit albedo,
 the phase function's normalization and asymmetry, the Fig. 1 Snell shift
@@ -14,13 +14,12 @@ from functools import cache, lru_cache
 import numpy as np
 from scipy import integrate
 
-import models
-import references
-from models.polarization import reciprocal_mueller
-from models.smooth_interface import internal_hemispherical_reflectance
-from validation.numerics.grid import grid_reflectance
-from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench import models, references
+from scatterbench.models.polarization import reciprocal_mueller
+from scatterbench.models.smooth_interface import internal_hemispherical_reflectance
+from scatterbench.validation.numerics.grid import grid_reflectance
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 from .common import count_extremes, random_geometries
 from .conformance_scatmech import SCATMECH_FLOOR, scatmech_tolerance

@@ -1,7 +1,7 @@
 """Energy with Smith shadowing-masking (issue 15): perfect-conductor albedo versus incidence.
 
 Without shadowing the facet model's integrated reflectance is bounded by the hit fraction
-``H = C (1 + Lambda)`` (:mod:`validation.numerics.energy`), which exceeds 1 near grazing
+``H = C (1 + Lambda)`` (:mod:`scatterbench.validation.numerics.energy`), which exceeds 1 near grazing
 incidence on rough surfaces.  The separable Smith ``G = G1(i) G1(o)`` divides the
 incident side by exactly ``1 + Lambda``, so with it a perfect conductor's albedo stays
 at or below 1 (the outgoing ``G1 <= 1`` can only remove light).  :func:`conductor_albedo_curves`
@@ -15,8 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import models
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 from .registry import check, judge
 
@@ -33,7 +33,7 @@ TOL = 1e-4
 
 @dataclass(frozen=True)
 class AlbedoCurve:
-    """Perfect-conductor albedo of :class:`models.FacetBRDF` versus incidence, one slope
+    """Perfect-conductor albedo of :class:`scatterbench.models.FacetBRDF` versus incidence, one slope
     distribution and shadowing choice; ``error`` the integrator's estimates."""
 
     family: str
@@ -69,9 +69,9 @@ def conductor_albedo_curves(widths=WIDTHS, angles_deg=ANGLES_DEG, shadowings=("n
     angles_deg : sequence of float
         Incidence angles in degrees, in [0, 90).
     shadowings : sequence of str
-        The ``shadowing`` choices of :class:`models.FacetBRDF` to compute.
+        The ``shadowing`` choices of :class:`scatterbench.models.FacetBRDF` to compute.
     tol : float
-        Tolerance of :func:`validation.integrated_reflectance`.
+        Tolerance of :func:`scatterbench.validation.integrated_reflectance`.
 
     Returns
     -------

@@ -1,9 +1,9 @@
 """Seed 000 Table I, computed and compared honestly with the printed values.
 
 Each of the 27 entries is the integrated reflectance of
-:class:`models.SubsurfaceFacetBRDF` (exponential slopes, ``theta_i = 60 deg``)
+:class:`scatterbench.models.SubsurfaceFacetBRDF` (exponential slopes, ``theta_i = 60 deg``)
 for unpolarized light.  The ``sigma = 0.0`` column is the flat-interface limit:
-its value is the closed form :func:`validation.numerics.flat.flat_coated_reflectance`,
+its value is the closed form :func:`scatterbench.validation.numerics.flat.flat_coated_reflectance`,
 shown beside the integral at ``sigma = 1e-3`` (the limit approached by the
 model itself).  Every entry is compared with
 
@@ -24,10 +24,9 @@ import math
 import time
 from dataclasses import asdict, dataclass
 
-import models
-import references
-from validation.numerics.flat import flat_coated_reflectance
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models, references
+from scatterbench.validation.numerics.flat import flat_coated_reflectance
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 __all__ = ["Table1Row", "compute_table1", "format_table1", "THETA_I"]
 

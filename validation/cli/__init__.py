@@ -35,13 +35,13 @@ EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 
 #: exception that reaches :func:`main` is a bug (exit 3); a ``ValueError`` is not
 #: input's by itself (numpy raises them too), only these subclasses are.
 INPUT_ERRORS = {
-    "validation.cli.args": "UsageError",
-    "models.scene.schema": "SceneError",
-    "validation.fitting.datafile": "DataFileError",
-    "validation.fitting.fitspec": "FitSpecError",
-    "validation.fitting.checkpoint": "CheckpointError",
-    "validation.fitting.executors": "SchedulerError",
-    "validation.report.nightly": "HistoryError",
+    "scatterbench.validation.cli.args": "UsageError",
+    "scatterbench.models.scene.schema": "SceneError",
+    "scatterbench.validation.fitting.datafile": "DataFileError",
+    "scatterbench.validation.fitting.fitspec": "FitSpecError",
+    "scatterbench.validation.fitting.checkpoint": "CheckpointError",
+    "scatterbench.validation.fitting.executors": "SchedulerError",
+    "scatterbench.validation.report.nightly": "HistoryError",
 }
 
 

@@ -12,8 +12,8 @@ import math
 import os
 import re
 
-from models.scene.schema import shown
-from validation.atomic import write_problem
+from scatterbench.models.scene.schema import shown
+from scatterbench.validation.atomic import write_problem
 
 __all__ = [
     "UsageError",

@@ -14,9 +14,9 @@ __all__ = ["register", "run"]
 def run(spec, json_path=None, quick=False, checks=None) -> int:
     """Check the model ``spec`` names, print the table, write ``json_path`` (strict JSON,
     atomically) if given; 0 when no check fails, 1 when one does.  A bad argument raises
-    :class:`~validation.cli.args.UsageError` (the command line: ``error: ...``, exit 2)."""
-    from validation.atomic import atomic_write_json
-    from validation.testing import check_model, load_model
+    :class:`~scatterbench.validation.cli.args.UsageError` (the command line: ``error: ...``, exit 2)."""
+    from scatterbench.validation.atomic import atomic_write_json
+    from scatterbench.validation.testing import check_model, load_model
 
     # like pytest, a module beside the user is importable: `scatterbench check mybrdf:Model`
     if os.getcwd() not in sys.path:

@@ -6,8 +6,8 @@ __all__ = ["register"]
 
 
 def _cmd_models(args) -> int:
-    import models
-    from validation.testing import format_contributed
+    from scatterbench import models
+    from scatterbench.validation.testing import format_contributed
 
     print(models.list_models())
     print(format_contributed())

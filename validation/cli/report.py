@@ -8,7 +8,7 @@ from .args import nonneg_float, writable_folder
 
 
 def _report(args) -> int:
-    from validation.report import write_report
+    from scatterbench.validation.report import write_report
 
     writable_folder(args.out, "--out")
     res = write_report(args.out, quick=args.quick)
@@ -23,7 +23,7 @@ def _report(args) -> int:
 
 
 def _nightly(args) -> int:
-    from validation.report import nightly
+    from scatterbench.validation.report import nightly
 
     run = nightly(args.history, quick=args.quick, wait=args.wait)
     print(f"nightly run written to {run.run_dir}; latest -> {os.path.relpath(run.run_dir, args.history)}")

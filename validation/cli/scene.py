@@ -8,8 +8,8 @@ __all__ = ["register"]
 
 
 def _cmd_scene(args) -> int:
-    from models import scene as scene_mod
-    from validation.studies.scenes import write_scene_outputs
+    from scatterbench.models import scene as scene_mod
+    from scatterbench.validation.studies.scenes import write_scene_outputs
 
     writable_folder(args.out, "--out")
     sc = scene_mod.load(args.file)

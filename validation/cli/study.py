@@ -1,9 +1,9 @@
 """``scatterbench study recovery | inversion | compare``: uncertainty studies.
 
 * ``recovery``: injection-recovery coverage, bias and width versus noise level
-  and number of geometries (:mod:`validation.fitting.recovery`).
-* ``inversion``: slope distribution from measured BRDF (:mod:`validation.fitting.inversion`).
-* ``compare``: several scenes fitted to the same data (:mod:`validation.fitting.compare`).
+  and number of geometries (:mod:`scatterbench.validation.fitting.recovery`).
+* ``inversion``: slope distribution from measured BRDF (:mod:`scatterbench.validation.fitting.inversion`).
+* ``compare``: several scenes fitted to the same data (:mod:`scatterbench.validation.fitting.compare`).
 
 Each writes JSON and PNG into ``--out`` (refused when it exists and is not
 empty, unless ``--force``).
@@ -56,8 +56,8 @@ def _print_recovery(cells, injections):
 
 
 def _cmd_recovery(args) -> int:
-    from validation.atomic import atomic_write_json
-    from validation.fitting.recovery import check_inputs, recovery_study
+    from scatterbench.validation.atomic import atomic_write_json
+    from scatterbench.validation.fitting.recovery import check_inputs, recovery_study
 
     _check_out(args.out, args.force)
     _check_executor(args)
@@ -111,7 +111,7 @@ def _recovery_plot(cells, out):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from validation.atomic import atomic_savefig
+    from scatterbench.validation.atomic import atomic_savefig
 
     keys = list(cells[0]["summary"])
     fig, axes = plt.subplots(3, len(keys), figsize=(4.5 * len(keys), 8), squeeze=False)
@@ -147,11 +147,11 @@ def _recovery_plot(cells, out):
 # ----------------------------------------------------------------------------- inversion
 def _inversion_model(args):
     """The data (masked) and the scene's model for them, at a point detector."""
-    from models import DetectorAperture
-    from models import scene as scene_mod
-    from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import masked_rows
-    from validation.fitting.likelihood import scene_for_data
+    from scatterbench.models import DetectorAperture
+    from scatterbench.models import scene as scene_mod
+    from scatterbench.validation.fitting.datafile import load_data
+    from scatterbench.validation.fitting.fitspec import masked_rows
+    from scatterbench.validation.fitting.likelihood import scene_for_data
 
     sc = scene_mod.load(args.scene)
     data = masked_rows(load_data(args.data), args.near_specular_deg, args.exclude)
@@ -188,8 +188,8 @@ def _cmd_inversion(args) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from validation.atomic import atomic_savefig, atomic_write_json
-    from validation.fitting.inversion import inversion_figure, inversion_study
+    from scatterbench.validation.atomic import atomic_savefig, atomic_write_json
+    from scatterbench.validation.fitting.inversion import inversion_figure, inversion_study
 
     _check_out(args.out, args.force)
     data, model = _inversion_model(args)
@@ -212,10 +212,10 @@ def _cmd_inversion(args) -> int:
 # ----------------------------------------------------------------------------- compare
 def _compare_likelihoods(args):
     """One likelihood per ``--scene`` on the data, named by the scene file."""
-    from models import scene as scene_mod
-    from validation.fitting.datafile import load_data
-    from validation.fitting.fitspec import fitspec_from
-    from validation.fitting.likelihood import Likelihood
+    from scatterbench.models import scene as scene_mod
+    from scatterbench.validation.fitting.datafile import load_data
+    from scatterbench.validation.fitting.fitspec import fitspec_from
+    from scatterbench.validation.fitting.likelihood import Likelihood
 
     data = load_data(args.data)
     liks, names = [], []
@@ -228,8 +228,8 @@ def _compare_likelihoods(args):
 
 
 def _cmd_compare(args) -> int:
-    from validation.atomic import atomic_write_json
-    from validation.fitting.compare import check_comparable, compare_fits, format_comparison
+    from scatterbench.validation.atomic import atomic_write_json
+    from scatterbench.validation.fitting.compare import check_comparable, compare_fits, format_comparison
 
     _check_out(args.out, args.force)
     _check_executor(args)

@@ -8,7 +8,7 @@ __all__ = ["register"]
 
 
 def _cmd_table1(args) -> int:
-    from validation.checks.table1 import compute_table1, format_table1
+    from scatterbench.validation.checks.table1 import compute_table1, format_table1
 
     rows, seconds = compute_table1(tol=args.tol)
     print(format_table1(rows))

@@ -13,8 +13,8 @@ def _plot(results, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from validation.atomic import atomic_savefig
-    from validation.studies.tradeoff import pareto
+    from scatterbench.validation.atomic import atomic_savefig
+    from scatterbench.validation.studies.tradeoff import pareto
 
     fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 4.2), squeeze=False)
     for ax, r in zip(axes[0], results, strict=True):
@@ -37,7 +37,7 @@ def _plot(results, path):
 
 
 def _print_knob(r, tol):
-    from validation.studies.tradeoff import choose, pareto
+    from scatterbench.validation.studies.tradeoff import choose, pareto
 
     print(f"{r.knob}: {r.quantity}")
     print(f"  reference: {r.reference}")
@@ -62,8 +62,8 @@ def _print_knob(r, tol):
 def _cmd_tradeoff(args) -> int:
     import os
 
-    from validation.atomic import atomic_write_json
-    from validation.studies.tradeoff import BATCH, MIN_BATCHES, MIN_WORK, study
+    from scatterbench.validation.atomic import atomic_write_json
+    from scatterbench.validation.studies.tradeoff import BATCH, MIN_BATCHES, MIN_WORK, study
 
     writable_folder(args.out, "--out")  # refused before the study, not after
     skipped = {}

@@ -15,12 +15,12 @@ def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
     """Run the checks, print the table and the text blocks, write ``json_path`` (strict
     JSON, atomically) if given; 1 if a check fails, else 0.
 
-    ``ctx``: a :class:`~validation.checks.registry.CheckContext` whose memo is shared
+    ``ctx``: a :class:`~scatterbench.validation.checks.registry.CheckContext` whose memo is shared
     (e.g. with a report built on it); ``specs``: the checks (default: every registered
     check, less the slow ones when ``quick``).
     """
-    from validation.atomic import atomic_write_json
-    from validation.checks.registry import (
+    from scatterbench.validation.atomic import atomic_write_json
+    from scatterbench.validation.checks.registry import (
         CheckContext,
         check_record,
         format_checks,

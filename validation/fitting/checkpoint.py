@@ -2,10 +2,10 @@
 
 :class:`CheckpointBackend` is an :class:`emcee.backends.Backend`: the sampler
 stores every step in it, in memory, as emcee's default backend does.  At the
-end of each segment of ``check_every`` steps :func:`validation.fitting.sampling.run_chain`
+end of each segment of ``check_every`` steps :func:`scatterbench.validation.fitting.sampling.run_chain`
 calls :meth:`CheckpointBackend.end_segment`, which records the
 autocorrelation time of the whole chain and writes the file atomically
-(:mod:`validation.atomic`): the chain, log posterior, acceptance counts, the
+(:mod:`scatterbench.validation.atomic`): the chain, log posterior, acceptance counts, the
 sampler's random state, the run's fingerprint, the tau history and the
 sampling time.  :meth:`CheckpointBackend.load` restores all of it, so a resumed
 sampler continues with the same random numbers: the chain is the same, bit
@@ -28,7 +28,7 @@ import zlib
 import emcee
 import numpy as np
 
-from validation.atomic import atomic_write_bytes
+from scatterbench.validation.atomic import atomic_write_bytes
 
 __all__ = ["CheckpointBackend", "CheckpointError", "FORMAT", "saved_steps"]
 

@@ -24,7 +24,7 @@ __all__ = ["waic", "check_comparable", "compare_fits", "format_comparison", "see
 
 def waic(fit, n_draws=200, seed=0):
     """WAIC of a fit from the per-row log-likelihood of ``n_draws`` posterior draws (all
-    evaluated in one :meth:`~validation.fitting.likelihood.Likelihood.pointwise_batch`)."""
+    evaluated in one :meth:`~scatterbench.validation.fitting.likelihood.Likelihood.pointwise_batch`)."""
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 5]))
     s = fit.chain.samples()
     pick = rng.choice(len(s), size=min(n_draws, len(s)), replace=False)
@@ -110,7 +110,7 @@ def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor
         Every fit's chain (default ``ChainSettings()``); its seed also seeds the
         predictive draws and the WAIC.
     executor : optional
-        Runs the fits, one task per fit (:mod:`validation.fitting.executors`;
+        Runs the fits, one task per fit (:mod:`scatterbench.validation.fitting.executors`;
         default in-process); the rows are the same on any executor.
 
     Returns
@@ -174,8 +174,8 @@ def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf")
 def _pairing_cases(rows, terms):
     """The pairing's cases (``{"data", "generator", "terms"}``) and, for each, the
     ``(likelihoods, hypothesis names)`` to compare."""
-    import references
-    from models import scene as scene_mod
+    from scatterbench import references
+    from scatterbench.models import scene as scene_mod
 
     from .datafile import load_data
     from .fitspec import fitspec_from

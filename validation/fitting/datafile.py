@@ -60,8 +60,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models.polarization import ellipsometric, stokes
-from models.scene.schema import is_number, long_digits, read_utf8, shown, where
+from scatterbench.models.polarization import ellipsometric, stokes
+from scatterbench.models.scene.schema import is_number, long_digits, read_utf8, shown, where
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -460,7 +460,7 @@ def write_data(path, columns: dict, meta: dict | None = None, comments=()):
     for ``incident``, to a list of strings.  Numbers are written with 17
     significant digits so a round trip is exact.
     """
-    from validation.atomic import atomic_write_json, atomic_write_text
+    from scatterbench.validation.atomic import atomic_write_json, atomic_write_text
 
     names = list(columns)
     for n in names:

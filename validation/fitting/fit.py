@@ -1,7 +1,7 @@
 """A fit from data file + scene + spec to a posterior: optimum, chain, summary, checks, plots.
 
 ``run_fit`` does the work (no files except the resumable checkpoint, a
-:class:`~validation.fitting.checkpoint.CheckpointBackend`: chain, log posterior,
+:class:`~scatterbench.validation.fitting.checkpoint.CheckpointBackend`: chain, log posterior,
 acceptance counts, the sampler's random state, tau history; ``scatterbench fit``
 keeps it as ``chain.npz``); ``write_fit`` writes ``posterior.json`` and the
 plots ``corner.png``, ``predictive.png``, ``residuals.png``.
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.polarization import wrap_axis
+from scatterbench.models.polarization import wrap_axis
 
 from .checkpoint import CheckpointBackend
 from .likelihood import TERMS, Likelihood, replicate, term_variances
@@ -94,7 +94,7 @@ def run_fit(
         Where the chain's checkpoint is written at every check.
     resume : bool
         Continue the chain saved in ``resume_from`` (default ``checkpoint``);
-        a :class:`~validation.fitting.checkpoint.CheckpointError` if it cannot be.
+        a :class:`~scatterbench.validation.fitting.checkpoint.CheckpointError` if it cannot be.
     progress : bool
         Show a progress bar.
 
@@ -218,7 +218,7 @@ def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", p
     """Write posterior.json (strict JSON; the wall-clock measurements under ``timing``, so
     the rest is the same, byte for byte, for the same inputs and seed) and the plots into
     ``out`` (atomic writes)."""
-    from validation.atomic import atomic_write_json
+    from scatterbench.validation.atomic import atomic_write_json
 
     os.makedirs(out, exist_ok=True)
     pp = predictive(fit, n_draws=n_draws, seed=fit.settings.seed)
@@ -323,7 +323,7 @@ def _plots(fit, pp, out):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from validation.atomic import atomic_savefig
+    from scatterbench.validation.atomic import atomic_savefig
 
     spec = fit.spec
     fig = corner_figure(fit)

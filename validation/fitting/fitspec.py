@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from models.scene.schema import shown
+from scatterbench.models.scene.schema import shown
 
 __all__ = [
     "FreeParam",

@@ -29,9 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate, interpolate
 
-from models.base import Sum
-from models.facet import _FacetModel, facet_slopes
-from models.slopes import UnitSlopes
+from scatterbench.models.base import Sum
+from scatterbench.models.facet import _FacetModel, facet_slopes
+from scatterbench.models.slopes import UnitSlopes
 
 __all__ = [
     "UnitSlopes",

@@ -18,7 +18,7 @@ The detector aperture is the data's: a sidecar that records ``aperture_deg``
 replaces the scene's ``[detector]`` (:func:`scene_for_data`).  Whether averaging
 over it matters (and the quadrature resolution), and whether a point source
 does, is measured once, at the scene's own values
-(:meth:`models.scene.Scene.decisions`), and kept for every evaluation, so the
+(:meth:`scatterbench.models.scene.Scene.decisions`), and kept for every evaluation, so the
 likelihood stays smooth in the parameters.
 
 The log-likelihood omits the data-only Jacobian ``-sum ln brdf_obs`` (a
@@ -31,9 +31,9 @@ import math
 
 import numpy as np
 
-from models import evaluation
-from models.polarization import ellipsometric, wrap_axis
-from models.scene import binding
+from scatterbench.models import evaluation
+from scatterbench.models.polarization import ellipsometric, wrap_axis
+from scatterbench.models.scene import binding
 
 from .fitspec import FitSpec, FitSpecError
 
@@ -94,7 +94,7 @@ class Likelihood:
 
     :meth:`batch` evaluates many positions at once, ``(walkers, k)`` in, ``(walkers,)`` out:
     the scene's model is evaluated once, as a model set over the walkers
-    (:mod:`models.scene.binding`), and the prior bounds are checked once, vectorized.  A
+    (:mod:`scatterbench.models.scene.binding`), and the prior bounds are checked once, vectorized.  A
     single position (``self(u)``, :meth:`pointwise`, :meth:`whitened`) is a batch of one, so
     every path gives the same numbers, bit for bit, whatever the batch (the chains of a
     vectorized sampler equal those of a per-walker one).  Scenes whose free keys cannot be

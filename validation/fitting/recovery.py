@@ -14,7 +14,7 @@ width are tabulated against the noise level and the number of geometries.
 Beside the posterior intervals each member also records whether the truth
 lies inside the *curvature* intervals of the optimum (``u_opt +- 1`` and ``+- 2``
 Gauss-Newton standard deviations in sampling coordinates; for free noise levels
-the ``1/sqrt(2N)`` approximation of :func:`~validation.fitting.sampling.optimize`).
+the ``1/sqrt(2N)`` approximation of :func:`~scatterbench.validation.fitting.sampling.optimize`).
 They cost nothing and answer the first question a low coverage raises: when the
 curvature intervals cover nominally on the same data sets and the posterior's
 do not, the sampler (chain length, walkers, burn-in) is at fault, not the data;
@@ -64,7 +64,7 @@ def simulate(scene, spec: FitSpec, data, truth: dict, noise: dict, rng):
     ``noise``: levels by term (``brdf`` fractional, ``eta_deg``, ``P``, ``P_C``);
     polarization columns are simulated only for terms with a level.  The model is the
     fit's own (its detector aperture, decided as the fit decides it) and the noise is the
-    likelihood's (:func:`~validation.fitting.likelihood.replicate`); error columns are not kept.
+    likelihood's (:func:`~scatterbench.validation.fitting.likelihood.replicate`); error columns are not kept.
     """
     lik = Likelihood(scene, spec, data)
     pred = lik.predict(lik.model(truth), data)

@@ -7,8 +7,8 @@ full log posterior from the best of them.
 
 ``run_chain`` runs an :class:`emcee.EnsembleSampler` (the stretch move, or
 differential evolution: ``ChainSettings.moves``) in
-segments of ``check_every`` steps (:class:`~validation.fitting.settings.ChainSettings`),
-storing the chain in a :class:`~validation.fitting.checkpoint.CheckpointBackend`.
+segments of ``check_every`` steps (:class:`~scatterbench.validation.fitting.settings.ChainSettings`),
+storing the chain in a :class:`~scatterbench.validation.fitting.checkpoint.CheckpointBackend`.
 After each segment the backend estimates the integrated autocorrelation time
 ``tau`` of every parameter (emcee's ``integrated_time`` on the whole chain,
 ``c = 5``) and, when it has a path, writes its checkpoint atomically.  The run
@@ -104,7 +104,7 @@ def _polish_noise(lik, u, val, bounds):
 
 
 def optimize(lik, seed, n_starts=4, start=None):
-    """Maximum of the log posterior ``lik(u)`` (a :class:`~validation.fitting.likelihood.Likelihood`).
+    """Maximum of the log posterior ``lik(u)`` (a :class:`~scatterbench.validation.fitting.likelihood.Likelihood`).
 
     Parameters
     ----------
@@ -287,7 +287,7 @@ def _progress_bar(show, total, initial=0, unit="step", desc="emcee"):
 
 def vectorized(log_prob) -> bool:
     """True when ``log_prob`` evaluates many positions at once (a ``batch`` method, as
-    :class:`~validation.fitting.likelihood.Likelihood` has): the sampler then hands it every
+    :class:`~scatterbench.validation.fitting.likelihood.Likelihood` has): the sampler then hands it every
     walker of a step in one call."""
     return callable(getattr(log_prob, "batch", None))
 

@@ -3,7 +3,7 @@
 A fit, a recovery study's members, a model comparison, the command line and
 the report all run chains with the same handful of settings; they pass one
 frozen, validated object instead of re-listing them.  The command line builds
-it from its flags in one place (``_chain_settings`` in :mod:`validation.cli.fit`).
+it from its flags in one place (``_chain_settings`` in :mod:`scatterbench.validation.cli.fit`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.params import check_real
+from scatterbench.models.params import check_real
 
 __all__ = ["ChainSettings", "MOVES"]
 
@@ -26,7 +26,7 @@ MOVES = ("stretch", "de")
 
 def _integer(name, value, low):
     """``value`` as an ``int >= low`` (the settings' fields, a study's injections, a process
-    executor's workers).  Not :func:`models.params.check_real`: that converts to a float,
+    executor's workers).  Not :func:`scatterbench.models.params.check_real`: that converts to a float,
     which an integer above sys.float_info.max overflows (a valid seed here)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < low:
         raise ValueError(f"{name} must be an integer >= {low}; got {value!r}")
@@ -34,7 +34,7 @@ def _integer(name, value, low):
 
 
 def _positive(name, value):
-    """``value`` as a finite float > 0, judged by :func:`models.params.check_real` (a bool is
+    """``value`` as a finite float > 0, judged by :func:`scatterbench.models.params.check_real` (a bool is
     not a number), with the settings' own message; a complex is refused here, where
     ``check_real`` would take one of no imaginary part."""
     try:

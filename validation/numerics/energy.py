@@ -20,7 +20,7 @@ model (SCATMECH's ``Facet_BRDF_Model`` behaves identically), reported as such.
 
 Since ``integral P3 zeta_x d^2 zeta = 0``, ``H = C (1 + Lambda(cot theta_i'))`` with
 ``Lambda`` Smith's function of the slopes along the beam's azimuth
-(:mod:`models.shadowing`): the separable Smith ``G1 = 1 / (1 + Lambda)`` is exactly the
+(:mod:`scatterbench.models.shadowing`): the separable Smith ``G1 = 1 / (1 + Lambda)`` is exactly the
 factor that brings ``H`` back to ``C``.  The tests hold the quadrature here to that
 identity; nothing here uses it.
 
@@ -46,9 +46,9 @@ import math
 
 import numpy as np
 
-from models.fresnel import fresnel_reflectance
-from models.shadowing import azimuthal_width
-from models.slopes import AnisotropicGGXSlopes, GGXSlopes
+from scatterbench.models.fresnel import fresnel_reflectance
+from scatterbench.models.shadowing import azimuthal_width
+from scatterbench.models.slopes import AnisotropicGGXSlopes, GGXSlopes
 
 __all__ = ["hit_fraction", "exposed_reflectance", "tail_radius", "TAIL_TOL"]
 
@@ -126,7 +126,7 @@ def _hit_fraction(slopes, tan):
 
 
 def exposed_reflectance(slopes, theta_i, substrate):
-    """Integrated reflectance of :class:`models.FacetBRDF` for unpolarized light, in slope space."""
+    """Integrated reflectance of :class:`scatterbench.models.FacetBRDF` for unpolarized light, in slope space."""
     ti = float(theta_i)
     si, ci = math.sin(ti), math.cos(ti)
     tan = si / ci

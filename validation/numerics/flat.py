@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from models.fresnel import fresnel_reflectance, fresnel_transmittance
+from scatterbench.models.fresnel import fresnel_reflectance, fresnel_transmittance
 
 __all__ = ["flat_coated_reflectance"]
 

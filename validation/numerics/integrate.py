@@ -1,4 +1,4 @@
-"""Hemispherical integrals of BRDFs: globally adaptive cubature (:func:`models.cubature.adaptive`).
+"""Hemispherical integrals of BRDFs: globally adaptive cubature (:func:`scatterbench.models.cubature.adaptive`).
 
 ``integrated_reflectance(model, theta_i, tol)`` integrates ``M00 cos(tr) dOmega``
 over the hemisphere for unpolarized incidence (or ``(M @ S_in)[0]`` for a given
@@ -8,7 +8,7 @@ which ``cos(tr) sin(tr) dtr = dt / 2``: the projected solid angle is uniform in
 a singular weight.
 
 The rectangles of ``(t, phi)`` of an initial partition are the cells of
-:func:`models.cubature.adaptive` (the integrator :class:`models.PointSourceBRDF` refines with):
+:func:`scatterbench.models.cubature.adaptive` (the integrator :class:`scatterbench.models.PointSourceBRDF` refines with):
 each region gets the Genz-Malik rule of degree 7 (17 points) and its embedded degree-5 rule,
 whose difference, or half the change a split made to its parent, is its error estimate
 (conservative: it bounds the degree-5 error, the returned value is the degree-7 one).  The
@@ -30,9 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models import cubature
-from models.params import check_real
-from models.polarization import stokes
+from scatterbench.models import cubature
+from scatterbench.models.params import check_real
+from scatterbench.models.polarization import stokes
 
 __all__ = ["IntegralResult", "integrated_reflectance"]
 
@@ -95,7 +95,7 @@ def integrated_reflectance(
         Polar angle of incidence, radians in [0, pi/2] (a scalar or a 0-d array).
     tol : float
         Absolute error requested on the integral (the result's ``error`` is the
-        summed regional estimate of :func:`models.cubature.adaptive`, which bounds it
+        summed regional estimate of :func:`scatterbench.models.cubature.adaptive`, which bounds it
         conservatively).
     incident : str or array
         Incident polarization (Stokes vector or name); the integrand is the
@@ -145,7 +145,7 @@ def integrated_reflectance(
 
 
 def _refine(f, n_cells, goal, max_evaluations):
-    """:func:`models.cubature.adaptive` on one row of ``n_cells`` cells: absolute error ``goal``,
+    """:func:`scatterbench.models.cubature.adaptive` on one row of ``n_cells`` cells: absolute error ``goal``,
     regions capped so that the evaluations (each region's, and its parent's before it) stay
     within about ``max_evaluations``."""
     return cubature.adaptive(

@@ -25,7 +25,7 @@ depolarizing reciprocal models too)
 
     M_rev = D M^T D,      D = diag(1, 1, -1, 1).
 
-:func:`models.polarization.reciprocal_jones` / ``reciprocal_mueller``
+:func:`scatterbench.models.polarization.reciprocal_jones` / ``reciprocal_mueller``
 implement the two and are tested against each other on random Jones matrices.
 """
 
@@ -36,8 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.base import is_isotropic, rotated_set
-from models.polarization import reciprocal_jones, reciprocal_mueller
+from scatterbench.models.base import is_isotropic, rotated_set
+from scatterbench.models.polarization import reciprocal_jones, reciprocal_mueller
 
 __all__ = [
     "ReciprocityErrors",

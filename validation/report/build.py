@@ -9,8 +9,8 @@ import sys
 import time
 import traceback
 
-from validation.atomic import atomic_write_json, atomic_write_text
-from validation.checks.registry import SEED, check_record, judge, select, tally
+from scatterbench.validation.atomic import atomic_write_json, atomic_write_text
+from scatterbench.validation.checks.registry import SEED, check_record, judge, select, tally
 
 from .core import Context, Section, render_html
 from .provenance import git_commit
@@ -87,7 +87,7 @@ def build_report(
     ``extra_scenes``: scene files shown beside the built-in examples;
     ``checks``: ids of the registered checks the summary judges (default: every one,
     less the slow ones in a quick run: the set ``validate`` judges);
-    ``context``: a :class:`~validation.report.core.Context` to run in (its memo shared,
+    ``context``: a :class:`~scatterbench.validation.report.core.Context` to run in (its memo shared,
     e.g. with ``validate``); default a new one.
     """
     ctx = _context(context, quick, previous, seed)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import jinja2
 
-from validation.checks.registry import CheckContext
+from scatterbench.validation.checks.registry import CheckContext
 
 __all__ = [
     "Section",
@@ -158,7 +158,7 @@ def _env():
     global _ENV
     if _ENV is None:
         _ENV = jinja2.Environment(
-            loader=jinja2.PackageLoader("validation.report", "templates"),
+            loader=jinja2.PackageLoader("scatterbench.validation.report", "templates"),
             autoescape=jinja2.select_autoescape(enabled_extensions=("html", "j2"), default=True),
             undefined=jinja2.StrictUndefined,
         )

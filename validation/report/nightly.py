@@ -35,7 +35,7 @@ import re
 import shutil
 from typing import NamedTuple
 
-from validation.atomic import LockHeld, atomic_write_json, file_lock, write_problem
+from scatterbench.validation.atomic import LockHeld, atomic_write_json, file_lock, write_problem
 
 from .build import read_results_checked, write_report
 
@@ -199,7 +199,7 @@ def nightly(history, quick=False, stamp=None, wait=3600.0, _after_build=None, **
     wait : float or None
         Seconds to wait for another run holding the history (``None``: as long as it takes).
     **kwargs
-        Passed to :func:`~validation.report.build.build_report` (``only``, ``checks``, ...).
+        Passed to :func:`~scatterbench.validation.report.build.build_report` (``only``, ``checks``, ...).
 
     Returns
     -------

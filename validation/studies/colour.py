@@ -9,9 +9,9 @@ transmission (``|t_in t_out|^2``, seed 000 Eq. 14-15) and ``R`` the stack's refl
 at ``alpha`` seen from the coating.  Divided by the same model with a perfect-mirror
 substrate (``R_s = R_p = 1``), it is a reflectance in [0, 1]: the colour seen at that
 aspecular angle, whose travel with angle is the interference pigment's "flop".
-:func:`colour_travel` computes it for a :class:`models.FacetBRDF` or
-:class:`models.SubsurfaceFacetBRDF` whose substrate is a :class:`models.FilmStack`
-(evaluated at each wavelength with :meth:`models.FilmStack.at`, so dispersive indices,
+:func:`colour_travel` computes it for a :class:`scatterbench.models.FacetBRDF` or
+:class:`scatterbench.models.SubsurfaceFacetBRDF` whose substrate is a :class:`scatterbench.models.FilmStack`
+(evaluated at each wavelength with :meth:`scatterbench.models.FilmStack.at`, so dispersive indices,
 callables of the wavelength, are followed); :func:`film_reflectance` is the stack's own
 ``(R_s + R_p) / 2``.
 
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import models
+from scatterbench import models
 
 __all__ = [
     "ColourTravel",
@@ -123,7 +123,7 @@ def _model_reflectance(model, theta_i, tr, pr, wavelengths_nm):
 
 def colour_travel(model, theta_i, aspecular_deg=ASPECULAR_DEG, wavelengths_nm=WAVELENGTHS_NM):
     """:class:`ColourTravel` of ``model`` (a facet model whose substrate is a
-    :class:`models.FilmStack`) lit at ``theta_i`` (radians), seen in the plane of incidence at
+    :class:`scatterbench.models.FilmStack`) lit at ``theta_i`` (radians), seen in the plane of incidence at
     each aspecular angle (degrees; the view must stay above the surface)."""
     stack = getattr(model, "substrate", None)
     if not isinstance(stack, models.FilmStack):

@@ -16,9 +16,9 @@ import os
 
 import numpy as np
 
-from models.geometry import signed_inplane
-from models.polarization import ellipsometric
-from validation.atomic import atomic_savefig, atomic_write_text
+from scatterbench.models.geometry import signed_inplane
+from scatterbench.models.polarization import ellipsometric
+from scatterbench.validation.atomic import atomic_savefig, atomic_write_text
 
 __all__ = ["scan", "scene_csv", "write_scene_outputs"]
 
@@ -26,7 +26,7 @@ __all__ = ["scan", "scene_csv", "write_scene_outputs"]
 def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
     """The in-plane curve and the out-of-plane scan of ``model`` (default the scene's),
     evaluated at ``precision`` (``"float32"`` only where a float32 kernel evaluates the
-    model, :func:`validation.studies.tradeoff.at_precision`).  Returns ``(model, rows)``."""
+    model, :func:`scatterbench.validation.studies.tradeoff.at_precision`).  Returns ``(model, rows)``."""
     from .tradeoff import at_precision
 
     model = scene.build() if model is None else model
@@ -95,7 +95,7 @@ def choose_settings(scene, tol):
     """
     import dataclasses
 
-    from models import PointSourceBRDF, RoughDiffuseBRDF
+    from scatterbench.models import PointSourceBRDF, RoughDiffuseBRDF
 
     notes = []
     n_inplane = int(_pick("in-plane grid", tol, notes))

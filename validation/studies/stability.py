@@ -1,7 +1,7 @@
 """Stability sweep: every model at the edges of its parameter space and geometry.
 
 For each public model class (``models.Model.registry``), and each model another package
-contributes (``scatterbench.models`` entry points, :func:`validation.testing.contributed_models`),
+contributes (``scatterbench.models`` entry points, :func:`scatterbench.validation.testing.contributed_models`),
 the sweep builds instances at the edges of each declared parameter, one parameter at a time
 from the defaults (nested declared objects, such as slope distributions, are
 swept the same way), and evaluates them on edge geometries: polar angles 0,
@@ -37,12 +37,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-import models
-from models.params import Declared
-from models.polarization import coherency_eigenvalues
-from validation.numerics.energy import hit_fraction
-from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_error
+from scatterbench import models
+from scatterbench.models.params import Declared
+from scatterbench.models.polarization import coherency_eigenvalues
+from scatterbench.validation.numerics.energy import hit_fraction
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 __all__ = [
     "Finding",
@@ -296,7 +296,7 @@ def _label(ti, tr, pr):
 
 
 def _evaluate(model, ti, tr, pr, found, name, params):
-    from validation.checks.common import fp_warnings  # not at import: it loads every check
+    from scatterbench.validation.checks.common import fp_warnings  # not at import: it loads every check
 
     with fp_warnings() as caught:
         M = model.mueller(ti, tr, pr)
@@ -353,7 +353,7 @@ def _scalar_params(model):
 
 
 def model_hit_fraction(model, theta_i):
-    """The hit fraction (:func:`validation.numerics.energy.hit_fraction`, an integral) of the
+    """The hit fraction (:func:`scatterbench.validation.numerics.energy.hit_fraction`, an integral) of the
     model's slope distribution under its coating at ``theta_i``; ``None`` without slopes."""
     slopes = getattr(model, "slopes", None)
     if not isinstance(slopes, models.SlopeDistribution):
@@ -440,17 +440,17 @@ def sweep(classes=None, energy=True, executor=None):
     Parameters
     ----------
     classes : list of type, optional
-        Model classes (default every registered model class but :class:`models.Sum`,
+        Model classes (default every registered model class but :class:`scatterbench.models.Sum`,
         then the models other packages contribute, ``scatterbench.models`` entry
         points, under their entry-point names).
     energy : bool
         Integrate each instance's reflectance (the slow part).
     executor : optional
-        Runs the instances, one task each (:mod:`validation.fitting.executors`;
+        Runs the instances, one task each (:mod:`scatterbench.validation.fitting.executors`;
         default in-process).  The findings, and their order, are the same on any
         executor: each instance is swept alone and they are collected in order.
     """
-    from validation.fitting.executors import SerialExecutor
+    from scatterbench.validation.fitting.executors import SerialExecutor
 
     targets = [(None, c) for c in classes] if classes is not None else _default_targets()
     tasks = [(name, inst) for name, cls in targets for inst in edge_instances(cls)]
@@ -460,8 +460,8 @@ def sweep(classes=None, energy=True, executor=None):
 
 
 def _default_targets():
-    from validation.checks.conformance import as_model
-    from validation.testing import contributed_models
+    from scatterbench.validation.checks.conformance import as_model
+    from scatterbench.validation.testing import contributed_models
 
     own = [(None, c) for c in models.Model.registry if c is not models.Sum]
     return own + [(c.name, as_model(c.model)) for c in contributed_models() if c.model is not None]

@@ -6,7 +6,7 @@ an independent higher-accuracy reference (never an extrapolation):
 
 * ``integration tolerance``: the integrated reflectance at ``tol`` in
   1e-2 .. 1e-8, against the slope-space prediction of
-  :mod:`validation.numerics.energy` (an exposed facet surface) — a different algorithm,
+  :mod:`scatterbench.validation.numerics.energy` (an exposed facet surface) — a different algorithm,
   not the same integrator at a tighter tolerance;
 * ``in-plane grid``: an in-plane BRDF curve sampled on ``k`` points and linearly
   interpolated, against the model evaluated on a 20001-point grid (max relative
@@ -41,10 +41,10 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-import models
-from models.geometry import signed_inplane
-from validation.numerics.energy import exposed_reflectance
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.models.geometry import signed_inplane
+from scatterbench.validation.numerics.energy import exposed_reflectance
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 __all__ = [
     "Point",
@@ -285,12 +285,12 @@ def knob_point_source(quick=False):
 def float32_unavailable(model):
     """Why ``model`` has no float32 evaluation to measure (a sentence naming it), or ``None``.
 
-    Every :class:`models.Model`'s ``mueller`` takes ``precision="float32"``, but only a
+    Every :class:`scatterbench.models.Model`'s ``mueller`` takes ``precision="float32"``, but only a
     model a compiled kernel evaluates (``_kernel_spec()`` not ``None``, numba backend)
     computes in float32, and only inside the kernels' float32-safe domain
-    (:mod:`models.float32_domain`): elsewhere (Monte Carlo, wrappers such as the point
+    (:mod:`scatterbench.models.float32_domain`): elsewhere (Monte Carlo, wrappers such as the point
     source; parameters outside the domain) it evaluates in float64 and rounds, at float64's
-    cost.  An object that is not a :class:`models.Model` is taken at its word when its
+    cost.  An object that is not a :class:`scatterbench.models.Model` is taken at its word when its
     ``mueller`` takes the keyword.
     """
     name = type(model).__name__
@@ -344,7 +344,7 @@ def knob_precision(quick=False, model=None):
             f"{reason}: it evaluates in float64 (and rounds a float32 request), so there is no "
             "float32 cost to measure"
         )
-    from validation.checks.common import random_geometries  # not at import: it loads every check
+    from scatterbench.validation.checks.common import random_geometries  # not at import: it loads every check
 
     ti, tr, pr = random_geometries(4096, seed=12, max_deg=85.0)
     measured = {

@@ -2,7 +2,7 @@
 
 from lambert_specular import LambertSpecular
 
-from validation.testing import parametrize_with_checks
+from scatterbench.validation.testing import parametrize_with_checks
 
 
 @parametrize_with_checks([LambertSpecular(), LambertSpecular(albedo=1.0, weight=0.5, roughness=0.05, n=2.5)])

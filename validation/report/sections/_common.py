@@ -8,8 +8,8 @@ matplotlib.use("Agg")  # the report draws without a display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-import models  # noqa: E402
-from models.geometry import signed_inplane  # noqa: E402
+from scatterbench import models  # noqa: E402
+from scatterbench.models.geometry import signed_inplane  # noqa: E402
 
 __all__ = ["plt", "AL", "signed", "inplane", "default_models", "is_heavy", "finish"]
 
@@ -18,7 +18,7 @@ AL = 1.37 + 7.62j
 
 
 def signed(x_deg):
-    """Signed in-plane angle (deg) -> (theta_r, phi_r) (:func:`models.geometry.signed_inplane`)."""
+    """Signed in-plane angle (deg) -> (theta_r, phi_r) (:func:`scatterbench.models.geometry.signed_inplane`)."""
     return signed_inplane(np.radians(x_deg))
 
 
@@ -31,7 +31,7 @@ def default_models():
     """One instance per model class: its defaults, or the stability sweep's
     representative base (the point-source wrapper around Cook-Torrance, the Monte
     Carlo model at 200 pairs)."""
-    from validation.studies.stability import _BASES
+    from scatterbench.validation.studies.stability import _BASES
 
     out = []
     for cls in models.Model.registry:

@@ -8,9 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from validation.checks.shadowing import ANGLES_DEG, QUICK_ANGLES_DEG, conductor_albedo_curves
-from validation.numerics.integrate import integrated_reflectance
-from validation.numerics.reciprocity import reciprocity_errors
+from scatterbench.validation.checks.shadowing import ANGLES_DEG, QUICK_ANGLES_DEG, conductor_albedo_curves
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.reciprocity import reciprocity_errors
 
 from ..core import figure_block, table_block, text_block
 from ._common import default_models, finish, is_heavy, plt
@@ -25,7 +25,7 @@ GRID_DEG = (0.5, 88.5)
 class ConservationData:
     """``maps``: per model, (name, relative reciprocity error over theta_i x theta_r);
     ``albedo``: per reflecting model, (name, theta_i in deg, albedo); ``smith``: the
-    perfect-conductor :class:`~validation.checks.shadowing.AlbedoCurve` s, with and without
+    perfect-conductor :class:`~scatterbench.validation.checks.shadowing.AlbedoCurve` s, with and without
     Smith shadowing."""
 
     skipped: tuple[str, ...]

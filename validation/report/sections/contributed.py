@@ -1,5 +1,5 @@
 """Contributed models: every model another package registers in the ``scatterbench.models``
-entry-point group, with its conformance kit results (:func:`validation.testing.contributed_section`)."""
+entry-point group, with its conformance kit results (:func:`scatterbench.validation.testing.contributed_section`)."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ _RESULTS = ["entry point", "check", "measured", "limit", "status", "message"]
 
 @dataclass(frozen=True)
 class ContributedData:
-    """``group``: the entry-point group; ``rows``: one :class:`validation.testing.ContributedRow`
+    """``group``: the entry-point group; ``rows``: one :class:`scatterbench.validation.testing.ContributedRow`
     per entry, in name order (empty: none installed)."""
 
     group: str
@@ -33,7 +33,7 @@ class ContributedData:
 
 
 def compute(ctx):
-    from validation.testing import ENTRY_POINT_GROUP, contributed_section
+    from scatterbench.validation.testing import ENTRY_POINT_GROUP, contributed_section
 
     return ContributedData(ENTRY_POINT_GROUP, tuple(contributed_section(ctx)))
 

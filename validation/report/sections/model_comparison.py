@@ -1,12 +1,12 @@
 """Model comparison: seed 003's combination against Maxwell-Beard on the same data (issue 6 item 8).
 
-Both hypotheses are fitted (emcee, :func:`validation.fitting.compare.seed003_pairing`)
+Both hypotheses are fitted (emcee, :func:`scatterbench.validation.fitting.compare.seed003_pairing`)
 to two held-out SCATMECH data sets, one made by each hypothesis's generator,
 once with every likelihood term (BRDF, eta, P, P_C) and once with the BRDF
 alone; the page shows the information criteria, the fitted speckle level
 (against the level the data were made with) and the posterior-predictive coverage.  The check
 that the generating hypothesis is preferred on each data set is registered in
-:mod:`validation.checks.fitting`, whose fits this section draws.
+:mod:`scatterbench.validation.checks.fitting`, whose fits this section draws.
 """
 
 from __future__ import annotations
@@ -115,8 +115,8 @@ def _comparison_rows(cases):
 
 
 def compute(ctx):
-    from validation.checks.fitting import comparison_cases, comparison_settings
-    from validation.fitting.compare import SEED003_PAIRING
+    from scatterbench.validation.checks.fitting import comparison_cases, comparison_settings
+    from scatterbench.validation.fitting.compare import SEED003_PAIRING
 
     st = comparison_settings(ctx.quick)
     cases = comparison_cases(ctx)  # the model-comparison check's fits, run once

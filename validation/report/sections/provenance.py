@@ -8,7 +8,7 @@ import sys
 from dataclasses import dataclass
 from importlib import metadata
 
-import references
+from scatterbench import references
 
 from ..core import table_block
 from ..provenance import git_commit

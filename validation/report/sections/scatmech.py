@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import models
+from scatterbench import models
 
 from ..core import figure_block, table_block, text_block
 from ._common import AL, finish, plt
@@ -53,8 +53,8 @@ def _row(label, e):
 
 
 def compute(ctx):
-    from validation.checks.seed000 import scatmech_facet_errors
-    from validation.checks.seed003 import scatmech_error_distributions
+    from scatterbench.validation.checks.seed000 import scatmech_facet_errors
+    from scatterbench.validation.checks.seed003 import scatmech_error_distributions
 
     errs = {f"{k} (committed)": v for k, v in scatmech_facet_errors().items()}
     errs.update(scatmech_error_distributions())

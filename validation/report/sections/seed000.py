@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import models
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 from ..core import figure_block, table_block
 from ._common import AL, inplane, plt

@@ -7,10 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import models
-import references
-from validation.checks.seed001 import RATIO_GEOMETRIES
-from validation.numerics.integrate import integrated_reflectance
+from scatterbench import models, references
+from scatterbench.validation.checks.seed001 import RATIO_GEOMETRIES
+from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 from ..core import figure_block, table_block, text_block
 from ._common import plt
@@ -62,7 +61,7 @@ class Seed001Data:
 
 
 def ct_albedo_rows(published):
-    """Per incidence of ``published`` (:func:`validation.checks.seed001.published_albedos`' ``{deg:
+    """Per incidence of ``published`` (:func:`scatterbench.validation.checks.seed001.published_albedos`' ``{deg:
     albedo}``), the energy-normalized albedo of the same iron plate model and the ratio / (4 pi)."""
     rows = []
     for t, v in published.items():
@@ -90,7 +89,7 @@ def _ratio(a, b):
 
 def _varnish(n_t, n_p):
     """The varnish ratio maps and their summary rows (validation.checks.seed001.varnish_ratio_map)."""
-    from validation.checks.seed001 import _pair, varnish_ratio_map
+    from scatterbench.validation.checks.seed001 import _pair, varnish_ratio_map
 
     rows = [
         {
@@ -146,7 +145,7 @@ def point_source_scan(vn, lo, hi):
 def _point_source():
     """The iron plate (references.IRON_PLATE) under each printed incidence range, and the
     point source's approach to the collimated beam as it recedes."""
-    from validation.checks.seed001 import iron_plate_models, point_source_collimated_error
+    from scatterbench.validation.checks.seed001 import iron_plate_models, point_source_collimated_error
 
     _, vn = iron_plate_models()
     scans, rows = zip(
@@ -159,7 +158,7 @@ def _point_source():
 
 
 def compute(ctx):
-    from validation.checks.seed001 import published_albedos, published_over_energy_error
+    from scatterbench.validation.checks.seed001 import published_albedos, published_over_energy_error
 
     ratio_err = ctx.compute(published_over_energy_error)  # the check's value, computed once
     albedo_rows = ct_albedo_rows(ctx.compute(published_albedos))  # the energy check's integrals

@@ -8,10 +8,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize as _opt
 
-import models
-import references
-from models.combination import mueller_with_error
-from models.polarization import ellipsometric, stokes
+from scatterbench import models, references
+from scatterbench.models.combination import mueller_with_error
+from scatterbench.models.polarization import ellipsometric, stokes
 
 from ..core import figure_block, table_block, text_block
 from ._common import plt, signed
@@ -148,7 +147,7 @@ def _preset(name, pre, sc, model, x):
 
 
 def compute(ctx):
-    from models import scene as scene_mod
+    from scatterbench.models import scene as scene_mod
 
     x = np.linspace(-85.0, 85.0, 69 if ctx.quick else 171)
     presets = references.seed003_presets()

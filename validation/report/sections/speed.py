@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import references
-from models.kernels import PARALLEL_MIN
+from scatterbench import references
+from scatterbench.models.kernels import PARALLEL_MIN
 
 from ..core import figure_block, table_block
 from ._common import default_models, is_heavy, plt
@@ -36,7 +36,7 @@ _PEER_RUN = ["date", "machine", "load average (1 min, start / end)", "threads", 
 class SpeedData:
     """``knobs``: the trade-off study's results (each with every measured point);
     ``pareto``: per knob, its non-dominated points' rows; ``geometries``: throughput sample size;
-    ``peer_rows``, ``peer_run``: :func:`references.peer_timings`' pairs with their ratios, and
+    ``peer_rows``, ``peer_run``: :func:`scatterbench.references.peer_timings`' pairs with their ratios, and
     the run that measured them (date, machine, load, threads)."""
 
     knobs: tuple
@@ -55,7 +55,7 @@ def _throughput(n, seed):
     """Per model, the cost of one ``mueller`` call on ``n`` random geometries
     (:data:`HEAVY_GEOMETRIES` for the Monte Carlo and wrapper models), timed by the
     trade-off study's :func:`time_call`."""
-    from validation.studies.tradeoff import time_call
+    from scatterbench.validation.studies.tradeoff import time_call
 
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.45, (2, n))
@@ -109,7 +109,7 @@ def _peers():
 
 
 def compute(ctx):
-    from validation.studies.tradeoff import pareto, study
+    from scatterbench.validation.studies.tradeoff import pareto, study
 
     knobs = tuple(study(quick=ctx.quick))
     fronts = tuple(

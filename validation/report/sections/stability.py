@@ -48,8 +48,8 @@ def _group_row(g):
 
 def summarize(findings, accepted, quick=False):
     """The section's data from the sweep's ``findings`` and the ``accepted`` entries
-    (:func:`validation.studies.stability.load_accepted`)."""
-    from validation.studies.stability import classify, group_findings
+    (:func:`scatterbench.validation.studies.stability.load_accepted`)."""
+    from scatterbench.validation.studies.stability import classify, group_findings
 
     ok, bad = classify(findings, accepted)
     rows = tuple(
@@ -68,8 +68,8 @@ def summarize(findings, accepted, quick=False):
 
 
 def compute(ctx):
-    from validation.checks.stability import sweep_findings
-    from validation.studies.stability import load_accepted
+    from scatterbench.validation.checks.stability import sweep_findings
+    from scatterbench.validation.studies.stability import load_accepted
 
     return summarize(sweep_findings(ctx), load_accepted(), ctx.quick)  # the stability check's sweep
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from validation.checks.registry import check_record, registered, run_checks
+from scatterbench.validation.checks.registry import check_record, registered, run_checks
 
 from ..core import checks_block, text_block
 

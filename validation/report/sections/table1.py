@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from validation.checks import table1
+from scatterbench.validation.checks import table1
 
 from ..core import table_block, text_block
 

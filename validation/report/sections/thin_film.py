@@ -1,5 +1,5 @@
 """Thin-film interference flakes: the pearlescent example scene's spectrum and colour
-versus aspecular angle (:mod:`validation.studies.colour`)."""
+versus aspecular angle (:mod:`scatterbench.validation.studies.colour`)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import references
-from models import scene
+from scatterbench import references
+from scatterbench.models import scene
 
 from ..core import figure_block, table_block, text_block
 from ._common import plt
@@ -21,7 +21,7 @@ SCENE = "pearlescent_mica_tio2.toml"
 
 @dataclass(frozen=True)
 class ThinFilmData:
-    """The scene's name and stack, and its :class:`~validation.studies.colour.ColourTravel`."""
+    """The scene's name and stack, and its :class:`~scatterbench.validation.studies.colour.ColourTravel`."""
 
     scene_name: str
     stack: str
@@ -30,7 +30,7 @@ class ThinFilmData:
 
 
 def compute(ctx):
-    from validation.studies.colour import colour_travel
+    from scatterbench.validation.studies.colour import colour_travel
 
     sc = scene.load(references.scene_path(SCENE))
     model = sc.mechanisms()[0].model  # the flakes: a facet model whose substrate is the stack

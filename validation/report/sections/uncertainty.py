@@ -5,7 +5,7 @@ from __future__ import annotations
 import tempfile
 from dataclasses import dataclass
 
-import references
+from scatterbench import references
 
 from ..core import figure_block, table_block, text_block
 
@@ -56,7 +56,7 @@ class UncertaintyData:
 
 
 def _fit_settings(quick, seed):
-    from validation.fitting.settings import ChainSettings
+    from scatterbench.validation.fitting.settings import ChainSettings
 
     if quick:
         return ChainSettings(walkers=16, seed=seed, max_steps=1000, check_every=100, starts=2)
@@ -87,7 +87,7 @@ def _recovery_row(cell, name, v):
 
 def _recovery(ctx):
     """The injection-recovery coverage: the recovery-coverage check's study, run once."""
-    from validation.checks.fitting import RECOVERY_SCENE, recovery_cells, recovery_settings
+    from scatterbench.validation.checks.fitting import RECOVERY_SCENE, recovery_cells, recovery_settings
 
     rs = recovery_settings(ctx.quick, ctx.seed)
     rows = tuple(_recovery_row(c, k, v) for c in recovery_cells(ctx) for k, v in c["summary"].items())
@@ -98,11 +98,11 @@ def _recovery(ctx):
 
 def _fit(ctx):
     """The example fit, its posterior.json summary (truth check, predictive checks) and data."""
-    from models import scene as scene_mod
-    from validation.fitting.datafile import load_data
-    from validation.fitting.fit import run_fit, write_fit
-    from validation.fitting.fitspec import fitspec_from
-    from validation.fitting.likelihood import Likelihood
+    from scatterbench.models import scene as scene_mod
+    from scatterbench.validation.fitting.datafile import load_data
+    from scatterbench.validation.fitting.fit import run_fit, write_fit
+    from scatterbench.validation.fitting.fitspec import fitspec_from
+    from scatterbench.validation.fitting.likelihood import Likelihood
 
     sc = scene_mod.load(references.scene_path(FIT_SCENE))
     data = load_data(references.data_path(FIT_DATA))
@@ -166,7 +166,7 @@ def _sampling_row(samp, timing):
 
 
 def compute(ctx):
-    from validation.fitting.fit import predictive
+    from scatterbench.validation.fitting.fit import predictive
 
     fit, post, data, spec, st = _fit(ctx)
     pp = predictive(fit, n_draws=200, seed=ctx.seed)
@@ -224,7 +224,7 @@ def _recovery_text(d):
 
 
 def _render_figures(s, d):
-    from validation.fitting.fit import corner_figure, predictive_figure
+    from scatterbench.validation.fitting.fit import corner_figure, predictive_figure
 
     samp = d.sampling
     s.blocks.append(
