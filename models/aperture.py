@@ -117,7 +117,7 @@ class DetectorAperture(_Wrapper):
         evaluated once per block of :data:`_BLOCK` nodes (``python benchmarks/wrappers.py
         --blocks``, one run: blocks of 2^12 to 2^15 nodes alike, 1.7-2.5 us per geometry; 2^16,
         whose 16 result rows are 8 MB, 2.8-3.3 from 8000 geometries on)."""
-        from .kernels import aperture as kernel
+        from .kernels import aperture as kernel  # numba (heavy): compiled kernels load when one first runs
 
         a, b, cos_u, w = self._nodes
         K, n = a.size, ti.size

@@ -124,48 +124,25 @@ class Model(Declared):
         spec = self._kernel_spec()
         if spec is None:
             return None
-        from . import kernels
+        from . import kernels  # numba (heavy): compiled kernels load when one first runs
 
         return kernels.Compiled(self, *spec)
 
-    def _compiled(self):
-        """The compiled kernel to use here (``None``: numpy)."""
-        return self._kernel if evaluation.current_backend() == "numba" else None
-
     def _m16(self, ti, tr, pr):
-        """Mueller elements ``(16, n)`` of flat angles: the kernel or the numpy implementation."""
-        k = self._compiled()
-        if k is not None:
-            return k.run(ti, tr, pr, 16)
-        if self._sets and not self._numpy_sets:
-            return evaluation.each(self, ti, tr, pr, "_m16", 1)
-        return self._mueller16(ti, tr, pr)
+        """:func:`scatterbench.models.evaluation.flat`, Mueller elements ``(16, n)``."""
+        return evaluation.flat(self, ti, tr, pr, 16)
 
     def _m00(self, ti, tr, pr):
-        """``M00`` ``(n,)`` of flat angles: the kernel or the numpy implementation."""
-        k = self._compiled()
-        if k is not None:
-            return k.run(ti, tr, pr, 1)[0]
-        if self._sets and not self._numpy_sets:
-            return evaluation.each(self, ti, tr, pr, "_m00", 0)
-        return self._brdf_flat(ti, tr, pr)
+        """:func:`scatterbench.models.evaluation.flat`, ``M00`` ``(n,)``."""
+        return evaluation.flat(self, ti, tr, pr, 1)
 
-    # -- validation and chunked evaluation ----------------------------------------
+    # -- the public evaluation: every route is chosen in models.evaluation --------------
     def _angles(self, theta_i, theta_r, phi_r):
         return broadcast_angles(*evaluation.checked_angles(self, theta_i, theta_r, phi_r))
 
     @cached_property
     def _has_kernel(self) -> bool:
         return self._kernel_spec() is not None
-
-    def _kernel_path(self) -> bool:
-        """True when chunks go through the kernels here (a model set's chunks each build
-        their own, so the whole set's :attr:`_kernel` is never built)."""
-        return self._has_kernel and evaluation.current_backend() == "numba"
-
-    def _plan(self, theta_i, theta_r, phi_r):
-        chunk = evaluation.KERNEL_CHUNK if self._kernel_path() else evaluation.CHUNK
-        return evaluation.Plan(self, theta_i, theta_r, phi_r, chunk)
 
     def iter_mueller(self, theta_i, theta_r, phi_r=0.0):
         """Stream the Mueller BRDF: yields ``(flat_slice, block)`` with ``block`` of shape
@@ -174,8 +151,7 @@ class Model(Declared):
         Memory stays bounded by the chunk size however many geometries there are
         (10^7 and beyond): reduce or store each block as it comes.
         """
-        for sl, ti, tr, pr, m in self._plan(theta_i, theta_r, phi_r).blocks():
-            yield sl, m._m16(ti, tr, pr).T.reshape(-1, 4, 4)
+        return evaluation.blocks(self, theta_i, theta_r, phi_r)
 
     def mueller(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
         """Mueller-matrix BRDF ``(..., 4, 4)`` in 1/sr, s/p bases (SCATMECH ``psps``).
@@ -188,37 +164,25 @@ class Model(Declared):
         (:mod:`scatterbench.models.float32_domain`); otherwise, as for a model without a kernel, the
         float64 evaluation rounded to float32 (:attr:`float32_fallback` says why).
         """
-        fast = self._fast(theta_i, theta_r, phi_r, 16, precision, out)
+        fast = evaluation.small(self, theta_i, theta_r, phi_r, 16, precision, out)
         if fast is not None:
             return fast
-        shape, out = self.mueller16(theta_i, theta_r, phi_r, out, precision)
+        shape, out = evaluation.evaluate(self, theta_i, theta_r, phi_r, 16, precision, out)
         return evaluation.as_matrices(out, shape)
 
     def mueller16(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
         """``(shape, M)``: the Mueller BRDF as its element-major storage ``M`` ``(16, N)``
         (row ``4 a + b`` is element ``ab``) and the broadcast ``shape`` of the geometries
         (``N`` their number); :meth:`mueller` returns a ``shape + (4, 4)`` view of it."""
-        plan = self._plan(theta_i, theta_r, phi_r)
-        dtype = np.dtype(evaluation.check_precision(precision))
-        # Element-major storage: each chunk's (16, k) block is copied without a transpose.
-        if out is None:
-            out = np.empty((16, plan.n), dtype=dtype)
-        elif out.shape != (16, plan.n) or out.dtype != dtype:
-            raise ValueError(
-                f"out must have shape (16, {plan.n}) and dtype {dtype}; got {out.shape} {out.dtype}"
-            )
-        self._fill(plan, out, 16, precision)
-        return plan.shape, out
+        return evaluation.evaluate(self, theta_i, theta_r, phi_r, 16, precision, out)
 
     def brdf(self, theta_i, theta_r, phi_r=0.0, precision="float64"):
         """Unpolarized-in, total-out BRDF ``M00`` (1/sr); ``precision`` as for :meth:`mueller`."""
-        fast = self._fast(theta_i, theta_r, phi_r, 1, precision)
+        fast = evaluation.small(self, theta_i, theta_r, phi_r, 1, precision)
         if fast is not None:
             return fast
-        plan = self._plan(theta_i, theta_r, phi_r)
-        out = np.empty((1, plan.n), dtype=np.dtype(evaluation.check_precision(precision)))
-        self._fill(plan, out, 1, precision)
-        return out.reshape(plan.shape)
+        shape, out = evaluation.evaluate(self, theta_i, theta_r, phi_r, 1, precision)
+        return out.reshape(shape)
 
     @property
     def float32_fallback(self) -> str | None:
@@ -236,38 +200,6 @@ class Model(Declared):
     def _float32_unsafe(self):
         return float32_domain.model_unsafe(self)
 
-    def _falls_back(self) -> bool:
-        """True when a float32 request runs the kernel in float64 here (outside the
-        float32-safe domain, unless :func:`scatterbench.models.evaluation.raw_float32` is in effect)."""
-        return self._float32_unsafe is not None and evaluation.float32_guarded()
-
-    def _fill(self, plan, out, rows, precision):
-        """Evaluate ``plan`` into ``out`` chunk by chunk: the kernel where one covers the model
-        (a model set's chunk is a model with flat parameters, with its own kernel rows; float32
-        outside the float32-safe domain computed in float64), otherwise the numpy
-        implementation (rounded to ``out``'s dtype)."""
-        kernel = self._kernel_path()
-        if kernel and precision == "float32" and self._falls_back():
-            precision = "float64"
-        for sl, ti, tr, pr, m in plan.blocks(fill=not kernel):
-            if kernel:
-                m._kernel.write(out, sl, ti, tr, pr, precision)
-            else:
-                out[:, sl] = m._m16(ti, tr, pr) if rows == 16 else m._m00(ti, tr, pr)
-
-    def _fast(self, theta_i, theta_r, phi_r, rows, precision, out=None):
-        """A small call (:meth:`scatterbench.models.kernels.Compiled.fast`) straight into the kernel, or
-        ``None`` for the general path (which also raises the errors)."""
-        kernel = None if self._sets else self._compiled()
-        if kernel is None:
-            return None
-        if precision == "float64" or (precision == "float32" and not self._falls_back()):
-            return kernel.fast(theta_i, theta_r, phi_r, rows, precision, out)
-        if precision != "float32" or out is not None:
-            return None
-        fast = kernel.fast(theta_i, theta_r, phi_r, rows, "float64")  # the float32 fallback
-        return None if fast is None else fast.astype(np.float32)
-
     def _brdf_flat(self, ti, tr, pr):
         return self._mueller16(ti, tr, pr)[0]
 
@@ -277,16 +209,7 @@ class Model(Declared):
         non-depolarizing models; the overall phase is arbitrary."""
         if self.depolarizing:
             raise NotImplementedError(f"{type(self).__name__} is depolarizing: it has no Jones matrix")
-        plan = evaluation.Plan(self, theta_i, theta_r, phi_r, evaluation.CHUNK)
-        out = np.empty((plan.n, 2, 2), dtype=complex)
-        for sl, ti, tr, pr, m in plan.blocks():
-            out[sl] = m._jones_each(ti, tr, pr)
-        return out.reshape(plan.shape + (2, 2))
-
-    def _jones_each(self, ti, tr, pr):
-        if self._sets and not self._numpy_sets:
-            return evaluation.each(self, ti, tr, pr, "_jones_each", 0)
-        return self._jones_flat(ti, tr, pr)
+        return evaluation.jones(self, theta_i, theta_r, phi_r)
 
     def scattered_stokes(self, theta_i, theta_r, phi_r=0.0, incident="unpolarized"):
         """Scattered Stokes vector BRDF ``(..., 4)`` for an incident state (name or vector)."""

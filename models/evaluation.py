@@ -1,15 +1,26 @@
-"""How a model is evaluated: backend, precision, broadcasting and chunks, model sets.
+"""How a model is evaluated: one route chooser for backend, precision, broadcasting,
+chunks and model sets.
 
-:class:`scatterbench.models.Model` validates the angles, broadcasts them against its parameter shape
-(:mod:`scatterbench.models.modelset`) and evaluates them in chunks through one dispatcher per
-quantity (``_m16`` for the Mueller matrix, ``_m00`` for its first element):
+Every evaluation of a model goes through this module, and the choice between the routes is
+made in one place each:
 
-* the compiled kernels (:mod:`scatterbench.models.kernels`, numba) for the closed-form models and
-  the options they cover, the default backend;
-* otherwise the numpy implementation (``_mueller16``, ``_brdf_flat``), the reference
-  path the kernels are tested against (``with models.backend("numpy"): ...`` selects
-  it for everything).  A model set whose numpy implementation takes scalar parameters
-  only is evaluated one distinct parameter element at a time (:func:`each`).
+* :func:`compiled` chooses the implementation: the model's compiled kernel
+  (:mod:`scatterbench.models.kernels`, numba) where one covers the model and its options and
+  the numba backend is selected (the default), otherwise the numpy implementation
+  (``_mueller16``, ``_brdf_flat``), the reference path the kernels are tested against
+  (``with models.backend("numpy"): ...`` selects it for everything);
+* :func:`flat` is the named internal entry for angles that were validated already (flat
+  float64 arrays, a single model or a chunk of a model set): wrappers (point source,
+  aperture), sums and the Monte Carlo's surface term evaluate their inner models through it.
+  A model set whose numpy implementation takes scalar parameters only is evaluated one
+  distinct parameter element at a time (:func:`each`);
+* :func:`evaluate` is the route of a user's call (``mueller``, ``mueller16``, ``brdf``):
+  a small call of a single compiled model straight into its kernel (:func:`small`), or the
+  angles validated and broadcast once (:class:`Plan`) and evaluated chunk by chunk
+  (:func:`fill`); :func:`blocks` streams the same chunks (``iter_mueller``), and
+  :class:`FixedAngles` keeps one set of validated angles for many models (a fit's rows);
+* :func:`kernel_precision` decides, once per model, whether a float32 request runs the
+  float32 kernel or the float64 one (:mod:`scatterbench.models.float32_domain`).
 
 Chunks bound memory however many geometries there are: the numpy path's temporaries
 stay in cache (:data:`CHUNK`), a kernel keeps none and takes longer chunks
@@ -34,12 +45,18 @@ __all__ = [
     "PRECISIONS",
     "CHUNK",
     "KERNEL_CHUNK",
+    "compiled",
+    "flat",
+    "evaluate",
+    "small",
+    "blocks",
     "Plan",
     "FixedAngles",
     "small_angles",
     "as_matrices",
     "float32_guarded",
     "raw_float32",
+    "kernel_precision",
 ]
 
 #: Geometries per chunk on the numpy path, chosen so a model's float64 temporaries stay in
@@ -254,7 +271,7 @@ class Plan:
 class FixedAngles:
     """Angles at which many models are evaluated, one after another (a fit's rows, each
     likelihood evaluation a new model set of the walkers): :meth:`mueller16` is
-    ``model.mueller16`` at them.  For a compiled model whose geometries fit in one chunk, the
+    :func:`evaluate` at them.  For a compiled model whose geometries fit in one chunk, the
     angles are validated and broadcast once per broadcast shape and handed to its kernel as
     :class:`Plan`'s single chunk hands them: the same flat inputs and the same kernel, so
     the same bits, without the validation and broadcasting a :class:`Plan` repeats per call."""
@@ -265,18 +282,18 @@ class FixedAngles:
 
     def mueller16(self, model):
         """``(shape, M)``: ``model.mueller16`` at the angles."""
-        if not model._kernel_path():
-            return model.mueller16(*self.angles)
+        if not kernel_path(model):
+            return evaluate(model, *self.angles, 16)
         leaves = model._sets
         shape = np.broadcast_shapes(*(np.shape(a) for a in self.angles), *(v.shape for v in leaves.values()))
         if math.prod(shape) > KERNEL_CHUNK:
-            return model.mueller16(*self.angles)
-        flat = self._flat.get(shape)
-        if flat is None:
-            flat = self._flat[shape] = [_whole(a, shape) for a in checked_angles(model, *self.angles)]
+            return evaluate(model, *self.angles, 16)
+        angles = self._flat.get(shape)
+        if angles is None:
+            angles = self._flat[shape] = [_whole(a, shape) for a in checked_angles(model, *self.angles)]
         if leaves:
             model = with_leaves(model, {k: _whole(v, shape) for k, v in leaves.items()})
-        return shape, model._m16(*flat)
+        return shape, model._kernel.run(*angles, 16)
 
 
 def _whole(a, shape):
@@ -300,11 +317,11 @@ def _gather(arrays, flat, shape, start, stop, fill):
     return parts
 
 
-def each(model, ti, tr, pr, method, axis):
-    """``method`` (e.g. ``"_m16"``) of a model whose parameters are flat arrays (one per
+def each(model, ti, tr, pr, fn, axis):
+    """``fn(element, ti, tr, pr)`` of a model whose parameters are flat arrays (one per
     geometry) and whose numpy implementation takes scalar parameters: evaluated once per
     distinct parameter element, on the geometries that have it.  ``axis`` is the geometry
-    axis of the method's result (1 for ``(16, n)``, 0 for ``(n,)`` or ``(n, 2, 2)``)."""
+    axis of the result (1 for ``(16, n)``, 0 for ``(n,)`` or ``(n, 2, 2)``)."""
     leaves = model._sets
     cols = []
     for a in leaves.values():
@@ -314,10 +331,127 @@ def each(model, ti, tr, pr, method, axis):
     out = None
     for r, i0 in enumerate(first):
         sel = np.flatnonzero(inverse == r)
-        val = getattr(model._element(leaves, int(i0)), method)(ti[sel], tr[sel], pr[sel])
+        val = fn(model._element(leaves, int(i0)), ti[sel], tr[sel], pr[sel])
         if out is None:
             shape = list(val.shape)
             shape[axis] = ti.size
             out = np.empty(shape, dtype=val.dtype)
         out[(slice(None),) * axis + (sel,)] = val
     return out
+
+
+# --------------------------------------------------------------------------- the routes
+def compiled(model):
+    """``model``'s compiled kernel where it evaluates here, else ``None`` (numpy): the numba
+    backend is selected and a kernel covers the model and its options.  For a single model or
+    a chunk of a model set (flat parameters): a whole model set's chunks build their own."""
+    if _BACKEND.get() != "numba" or not model._has_kernel:
+        return None
+    return model._kernel
+
+
+def flat(model, ti, tr, pr, rows=16):
+    """The named internal entry: Mueller elements ``(16, n)`` (``rows=16``) or ``M00``
+    ``(n,)`` (``rows=1``) of flat float64 angles validated already, for a single model or a
+    chunk of a model set (its array parameters flat, one element per geometry), by
+    :func:`compiled`'s choice of implementation."""
+    kernel = compiled(model)
+    if kernel is not None:
+        out = kernel.run(ti, tr, pr, rows)
+        return out if rows == 16 else out[0]
+    if model._sets and not model._numpy_sets:
+        return each(model, ti, tr, pr, lambda m, a, b, c: flat(m, a, b, c, rows), 1 if rows == 16 else 0)
+    return model._mueller16(ti, tr, pr) if rows == 16 else model._brdf_flat(ti, tr, pr)
+
+
+def flat_jones(model, ti, tr, pr):
+    """:func:`flat` for the Jones matrix ``(n, 2, 2)`` of a non-depolarizing model (numpy:
+    no kernel computes Jones matrices)."""
+    if model._sets and not model._numpy_sets:
+        return each(model, ti, tr, pr, flat_jones, 0)
+    return model._jones_flat(ti, tr, pr)
+
+
+def kernel_precision(model, precision):
+    """The precision a kernel of ``model`` runs a ``precision`` request in: float32 only
+    inside the model's float32-safe domain (:mod:`scatterbench.models.float32_domain`,
+    decided once per model), unless :func:`raw_float32` is in effect; then the float64
+    result is rounded."""
+    if precision == "float32" and model._float32_unsafe is not None and float32_guarded():
+        return "float64"
+    return precision
+
+
+def kernel_path(model) -> bool:
+    """True when ``model``'s chunks go through the kernels here (a model set's chunks each
+    build their own, so the whole set's kernel is never built)."""
+    return model._has_kernel and _BACKEND.get() == "numba"
+
+
+def plan(model, theta_i, theta_r, phi_r):
+    """The validated, broadcast evaluation of ``model`` at a user's angles, in the chunk size
+    of its route (:class:`Plan`)."""
+    return Plan(model, theta_i, theta_r, phi_r, KERNEL_CHUNK if kernel_path(model) else CHUNK)
+
+
+def small(model, theta_i, theta_r, phi_r, rows, precision, out=None):
+    """The small-call route (:meth:`scatterbench.models.kernels.Compiled.fast`): a single
+    compiled model's call straight into its kernel, formatted (``(..., 4, 4)`` matrices, or
+    ``M00`` of the angles' shape); ``None`` for the general route (which also raises the
+    errors)."""
+    kernel = None if model._sets else compiled(model)
+    if kernel is None or precision not in PRECISIONS:
+        return None
+    runs = kernel_precision(model, precision)
+    if runs == precision:
+        return kernel.fast(theta_i, theta_r, phi_r, rows, precision, out)
+    if out is not None:
+        return None
+    fast = kernel.fast(theta_i, theta_r, phi_r, rows, runs)  # the float32 fallback
+    return None if fast is None else fast.astype(np.float32)
+
+
+def evaluate(model, theta_i, theta_r, phi_r, rows, precision="float64", out=None):
+    """``(shape, M)``: ``model`` at a user's angles, validated and broadcast once, as
+    element-major storage ``M`` ``(rows, N)`` (rows 16: row ``4 a + b`` is element ``ab``;
+    rows 1: ``M00``), ``shape`` the broadcast shape (``N`` its size); into ``out`` when given
+    (a ``(rows, N)`` array of the precision's dtype, e.g. a ``numpy.memmap``)."""
+    p = plan(model, theta_i, theta_r, phi_r)
+    dtype = np.dtype(check_precision(precision))
+    if out is None:
+        out = np.empty((rows, p.n), dtype=dtype)
+    elif out.shape != (rows, p.n) or out.dtype != dtype:
+        raise ValueError(
+            f"out must have shape ({rows}, {p.n}) and dtype {dtype}; got {out.shape} {out.dtype}"
+        )
+    fill(p, out, rows, precision)
+    return p.shape, out
+
+
+def fill(p, out, rows, precision):
+    """Evaluate plan ``p`` into ``out`` chunk by chunk: the kernel where one covers the model
+    (a model set's chunk is a model with flat parameters, with its own kernel rows), in
+    :func:`kernel_precision`; otherwise :func:`flat`'s numpy implementation, rounded to
+    ``out``'s dtype."""
+    kernel = kernel_path(p.model)
+    runs = kernel_precision(p.model, precision) if kernel else precision
+    for sl, ti, tr, pr, m in p.blocks(fill=not kernel):
+        if kernel:
+            m._kernel.write(out, sl, ti, tr, pr, runs)
+        else:
+            out[:, sl] = flat(m, ti, tr, pr, rows)
+
+
+def blocks(model, theta_i, theta_r, phi_r):
+    """Stream ``model`` at a user's angles: ``(flat_slice, (k, 4, 4) block)`` per chunk."""
+    for sl, ti, tr, pr, m in plan(model, theta_i, theta_r, phi_r).blocks():
+        yield sl, flat(m, ti, tr, pr).T.reshape(-1, 4, 4)
+
+
+def jones(model, theta_i, theta_r, phi_r):
+    """The Jones matrices ``(..., 2, 2)`` of a non-depolarizing model at a user's angles."""
+    p = Plan(model, theta_i, theta_r, phi_r, CHUNK)
+    out = np.empty((p.n, 2, 2), dtype=complex)
+    for sl, ti, tr, pr, m in p.blocks():
+        out[sl] = flat_jones(m, ti, tr, pr)
+    return out.reshape(p.shape + (2, 2))

@@ -97,7 +97,16 @@ import math
 
 import numpy as np
 
-from .kernel_specs import ANISO_EXPONENTIAL, ANISO_GAUSSIAN, ANISO_GGX, EXPONENTIAL, GAUSSIAN, GGX, STROKE
+from .kernel_specs import (
+    ANISO_EXPONENTIAL,
+    ANISO_GAUSSIAN,
+    ANISO_GGX,
+    EXPONENTIAL,
+    GAUSSIAN,
+    GGX,
+    KERNEL_ROWS,
+    STROKE,
+)
 
 __all__ = [
     "EPS",
@@ -234,7 +243,7 @@ def condition(code, rows, iopt):
     code : str
         The kernel (:data:`scatterbench.models.kernels.drive.CODES`).
     rows : dict
-        The kernel's parameter rows by name (:data:`scatterbench.models.kernels.drive.ROWS`), flat float64
+        The kernel's parameter rows by name (:data:`scatterbench.models.kernel_specs.KERNEL_ROWS`), flat float64
         arrays of one length.
     iopt : sequence of int
         The kernel's options.
@@ -291,9 +300,7 @@ def unsafe(model, code, rows, iopt):
 def model_unsafe(model):
     """:func:`unsafe` of a model a kernel covers (``model._kernel_spec()`` not ``None``): its
     kernel rows broadcast over a model set's elements."""
-    from .kernels import drive  # numba: only where a kernel runs
-
     code, rows, options = model._kernel_spec()
     values = np.broadcast_arrays(*(np.asarray(r, dtype=float) for r in rows))
-    named = {name: v.reshape(-1) for name, v in zip(drive.ROWS[code], values, strict=True)}
+    named = {name: v.reshape(-1) for name, v in zip(KERNEL_ROWS[code], values, strict=True)}
     return unsafe(model, code, named, options)

@@ -37,6 +37,30 @@ SHADOWING_KINDS = {"none": 0, "smith": 1, "smith-correlated": 2}
 COOK_SHADOWING = {"none": 0, "blinn": 1, "smith": 2}
 
 
+#: each kernel's parameter rows, by name and in order: a model's ``_kernel_spec`` gives its
+#: rows in this order, the kernels read them by position, and :class:`scatterbench.models.kernels.Compiled`
+#: checks a spec against them (names only here: no numba)
+FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
+BTDF_ROWS = ("substrate", "sx", "sy", "rotation", "coverage")
+SINGLE_ROWS = ("coating", "g")
+DIFFUSE_ROWS = ("coating", "scale")
+#: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth, and the stroke
+#: azimuth's cosine and sine, taken once per model (no C library call per geometry: the
+#: Cook-Torrance loop runs on SIMD lanes)
+COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
+COOK_ROWS += ("stroke_cos", "stroke_sin")
+#: the facet kernel's rows, then rho_d, rho_v, tau, omega
+MAXWELL_ROWS = FACET_ROWS + ("rho_d", "rho_v", "tau", "omega")
+KERNEL_ROWS = {
+    "facet": FACET_ROWS,
+    "btdf": BTDF_ROWS,
+    "single": SINGLE_ROWS,
+    "diffuse": DIFFUSE_ROWS,
+    "cook": COOK_ROWS,
+    "maxwell": MAXWELL_ROWS,
+}
+
+
 def slope_rows(slopes):
     """``(kind, [sx, sy, rotation, coverage])`` of a slope distribution, or ``None``."""
     kind = SLOPE_KINDS.get(type(slopes).__name__)

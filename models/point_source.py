@@ -642,7 +642,7 @@ class _Disc:
 
     def _angles_compiled(self, rows, v, chi, w):
         """:meth:`angles` compiled (:mod:`scatterbench.models.kernels.disc`, held to it)."""
-        from .kernels import disc
+        from .kernels import disc  # numba (heavy): compiled kernels load when one first runs
 
         shape = np.broadcast_shapes((rows.size, 1), np.shape(v), np.shape(chi), np.shape(w))
         v, chi, w = (np.ascontiguousarray(np.broadcast_to(a, shape), dtype=float) for a in (v, chi, w))

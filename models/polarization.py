@@ -22,6 +22,8 @@ import numbers
 
 import numpy as np
 
+from .text import shown
+
 __all__ = [
     "jones_to_mueller",
     "mueller16_from_jones",
@@ -110,8 +112,6 @@ _STATES = "one of unpolarized, s, p, +45, -45, left, right, linear:<deg>, or [I,
 
 
 def _refused(what, state):
-    from .scene.schema import shown  # the one cut repr of a bad value (the scene imports this module)
-
     return ValueError(f"polarization {what}; got {shown(state)}")
 
 

@@ -396,7 +396,7 @@ class RoughDiffuseBRDF(Model):
         numpy backend (the reference it is tested against)."""
         if evaluation.current_backend() != "numba":
             return None
-        from .kernels import montecarlo
+        from .kernels import montecarlo  # numba (heavy): compiled kernels load when one first runs
 
         return montecarlo
 

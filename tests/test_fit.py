@@ -7,7 +7,7 @@ import os
 import numpy as np
 import pytest
 
-from scatterbench import references
+from scatterbench import models, references
 from scatterbench.models import scene
 from scatterbench.validation.checks.fitting import InterruptAfter
 from scatterbench.validation.cli import main
@@ -132,13 +132,13 @@ def test_a_brdf_only_fit_predicts_from_the_first_row_alone(coated, data):
     spec = fitspec_from(coated, ["sigma:0.01:1:log", "coating:1.2:2"], ["brdf=0.05"])
     lik = Likelihood(coated, spec, data)
     assert lik.terms == ("brdf",) and len(np.unique(data.incident, axis=0)) > 1
-    values, noise = lik.walkers(np.array([[math.log(0.1), 1.5], [math.log(0.2), 1.3]]))
-    model = lik.model(values)
+    v = lik.spec.values(np.array([[math.log(0.1), 1.5], [math.log(0.2), 1.3]]))
+    model = lik.model(v.scene)
     fast, full = lik.predict(model, terms=lik.terms), lik.predict(model)
     assert set(fast) == {"brdf"}
     np.testing.assert_allclose(fast["brdf"], full["brdf"], rtol=1e-14, atol=0)
-    ll_fast = lik._pointwise_rows(noise, fast)
-    ll_full = lik._pointwise_rows(noise, full)
+    ll_fast = lik._pointwise_rows(v.noise, fast)
+    ll_full = lik._pointwise_rows(v.noise, full)
     assert np.max(np.abs(ll_fast - ll_full)) <= 1e-12 * np.max(np.abs(ll_full))
 
 
@@ -168,9 +168,9 @@ def test_the_likelihood_s_kernel_route_gives_the_models_bits(scene_file, data_fi
         if walkers is None:
             model = lik.model(lik.spec.physical(u[0]))
         else:
-            model = lik.model(lik.walkers(u)[0])
+            model = lik.model(lik.spec.values(u).scene)
         # a sum of models (the paint) has no kernel of its own: the general route
-        assert model._kernel_path() == (scene_file != "red_paint_fit.toml")
+        assert models.evaluation.kernel_path(model) == (scene_file != "red_paint_fit.toml")
         shape, M = lik._rows.mueller16(model)
         ref_shape, ref = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
         assert shape == ref_shape and np.array_equal(M, ref)

@@ -129,7 +129,7 @@ def test_uncovered_options_fall_back_to_numpy():
         models.FacetBTDF(convention="corrected"),
     ):
         assert m._kernel_spec() is None
-        assert m._compiled() is None
+        assert models.evaluation.compiled(m) is None
 
 
 def test_model_sets_in_the_kernels():

@@ -96,12 +96,15 @@ def csqrt(a, b):
         return T(0.0), T(0.0)
     # |a|, |b| are index-sized (up to |n + ik|^2 ~ 3.3e32): their squares overflow float32 from
     # 1.8e19 and underflow below 1.1e-19; scaled by the larger, r (hence t) stays finite and
-    # nonzero there.  float64 (1e-300 > 0, a constant per precision) holds the squares
-    # unscaled: below 1e-154 they underflow, and t is then off by at most sqrt(2) at a size
-    # (< 1e-77) that moves no Fresnel coefficient; without the scaled branch the loops that
-    # use csqrt stay within LLVM's vectorization cost model (Cook-Torrance, LLVM 22)
+    # nonzero there.  float64 (1e-300 > 0: a constant per precision) holds them unscaled, with
+    # r = |a + ib| >= max(|a|, |b|) imposed: where both squares underflow (|a|, |b| < 1e-154,
+    # near INDEX_MIN) that keeps r, hence t, nonzero, and elsewhere sqrt(fl(x^2)) >= |x| leaves
+    # the bits alone.  Without the scaled branch the Cook-Torrance loops stay within LLVM 22's
+    # vectorization cost model (numba 0.68).
     s = max(abs(a), abs(b))
-    if T(1e-300) > T(0.0) or T(1.0e-19) < s < T(1.0e19):
+    if T(1e-300) > T(0.0):
+        r = max(sqrt(a * a + b * b), s)
+    elif T(1.0e-19) < s < T(1.0e19):
         r = sqrt(a * a + b * b)
     else:
         a_s, b_s = a / s, b / s

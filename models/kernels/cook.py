@@ -23,12 +23,6 @@ from .common import (
 )
 from .vector_math import sqrt
 
-#: parameter rows: varnish index (1: bare), metal index, Eq. 19's m values and stroke azimuth
-COOK_ROWS = ("coating", "substrate_re", "substrate_im", "m_parallel", "m_perpendicular", "stroke_angle")
-#: and the stroke azimuth's cosine and sine, taken once per model (no C library call per
-#: geometry: :mod:`scatterbench.models.kernels.vector` runs the loop on SIMD lanes)
-COOK_ROWS += ("stroke_cos", "stroke_sin")
-
 
 @njit(error_model="numpy")
 def fresnel_average(c, mr, mi, pec):

@@ -16,23 +16,17 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ..kernel_specs import KERNEL_ROWS
 from .common import azimuth
-from .cook import COOK_ROWS, cook
-from .facet import BTDF_ROWS, FACET_ROWS, btdf, facet
-from .maxwell import MAXWELL_ROWS, maxwell
-from .volume import DIFFUSE_ROWS, SINGLE_ROWS, diffuse, single
+from .cook import cook
+from .facet import btdf, facet
+from .maxwell import maxwell
+from .volume import diffuse, single
 
 FACET, BTDF, SINGLE, DIFFUSE, COOK, MAXWELL = range(6)
 CODES = {"facet": FACET, "btdf": BTDF, "single": SINGLE, "diffuse": DIFFUSE, "cook": COOK, "maxwell": MAXWELL}
 #: each kernel's parameter rows, in order (``Compiled`` checks a model's spec against them)
-ROWS = {
-    "facet": FACET_ROWS,
-    "btdf": BTDF_ROWS,
-    "single": SINGLE_ROWS,
-    "diffuse": DIFFUSE_ROWS,
-    "cook": COOK_ROWS,
-    "maxwell": MAXWELL_ROWS,
-}
+ROWS = KERNEL_ROWS
 
 
 #: rows of ``prm`` and entries of ``iopt`` every kernel is given (``Compiled`` pads to them;

@@ -12,9 +12,6 @@ from numba import njit
 from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, rs_k, smith_g
 from .vector_math import sqrt
 
-#: parameter rows of the facet reflection kernel
-FACET_ROWS = ("coating", "substrate_re", "substrate_im", "sx", "sy", "rotation", "coverage")
-
 
 @njit(error_model="numpy", inline="always")
 def facet_jones(g, p, o):
@@ -85,10 +82,6 @@ def facet(geo, p, o):
     """:class:`scatterbench.models.FacetBRDF` and :class:`scatterbench.models.SubsurfaceFacetBRDF` at one geometry."""
     a, b, c, d, e, f, g, h = facet_jones(geo, p, o)
     return mueller16(a, b, c, d, e, f, g, h)
-
-
-#: parameter rows of the facet transmission kernel
-BTDF_ROWS = ("substrate", "sx", "sy", "rotation", "coverage")
 
 
 @njit(error_model="numpy")

@@ -9,11 +9,8 @@ import math
 from numba import njit
 
 from .common import diag16, mueller16, polar_from, scaled16
-from .facet import FACET_ROWS, facet_jones_at
+from .facet import facet_jones_at
 from .vector_math import atan2, exp_neg, sincos, sqrt
-
-#: parameter rows: the facet kernel's, then rho_d, rho_v, tau, omega
-MAXWELL_ROWS = FACET_ROWS + ("rho_d", "rho_v", "tau", "omega")
 
 
 @njit(error_model="numpy", inline="always")

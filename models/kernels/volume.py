@@ -12,8 +12,6 @@ from .common import coating_cos, mueller16, polar
 from .vector_math import sqrt
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
-SINGLE_ROWS = ("coating", "g")
-DIFFUSE_ROWS = ("coating", "scale")
 
 
 @njit(error_model="numpy", forceinline=True)

@@ -8,10 +8,11 @@ import tomllib
 from dataclasses import dataclass, field
 
 from ..base import Model
+from ..text import long_digits, read_utf8, where
 from . import editing
 from .assembly import Mechanism, mechanisms
 from .decisions import Assembly, assemble
-from .schema import SceneError, check_structure, long_digits, parse, read_utf8, where
+from .schema import SceneError, check_structure, parse
 
 __all__ = ["Scene", "load", "loads", "from_dict"]
 

@@ -12,7 +12,7 @@ import math
 import os
 import re
 
-from scatterbench.models.scene.schema import shown
+from scatterbench.models.text import shown
 from scatterbench.validation.atomic import write_problem
 
 __all__ = [

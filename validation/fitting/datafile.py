@@ -61,7 +61,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from scatterbench.models.polarization import ellipsometric, stokes
-from scatterbench.models.scene.schema import is_number, long_digits, read_utf8, shown, where
+from scatterbench.models.text import is_number, long_digits, read_utf8, shown, where
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 

@@ -146,13 +146,13 @@ def predictive(fit: FitResult, n_draws=200, seed=0, data=None):
     samples = fit.chain.samples()
     pick = rng.choice(len(samples), size=min(n_draws, len(samples)), replace=False)
     U = samples[pick]
-    values, noise = lik.walkers(U)
+    v = lik.spec.values(U)
     if lik.binding is not None:  # every draw's model at once (a model set)
-        pred = lik.predict(lik.model(values), data)
+        pred = lik.predict(lik.model(v.scene), data)
     else:  # the scene rebuilt at each draw
-        each = [lik.predict(lik.model(lik.spec.physical(u)), data) for u in U]
+        each = [lik.predict(lik.model(lik.spec.values(u).scene), data) for u in U]
         pred = {t: np.array([p[t] for p in each]) for t in TERMS}
-    rep = replicate(pred, term_variances(noise, data, TERMS), rng)
+    rep = replicate(pred, term_variances(v.noise, data, TERMS), rng)
     res = {t: {"model": pred[t], "replicated": rep[t]} for t in TERMS}
     res["mask"] = lik.spec.mask(data)
     return res

@@ -43,11 +43,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from scatterbench.models.scene.schema import shown
+from scatterbench.models.text import shown
 
 __all__ = [
     "FreeParam",
     "FitSpec",
+    "Values",
     "FitSpecError",
     "ALIASES",
     "NOISE_TERMS",
@@ -105,6 +106,15 @@ class FreeParam:
 
 
 @dataclass(frozen=True)
+class Values:
+    """Physical values of sampling positions (:meth:`FitSpec.values`): ``scene``, the scene's
+    free keys; ``noise``, every noise level by term (fixed or free)."""
+
+    scene: dict
+    noise: dict
+
+
+@dataclass(frozen=True)
 class FitSpec:
     free: tuple  # of FreeParam, scene parameters first, then noise terms
     noise: dict = field(default_factory=dict)  # fixed noise values by term
@@ -130,18 +140,25 @@ class FitSpec:
         out = np.where(inside, 0.0, -math.inf)
         return float(out) if out.ndim == 0 else out
 
+    def values(self, u) -> Values:
+        """The physical values of sampling positions, once: ``u`` ``(k,)`` gives floats,
+        positions ``(W, k)`` give ``(W, 1)`` arrays (a model set over the walkers), split into
+        the scene's free keys and the noise levels (the fixed ones included)."""
+        u = np.asarray(u, dtype=float)
+        scene, noise = {}, dict(self.noise)
+        for i, p in enumerate(self.free):
+            x = p.from_u(u[..., i])
+            x = float(x) if u.ndim == 1 else x[:, None]
+            if p.is_noise:
+                noise[p.key[6:]] = x
+            else:
+                scene[p.key] = x
+        return Values(scene, noise)
+
     def physical(self, u) -> dict:
+        """One position's physical values by free key (``noise.<term>`` for noise levels):
+        what a report shows."""
         return {p.key: float(p.from_u(v)) for p, v in zip(self.free, u, strict=True)}
-
-    def noise_values(self, values: dict) -> dict:
-        out = dict(self.noise)
-        for k, v in values.items():
-            if k.startswith("noise."):
-                out[k[6:]] = v
-        return out
-
-    def scene_values(self, values: dict) -> dict:
-        return {k: v for k, v in values.items() if not k.startswith("noise.")}
 
     def mask(self, data) -> np.ndarray:
         """Boolean array: True for the rows the fit uses."""

@@ -129,17 +129,18 @@ class Likelihood:
 
     # -- model ---------------------------------------------------------------------
     def model(self, values: dict):
-        """The scene's model at physical ``values`` (scalars: one model; arrays of one shape:
-        a model set, trusted: callers check the prior bounds first)."""
-        scene_values = self.spec.scene_values(values)
+        """The scene's model at physical ``values`` by free key (noise levels, ``noise.*``,
+        are not the model's and are ignored): scalars give one model; arrays of one shape a
+        model set, trusted: callers check the prior bounds first."""
+        scene = {k: v for k, v in values.items() if not k.startswith("noise.")}
         if self.binding is None:  # scalars only: the scene rebuilt
-            return self.model_rebuilt({k: float(np.asarray(v).reshape(())) for k, v in values.items()})
-        shape = np.broadcast_shapes(*(np.shape(v) for v in scene_values.values()))
-        return self.binding.values_model(scene_values, shape)
+            return self.model_rebuilt({k: float(np.asarray(v).reshape(())) for k, v in scene.items()})
+        shape = np.broadcast_shapes(*(np.shape(v) for v in scene.values()))
+        return self.binding.values_model(scene, shape)
 
-    def model_rebuilt(self, values: dict):
-        """The scene rebuilt and validated at scalar ``values`` (no model set)."""
-        return self.scene.with_values(self.spec.scene_values(values)).build(decisions=self.decisions)
+    def model_rebuilt(self, scene: dict):
+        """The scene rebuilt and validated at scalar values of its free keys (no model set)."""
+        return self.scene.with_values(scene).build(decisions=self.decisions)
 
     def predict(self, model, data=None, terms=None) -> dict:
         """Model ``brdf, eta, P, P_C`` at the rows of ``data`` (default: the fitted rows); a
@@ -184,11 +185,6 @@ class Likelihood:
             out["P_C"] = d.P_C - pred["P_C"]
         return out
 
-    def walkers(self, U):
-        """Physical values of positions ``U`` (``(W, k)``) as ``(W, 1)`` arrays, and the noise."""
-        values = {p.key: p.from_u(U[:, i])[:, None] for i, p in enumerate(self.spec.free)}
-        return values, self.spec.noise_values(values)
-
     def _pointwise_rows(self, noise, pred) -> np.ndarray:
         res = self.residuals(pred)
         var = self._variances(noise)
@@ -206,13 +202,13 @@ class Likelihood:
         U = np.atleast_2d(np.asarray(U, dtype=float))
         if self.binding is None:
             return self._pointwise_each(U)
-        values, noise = self.walkers(U)
+        v = self.spec.values(U)  # sampling coordinates -> the scene's values and the noise, once
         try:
-            model = self.model(values)
+            model = self.model(v.scene)  # one model set over the walkers
             self.binding.check(model)  # vectorized: every walker's parameters at once
         except ValueError:
             return self._pointwise_valid(U)
-        return self._pointwise_rows(noise, self.predict(model, terms=self.terms))
+        return self._pointwise_rows(v.noise, self.predict(model, terms=self.terms))
 
     def _pointwise_valid(self, U):
         """Rows of ``-inf`` for the positions the scene refuses (rebuilt and validated one by
@@ -221,7 +217,7 @@ class Likelihood:
         ok = np.zeros(len(U), dtype=bool)
         for w, u in enumerate(U):
             try:
-                self.model_rebuilt(self.spec.physical(u))
+                self.model_rebuilt(self.spec.values(u).scene)
                 ok[w] = True
             except ValueError:
                 continue
@@ -246,10 +242,8 @@ class Likelihood:
     def pointwise_rebuilt(self, u) -> np.ndarray:
         """Per-row log-likelihood at one position with the scene rebuilt and validated there (the
         per-walker path before model sets; a ``ValueError`` where the scene refuses ``u``)."""
-        values = self.spec.physical(u)
-        return self._pointwise_rows(
-            self.spec.noise_values(values), self.predict(self.model_rebuilt(values), terms=self.terms)
-        )
+        v = self.spec.values(u)
+        return self._pointwise_rows(v.noise, self.predict(self.model_rebuilt(v.scene), terms=self.terms))
 
     def pointwise(self, u) -> np.ndarray:
         """Per-row log-likelihood (all terms summed per row), ``-inf`` where impossible."""
@@ -262,9 +256,9 @@ class Likelihood:
     def whitened(self, u) -> np.ndarray:
         """Residuals divided by their standard deviations (for least squares); large
         finite values where the model predicts no light."""
-        values, noise = self.walkers(np.asarray(u, dtype=float)[None])
-        res = self.residuals(self.predict(self.model(values), terms=self.terms))
-        var = self._variances(noise)
+        v = self.spec.values(np.asarray(u, dtype=float)[None])
+        res = self.residuals(self.predict(self.model(v.scene), terms=self.terms))
+        var = self._variances(v.noise)
         out = []
         for t in self.terms:
             with np.errstate(divide="ignore", invalid="ignore"):

@@ -120,7 +120,8 @@ def integrated_reflectance(
     Seed 003's diffuse subsurface model at unit albedo: what the interface's Fresnel
     reflection (not part of the model) leaves, the model returns diffusely.
 
-    >>> import math, models, validation
+    >>> import math
+    >>> from scatterbench import models, validation
     >>> r = validation.integrated_reflectance(models.DiffuseSubsurfaceBRDF(rho=1.0), 0.5, tol=1e-6)
     >>> rs, rp = models.fresnel_reflectance(math.cos(0.5), 1.0, 1.5)
     >>> round(float(r.value + (rs + rp) / 2), 6), r.converged

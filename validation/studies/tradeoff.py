@@ -42,6 +42,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from scatterbench import models
+from scatterbench.models import evaluation
 from scatterbench.models.geometry import signed_inplane
 from scatterbench.validation.numerics.energy import exposed_reflectance
 from scatterbench.validation.numerics.integrate import integrated_reflectance
@@ -297,7 +298,7 @@ def float32_unavailable(model):
     if "precision" not in inspect.signature(model.mueller).parameters:
         return f"{name} has no float32 kernel"
     if isinstance(model, models.Model):
-        if not model._kernel_path():
+        if not evaluation.kernel_path(model):
             return f"{name} has no float32 kernel"
         if model.float32_fallback is not None:
             return f"{name} falls back to float64 for float32 requests ({model.float32_fallback})"
