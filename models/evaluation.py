@@ -398,16 +398,21 @@ def small(model, theta_i, theta_r, phi_r, rows, precision, out=None):
     """The small-call route (:meth:`scatterbench.models.kernels.Compiled.fast`): a single
     compiled model's call straight into its kernel, formatted (``(..., 4, 4)`` matrices, or
     ``M00`` of the angles' shape); ``None`` for the general route (which also raises the
-    errors)."""
-    kernel = None if model._sets else compiled(model)
-    if kernel is None or precision not in PRECISIONS:
+    errors).  :func:`compiled`'s choice, written out: this route's overhead is the call's."""
+    if model._sets or _BACKEND.get() != "numba":
         return None
-    runs = kernel_precision(model, precision)
-    if runs == precision:
+    kernel = model._kernel  # None where no kernel covers the model
+    if kernel is None:
+        return None
+    if precision == "float64":
+        return kernel.fast(theta_i, theta_r, phi_r, rows, precision, out)
+    if precision != "float32":
+        return None
+    if kernel_precision(model, precision) == precision:
         return kernel.fast(theta_i, theta_r, phi_r, rows, precision, out)
     if out is not None:
         return None
-    fast = kernel.fast(theta_i, theta_r, phi_r, rows, runs)  # the float32 fallback
+    fast = kernel.fast(theta_i, theta_r, phi_r, rows, "float64")  # the float32 fallback
     return None if fast is None else fast.astype(np.float32)
 
 

@@ -178,7 +178,9 @@ class FacetBTDF(Model):
         ``"none"`` (seed 003), ``"smith"`` or ``"smith-correlated"``
         (:mod:`scatterbench.models.shadowing`): the incident direction's shadowing and the
         masking of the transmitted direction from below, ``chi+`` on each (Walter
-        et al. 2007 Eq. 21-23).  Smith's ``G1`` satisfies ``int G1(i) (i.m)+ D dm =
+        et al. 2007 Eq. 21-23); height-correlated, ``B(1 + Lambda_i, 1 + Lambda_t)``
+        (:func:`scatterbench.models.shadowing.correlated_g`: a facet lit from above must be
+        seen from below), not the reflection form ``1 / (1 + Lambda_i + Lambda_t)``.  Smith's ``G1`` satisfies ``int G1(i) (i.m)+ D dm =
         cos theta_i``, the projected-area identity that ``"paper"`` assumes, so it
         goes with ``convention="paper"`` only (``"corrected"`` corrects the same
         projected area without shadowing).
@@ -267,7 +269,9 @@ class FacetBTDF(Model):
         if slopes is None or self.convention != "paper":
             return None
         shadowing = kernel_specs.shadowing_kind(self.shadowing, slopes[0])
-        if shadowing is None:
+        # the height-correlated transmission form is a Beta function of two Lambdas
+        # (shadowing.correlated_g): scipy's, numpy path; the kernel has no Beta function
+        if shadowing is None or self.shadowing == "smith-correlated":
             return None
         return "btdf", [self.substrate, *slopes[1]], (slopes[0], shadowing, 0)
 

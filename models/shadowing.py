@@ -26,7 +26,10 @@ back of the facet normal ``m`` (Heitz Sec. 5.1).  Closed forms:
   tabulated once per distribution and interpolated (cubic Hermite), to 1e-10.
 
 The separable form is ``G = G1(i) G1(o)``; the height-correlated one (Heitz
-Eq. 99) ``G = chi+ chi+ / (1 + Lambda_i + Lambda_o)``.  ``Lambda`` uses the
+Eq. 99) ``G = chi+ chi+ / (1 + Lambda_i + Lambda_o)`` in reflection and
+``G = chi+ chi+ B(1 + Lambda_i, 1 + Lambda_o)`` (the Beta function; Heitz Sec. 6) in
+transmission, where the facet is seen from both sides of the surface
+(:func:`correlated_g` derives both).  ``Lambda`` uses the
 distribution normalized to unit coverage: the masking is by the microsurface
 itself (with ``C < 1``, e.g. sparse flakes, Smith's model is an assumption).
 """
@@ -54,6 +57,7 @@ __all__ = [
     "smith_lambda",
     "smith_g1",
     "smith_g",
+    "correlated_g",
     "check_shadowing",
 ]
 
@@ -238,12 +242,37 @@ def smith_g(shadowing, slopes, dir_i, dir_o, cos_local_i=None, cos_local_o=None)
         return 1.0
     if shadowing == "smith":
         return smith_g1(slopes, *dir_i, cos_local_i) * smith_g1(slopes, *dir_o, cos_local_o)
-    lam = smith_lambda(slopes, *dir_i) + smith_lambda(slopes, *dir_o)
-    g = 1.0 / (1.0 + lam)
+    g = correlated_g(
+        smith_lambda(slopes, *dir_i), smith_lambda(slopes, *dir_o), np.asarray(dir_i[0]) * dir_o[0] < 0.0
+    )
     for cl, d in ((cos_local_i, dir_i), (cos_local_o, dir_o)):
         if cl is not None:
             g = np.where(np.asarray(cl) * np.asarray(d[0]) > 0.0, g, 0.0)
     return g
+
+
+def correlated_g(lam_i, lam_o, transmission):
+    """The height-correlated ``G`` (without the back-facing tests) of two directions with
+    Smith ``Lambda`` values ``lam_i``, ``lam_o``; ``transmission``: the two lie on opposite
+    sides of the surface.
+
+    A facet at height ``h`` is seen from a direction above the surface with probability
+    ``C(h)^Lambda`` (``C`` the heights' distribution function; Heitz 2014 Sec. 6) and from a
+    direction below it with probability ``(1 - C(h))^Lambda``: the microsurface above the
+    facet masks the one, the microsurface below it the other.  Integrated over the facet's
+    height (``u = C(h)`` uniform on [0, 1]):
+
+    * reflection (both above): ``int_0^1 u^(Li + Lo) du = 1 / (1 + Li + Lo)`` (Heitz Eq. 99);
+    * transmission: ``int_0^1 u^Li (1 - u)^Lo du = B(1 + Li, 1 + Lo)``, the Beta function
+      (Heitz Sec. 6), which equals the reflection form only where a Lambda is 0.
+
+    A Lambda of inf (grazing) gives 0 either way."""
+    lam_i, lam_o = np.asarray(lam_i, dtype=float), np.asarray(lam_o, dtype=float)
+    reflected = 1.0 / (1.0 + (lam_i + lam_o))
+    dead = np.isinf(lam_i) | np.isinf(lam_o)
+    with np.errstate(invalid="ignore"):
+        through = np.where(dead, 0.0, special.beta(1.0 + lam_i, 1.0 + lam_o))
+    return np.where(transmission, through, reflected)
 
 
 def lambda_direct(slopes, mu):
