@@ -11,6 +11,9 @@ a new model cannot reach the site undocumented.
 
 from __future__ import annotations
 
+import os
+import tomllib
+
 from docutils import nodes
 from docutils.statemachine import StringList
 from sphinx.util import logging
@@ -109,6 +112,45 @@ class ModelTable(SphinxDirective):
         node = nodes.container()
         self.state.nested_parse(StringList(rows), self.content_offset, node)
         return node.children
+
+
+def _contracts():
+    """The import-linter contracts of ``pyproject.toml`` (beside ``docs/``), by id."""
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    with open(os.path.join(root, "pyproject.toml"), "rb") as fh:
+        config = tomllib.load(fh)["tool"]["importlinter"]
+    return {c["id"]: c for c in config["contracts"]}
+
+
+def layer_figure():
+    """Draw the ``layers`` contracts of ``validation`` and ``models`` side by side: one box per
+    layer, top to bottom, imports running down (for the architecture page's plot)."""
+    import matplotlib.pyplot as plt  # matplotlib (heavy): only the plot directive draws
+
+    contracts = _contracts()
+    columns = [
+        ("scatterbench.validation", contracts["validation"]),
+        ("scatterbench.models", contracts["models"]),
+    ]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 6.5))
+    for ax, (title, contract) in zip(axes, columns, strict=True):
+        layers = contract["layers"]
+        n = len(layers)
+        for k, layer in enumerate(layers):
+            y = n - 1 - k
+            names = [x.strip() for x in layer.replace("|", ":").split(":")]
+            text = "\n".join(", ".join(names[i : i + 3]) for i in range(0, len(names), 3))
+            ax.add_patch(plt.Rectangle((0.05, y + 0.12), 0.9, 0.76, fc="#e8eef7", ec="#35587a"))
+            ax.text(0.5, y + 0.5, text, ha="center", va="center", fontsize=7.5)
+            if k < n - 1:  # down to the next layer's box
+                ax.annotate("", xy=(0.5, y - 0.12), xytext=(0.5, y + 0.12), arrowprops={"arrowstyle": "->"})
+        ax.set_xlim(0, 1)
+        ax.set_ylim(-0.1, n)
+        ax.set_title(title, fontsize=10)
+        ax.axis("off")
+    fig.suptitle("imports run down each column (pyproject.toml [tool.importlinter])", fontsize=9)
+    fig.tight_layout()
+    return fig
 
 
 def setup(app):
