@@ -9,7 +9,7 @@ import pytest
 
 from scatterbench import models, references
 from scatterbench.models import zernike
-from scatterbench.models.polarization import xyxy_to_psps
+from scatterbench.models.polarization import basis_rotation, reciprocal_mueller, xyxy_to_psps
 from scatterbench.validation import integrated_reflectance, reciprocity_error
 from scatterbench.validation.fitting.mueller_data import load_mueller_data
 from scatterbench.validation.studies import measured_mueller as mm
@@ -197,3 +197,26 @@ def test_mutations_fail_the_residual_bound(nist, name, mutation):
         sub = dataclasses.replace(sub, phi_i=np.zeros(len(sub)))
     r = mm.model_residuals(models.ZernikeExpansionBRDF(coefficients=rows), sub, noise)
     assert r.chi2 > CHI2_MAX  # the bound a mutation must fail: measured 2.20 (orders swapped, 1064) to 28
+
+
+def test_scatmech_conversion_ignores_the_rotation(geometries):
+    """The slip documented in docs/guide/slips.md: SCATMECH's BRDF_Model::convert turns the
+    scattered basis by the azimuth relative to the plane of incidence, ``R(-phi_s)``, while the
+    expansion is evaluated at sample-frame azimuths (``phi_s - rotation``).  The reversed path
+    lies on the sample turned by ``pi - phi_r``, so that conversion breaks the reciprocity the
+    expansion has by construction; converting with the sample-frame azimuths keeps it."""
+    z = models.ZernikeExpansionBRDF(coefficients=references.nist_ptfe_coefficients("532"))
+    ti, _, tr, pr = geometries
+
+    def scatmech(theta_i, theta_r, phi_s, rotation):
+        M = z.mueller_general(theta_i, math.pi - rotation, theta_r, phi_s - rotation, basis="xyxy")
+        return basis_rotation(-phi_s) @ M
+
+    def ours(theta_i, theta_r, phi_s, rotation):
+        return z.mueller_general(theta_i, math.pi - rotation, theta_r, phi_s - rotation)
+
+    errors = {}
+    for name, f in (("scatmech", scatmech), ("ours", ours)):
+        fwd, rev = f(ti, tr, pr, 0.0), f(tr, ti, -pr, math.pi - pr)
+        errors[name] = np.max(np.abs(rev - reciprocal_mueller(fwd)) / fwd[:, :1, :1])
+    assert errors["ours"] < 1e-12 and errors["scatmech"] > 0.1
