@@ -47,7 +47,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
+from scipy import spatial
 
 from scatterbench.models.polarization import coherency_eigenvalues, reciprocal_mueller
 
@@ -74,7 +74,7 @@ ODD_ELEMENTS = tuple((i, j) for i in range(4) for j in range(4) if (i < 2) != (j
 def _matches(A, B, tol):
     """Index pairs ``(a, b)`` with ``|A[a] - B[b]| <= tol``, ``a < b`` (each pair once, no row with
     itself)."""
-    found = cKDTree(A).query_ball_point(B, r=tol)
+    found = spatial.cKDTree(A).query_ball_point(B, r=tol)
     pairs = [(a, b) for b, hits in enumerate(found) for a in hits if a < b]
     return np.array(pairs, dtype=int).reshape(-1, 2)
 
