@@ -6,7 +6,8 @@ Angles are radians; results broadcast and have shape ``broadcast + (4, 4)``.
 
 # isort: off
 # Model.registry lists the model classes in the order they are defined, which is the
-# order of these imports: seed 000, seed 001, seed 003, then the detector aperture.
+# order of these imports: seed 000, seed 001, seed 003, the detector aperture, then the
+# measured-data expansion (NIST's PTFE).
 from .base import CHUNK, Model, Sum
 from .evaluation import backend
 from .facet import FacetBRDF
@@ -23,18 +24,22 @@ from .rough_diffuse import RoughDiffuseBRDF
 from .combination import mueller_with_error
 from .maxwell_beard import MaxwellBeardBRDF
 from .aperture import DetectorAperture
+from .zernike import ZernikeExpansionBRDF
 
 # isort: on
 from . import shadowing
 from .fresnel import fresnel_coefficients, fresnel_reflectance, fresnel_transmittance
 from .params import ParamInfo
 from .polarization import (
+    basis_rotation,
     ellipsometric,
     is_physical,
     jones_to_mueller,
+    psps_to_xyxy,
     reciprocal_jones,
     reciprocal_mueller,
     stokes,
+    xyxy_to_psps,
 )
 from .slopes import (
     AnisotropicExponentialSlopes,
@@ -97,6 +102,10 @@ __all__ = [
     "mueller_with_error",
     "MaxwellBeardBRDF",
     "DetectorAperture",
+    "ZernikeExpansionBRDF",
+    "basis_rotation",
+    "xyxy_to_psps",
+    "psps_to_xyxy",
     "list_models",
 ]
 

@@ -36,6 +36,9 @@ __all__ = [
     "is_physical",
     "reciprocal_mueller",
     "reciprocal_jones",
+    "basis_rotation",
+    "xyxy_to_psps",
+    "psps_to_xyxy",
 ]
 
 
@@ -260,3 +263,47 @@ def reciprocal_mueller(M):
     """
     M = np.asarray(M)
     return _RECIP @ np.swapaxes(M, -1, -2) @ _RECIP
+
+
+def basis_rotation(alpha):
+    """Mueller matrix ``(..., 4, 4)`` that restates a Stokes vector given in a basis ``(e1, e2)``
+    turned by ``alpha`` (radians) about the propagation direction, ``e1 = cos(alpha) s +
+    sin(alpha) p``, ``e2 = -sin(alpha) s + cos(alpha) p``, in ``(s, p)``: ``S_sp = R S_e``.
+
+    The field components obey ``E_sp = [[c, -s], [s, c]] E_e``, hence ``Q_sp = cos(2 alpha) Q_e -
+    sin(2 alpha) U_e`` and ``U_sp = sin(2 alpha) Q_e + cos(2 alpha) U_e``; ``I`` and ``V`` are
+    unchanged.  ``R(alpha)^-1 = R(-alpha)``, and ``R`` has period pi (a basis and its negative
+    give the same Stokes vector).
+    """
+    a = np.asarray(alpha, dtype=float)
+    c, s = np.cos(2.0 * a), np.sin(2.0 * a)
+    R = np.zeros(a.shape + (4, 4))
+    R[..., 0, 0] = R[..., 3, 3] = 1.0
+    R[..., 1, 1] = R[..., 2, 2] = c
+    R[..., 1, 2] = -s
+    R[..., 2, 1] = s
+    return R
+
+
+def xyxy_to_psps(M, phi_i, phi_r):
+    """Mueller matrices ``(..., 4, 4)`` in SCATMECH's ``xyxy`` basis restated in the ``psps`` basis.
+
+    ``phi_i`` is the azimuth of the direction *toward the source* and ``phi_r`` that of the
+    scattered direction, both in the frame whose x axis defines the xyxy basis (radians; the
+    standard geometry has ``phi_i = pi``).  SCATMECH's xyxy basis of a ray (``GetBasisVectorsXY``
+    in its ``jmatrix.cpp``) is, up to an overall sign, its ``(s, p)`` basis turned by
+    ``-phi_r`` for the scattered ray and by ``+phi_i`` for the incident ray, so
+
+        M_psps = R(-phi_r) M_xyxy R(-phi_i)      (R = :func:`basis_rotation`).
+
+    The polar angles do not enter.  At ``phi_i = pi`` the incident factor is the identity and
+    ``M_psps = R(-phi_r) M_xyxy``; in-plane (``phi_r = 0`` or ``pi``) the two bases agree.
+    """
+    M = np.asarray(M, dtype=float)
+    return basis_rotation(-np.asarray(phi_r, float)) @ M @ basis_rotation(-np.asarray(phi_i, float))
+
+
+def psps_to_xyxy(M, phi_i, phi_r):
+    """The inverse of :func:`xyxy_to_psps`: ``M_xyxy = R(phi_r) M_psps R(phi_i)``."""
+    M = np.asarray(M, dtype=float)
+    return basis_rotation(np.asarray(phi_r, float)) @ M @ basis_rotation(np.asarray(phi_i, float))

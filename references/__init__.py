@@ -243,3 +243,61 @@ def tmm_both_ways() -> list[tuple[dict, dict]]:
     if [r["role"] for r in rows] != ["down", "up"] * (len(rows) // 2):
         raise ValueError("tmm_reference.csv: each 'down' row must be followed by its 'up' row")
     return list(zip(cases[::2], cases[1::2], strict=True))
+
+
+# NIST's sintered PTFE (T. A. Germer, Applied Optics 2017; a U.S. government work): the files are
+# committed as published in data/nist_ptfe/, with PROVENANCE.md beside them
+__all__ += ["nist_ptfe_path", "nist_ptfe_coefficients", "NIST_PTFE_TABLES", "read_coefficient_table"]
+
+_NIST = os.path.join(_DATA, "nist_ptfe")
+
+#: name -> file of the published expansion-coefficient tables (data/nist_ptfe/)
+NIST_PTFE_TABLES = {
+    "351": "PTFE.351.coeff.csv",
+    "532": "PTFE.532.coeff.csv",
+    "633": "PTFE.633.coeff.csv",
+    "1064": "PTFE.1064.coeff.csv",
+    "all": "PTFE.coeff.csv",
+    "grey10.532": "PTFE.grey10.532.coef.csv",
+}
+
+
+def nist_ptfe_path(name: str = "PTFE.data.csv") -> str:
+    """Path of a file of NIST's sintered-PTFE supplementary data (``data/nist_ptfe/``, as
+    published; provenance in ``PROVENANCE.md`` there): by default the 7296 measurements,
+    read with :func:`scatterbench.validation.fitting.mueller_data.load_mueller_data`."""
+    return os.path.join(_NIST, name)
+
+
+def read_coefficient_table(path) -> tuple:
+    """The rows of a SCATMECH ``ZernikeExpansion_BRDF_Model`` coefficient file, ``(i, j, n, m,
+    k, l, p, a)`` each (seven ints and a float), in file order.  Fields are separated by commas
+    and/or blanks; blank lines are skipped.  A line that is not eight numbers, or an index that
+    is not an integer, is a ``ValueError`` naming ``file:line``."""
+    rows = []
+    with open(path, encoding="utf-8") as fh:
+        for lineno, text in enumerate(fh, 1):
+            fields = text.replace(",", " ").split()
+            if not fields:
+                continue
+            try:
+                values = [float(f) for f in fields]
+            except ValueError:
+                raise ValueError(f"{path}:{lineno}: not a coefficient line (eight numbers)") from None
+            if len(values) != 8 or any(v != int(v) for v in values[:7] if math.isfinite(v)):
+                raise ValueError(
+                    f"{path}:{lineno}: expected i, j, n, m, k, l, p (integers) and a; got {text.strip()!r}"
+                )
+            rows.append((*(int(v) for v in values[:7]), values[7]))
+    return tuple(rows)
+
+
+def nist_ptfe_coefficients(name: str) -> tuple:
+    """A published expansion-coefficient table of NIST's sintered PTFE by name: ``"351"``,
+    ``"532"``, ``"633"``, ``"1064"`` (fitted to that wavelength's measurements), ``"all"``
+    (all four, with ``lambda^p`` terms, lambda in micrometres) or ``"grey10.532"`` (a grey
+    PTFE).  Rows ``(i, j, n, m, k, l, p, a)``, the ``coefficients`` of
+    :class:`scatterbench.models.ZernikeExpansionBRDF`."""
+    if name not in NIST_PTFE_TABLES:
+        raise ValueError(f"name must be one of {', '.join(map(repr, NIST_PTFE_TABLES))}; got {name!r}")
+    return read_coefficient_table(nist_ptfe_path(NIST_PTFE_TABLES[name]))

@@ -56,6 +56,11 @@ CORRESPONDENCE = {
         "—",
     ),
     "DetectorAperture": ("detector aperture around any model (no seed equation)", "—", "—"),
+    "ZernikeExpansionBRDF": (
+        "Koenderink & van Doorn (1998) extended to the Mueller matrix by Germer (2017): NIST's PTFE tables",
+        "``ZernikeExpansion_BRDF_Model`` (``coefficientfile``, ``scale``; xyxy basis)",
+        "—",
+    ),
 }
 
 
