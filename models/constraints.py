@@ -169,7 +169,17 @@ class Interval(Constraint):
     """Real numbers between ``low`` and ``high`` (``None``: unbounded), closed at the ends
     ``closed`` names (``"both"``, ``"left"``, ``"right"``, ``"neither"``).  Finite values only,
     except an infinite bound that is closed (``Interval(0, math.inf, closed="right")``: > 0 or
-    ``math.inf``).  One value; :class:`ScalarOrArray` for arrays."""
+    ``math.inf``).  One value; :class:`ScalarOrArray` for arrays.
+
+    >>> Interval(0.0, 1.0, closed="right").check("rho", 1)
+    1.0
+    >>> Interval(0.0, 1.0, closed="right").check("rho", 0.0)
+    Traceback (most recent call last):
+    ...
+    scatterbench.models.constraints.ParameterError: rho must be a finite real number in (0, 1]; got 0.0
+    >>> Interval(0.0, 1.0, closed="right").edges(0.5)
+    [1e-12, 1.0]
+    """
 
     kind = "real"
 
