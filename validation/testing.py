@@ -41,6 +41,7 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 
+from scatterbench import models
 from scatterbench.validation.checks.conformance import (
     ATTRIBUTES,
     ModelCheck,
@@ -306,8 +307,6 @@ def contributed_models() -> list[Contributed]:
 def format_contributed(contributed=None) -> str:
     """The contributed models as ``scatterbench models`` lists them: entry name, ``module:attr``,
     distribution, and the model's parameters (a :class:`scatterbench.models.Model`) or docstring summary."""
-    from scatterbench import models
-
     entries = contributed_models() if contributed is None else contributed
     lines = [f"\nContributed models (entry-point group {ENTRY_POINT_GROUP}): {len(entries) or 'none'}"]
     for c in entries:
@@ -337,8 +336,6 @@ def shipped_models() -> list[tuple[str, object]]:
     normalization, ``FacetBTDF``'s Eq. 37), the kit reports a finding with the reason
     ``accepted_findings.toml`` gives.
     """
-    from scatterbench import models
-
     out = []
     for cls in models.Model.registry:
         base = cls.sweep_base()
