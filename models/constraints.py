@@ -281,11 +281,10 @@ class Integer(Constraint):
     """Integers between ``low`` and ``high`` (``None``: unbounded), both ends included."""
 
     kind = "int"
+    low_open = high_open = False  # both ends are included
 
     def __init__(self, low=None, high=None):
         self.low, self.high = low, high
-
-    low_open = high_open = False
 
     def describe(self) -> str:
         return f"an integer in {interval_notation(self.low, self.high)}"
