@@ -309,7 +309,8 @@ class FacetBRDF(_FacetModel):
     One geometry gives one 4 x 4 Mueller matrix (1/sr, psps basis); arrays of angles
     broadcast, and so do array parameters (a model set):
 
-    >>> import math, numpy as np, models
+    >>> import math, numpy as np
+    >>> from scatterbench import models
     >>> m = models.FacetBRDF(slopes=models.GaussianSlopes(0.2), substrate=math.inf, shadowing="smith")
     >>> M = m.mueller(math.radians(30), math.radians(30), 0.0)  # specular, phi_r = 0
     >>> M.shape, round(float(M[0, 0]), 6)

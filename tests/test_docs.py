@@ -177,7 +177,7 @@ def test_site_in_chromium(site):
         "index.html",
         "guide/conventions.html",
         "api/models.html",
-        "api/generated/models.FacetBRDF.html",
+        "api/generated/scatterbench.models.FacetBRDF.html",
         "auto_examples/index.html",
         *(f"auto_examples/{p.name}" for p in sorted((out / "auto_examples").glob("plot_*.html"))),
     ]
