@@ -43,9 +43,8 @@ import json, math, os, resource, sys, time
 import numpy as np
 from scatterbench import models
 name, n, what = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-from scatterbench.validation.studies.stability import _BASES
 cls = next(c for c in models.Model.registry if c.__name__ == name)
-m = _BASES[name]() if name in _BASES else cls()
+m = cls.sweep_base()
 k = int(round(math.sqrt(n / 4)))
 tr = np.linspace(0, 1.5, k)[:, None]
 pr = np.linspace(-math.pi, math.pi, n // k)[None, :]

@@ -41,9 +41,13 @@ import numpy as np
 
 from . import evaluation
 from .base import Model, _Wrapper
+from .constraints import Instance, Integer, Interval, ScalarOrArray
+from .facts import Correspondence
 from .geometry import disc_quadrature, scattered_direction, sp_basis_angles
 from .params import param
 from .polarization import mueller16_from_jones
+from .slopes import ExponentialSlopes
+from .subsurface_facet import SubsurfaceFacetBRDF
 
 __all__ = ["DetectorAperture"]
 
@@ -65,11 +69,26 @@ class DetectorAperture(_Wrapper):
         Radial quadrature nodes over the cone (azimuthal nodes: twice as many).
     """
 
-    model: Model = param(dataclasses.MISSING, "the model seen through the aperture", kind="object")
-    aperture: float = param(
-        math.radians(0.7), "full cone angle of the detector (rad)", low=0.0, high=0.5 * math.pi
+    model: Model = param(
+        dataclasses.MISSING,
+        "the model seen through the aperture",
+        Instance(Model, text="a reflection model (models.Model)"),
     )
-    resolution: int = param(4, "radial quadrature nodes over the cone", kind="int", low=1, high=256)
+    # swept at a point, a hair, seed 000's 0.7 deg and the widest cone allowed
+    aperture: float = param(
+        math.radians(0.7),
+        "full cone angle of the detector (rad)",
+        ScalarOrArray(Interval(0.0, 0.5 * math.pi)),
+        edges=(0.0, 1e-6, math.radians(0.7), 0.5 * math.pi),
+    )
+    resolution: int = param(4, "radial quadrature nodes over the cone", Integer(1, 256), edges=(1, 64))
+
+    correspondence = Correspondence("detector aperture around any model (no seed equation)")
+
+    @classmethod
+    def sweep_base(cls):
+        """A narrow lobe (rms slope 0.02) under seed 000's 0.7 deg aperture: the aperture matters."""
+        return cls(model=SubsurfaceFacetBRDF(slopes=ExponentialSlopes(0.02)), aperture=math.radians(0.7))
 
     def lobe(self, theta_i):
         lb = self.model.lobe(theta_i)

@@ -22,7 +22,9 @@ from functools import cached_property
 import numpy as np
 
 from . import evaluation, float32_domain, modelset
+from .constraints import Instance
 from .evaluation import CHUNK
+from .facts import Correspondence, ModelFacts
 from .geometry import broadcast_angles
 from .modelset import array_leaves
 from .params import Declared, param
@@ -49,13 +51,13 @@ def rotated_set(model, angles):
         return None
 
 
-class Model(Declared):
+class Model(Declared, ModelFacts):
     """Base class of every scattering model (BRDF in 1/sr).
 
     Subclasses set ``depolarizing`` (True when no Jones matrix exists),
     ``reciprocal`` (True when Helmholtz reciprocity must hold) and
     ``transmission`` (True for a BTDF, whose second polar angle is measured from
-    -z).
+    -z), and the facts of :class:`scatterbench.models.facts.ModelFacts` that apply to them.
     """
 
     depolarizing = False
@@ -282,9 +284,12 @@ class Sum(Model):
     is.
     """
 
-    terms: tuple = param((), "tuple of (weight, model) pairs", kind="object")
+    terms: tuple = param(
+        (), "tuple of (weight, model) pairs", Instance(tuple, list, text="a tuple of (weight, model) pairs")
+    )
 
     depolarizing = True
+    correspondence = Correspondence("incoherent sum ``m1 + m2``, ``w * m`` (seed 003 Sec. 2.6 combination)")
 
     def _validate(self):
         if not self.terms:

@@ -44,6 +44,8 @@ import numpy as np
 
 from . import kernel_specs
 from .base import Model
+from .constraints import ComplexIndex, Instance, Options, ScalarOrArray
+from .facts import Correspondence
 from .fresnel import fresnel_reflectance
 from .params import SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN, Alias, check_real, choice_alias, convention_param, param
 from .shadowing import smith_g
@@ -62,6 +64,13 @@ __all__ = [
 _INV_4PI = 1.0 / (4.0 * math.pi)
 #: the ``shadowing`` choices of the Cook-Torrance models
 SHADOWING_CT = ("blinn", "none", "smith")
+#: the Cook-Torrance models' ``slopes``: the families whose D the kernels evaluate (coverage 1,
+#: checked by the models)
+CT_SLOPES = Instance(
+    GaussianSlopes,
+    StrokeSlopes,
+    text="models.GaussianSlopes(sigma=m) (Eq. 8) or models.StrokeSlopes (Eq. 19)",
+)
 
 
 def fresnel_real(cos_i, n, k=0.0):
@@ -314,13 +323,13 @@ class CookTorranceBRDF(_CookTorranceBase):
     """
 
     slopes: GaussianSlopes | StrokeSlopes = param(
-        GaussianSlopes(0.03),
-        "facet slopes of D: GaussianSlopes(sigma=m) (Eq. 8) or StrokeSlopes",
-        kind="object",
+        GaussianSlopes(0.03), "facet slopes of D: GaussianSlopes(sigma=m) (Eq. 8) or StrokeSlopes", CT_SLOPES
     )
-    substrate: complex = param(2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", kind="index")
+    substrate: complex = param(
+        2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", ScalarOrArray(ComplexIndex())
+    )
     convention: str = convention_param("Eq. 7-8 as printed (paper) or divided by 4 pi (corrected)")
-    shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=SHADOWING_CT)
+    shadowing: str = param("blinn", "geometric attenuation G", Options(*SHADOWING_CT))
 
     aliases = {
         "m": Alias("slopes", _slopes_from_m),
@@ -328,6 +337,7 @@ class CookTorranceBRDF(_CookTorranceBase):
             "convention", "normalization", {"published": "paper", "energy": "corrected"}
         ),
     }
+    correspondence = Correspondence("seed 001 Eq. 7-18")
 
     def _kernel_spec(self):
         return self._cook_spec(0, 1.0)

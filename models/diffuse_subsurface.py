@@ -37,7 +37,9 @@ from functools import cached_property
 import numpy as np
 
 from .base import Model
-from .params import param
+from .constraints import Interval, ScalarOrArray
+from .facts import Correspondence, scatmech_index
+from .params import coating_param, param
 from .smooth_interface import (
     depolarized_between,
     film_amplitudes,
@@ -46,7 +48,7 @@ from .smooth_interface import (
     internal_hemispherical_reflectance,
     squared_modulus,
 )
-from .thin_film import FilmedCoating, Films, check_films
+from .thin_film import FilmedCoating, Films, coating_films_param
 
 __all__ = ["DiffuseSubsurfaceBRDF"]
 
@@ -67,19 +69,28 @@ class DiffuseSubsurfaceBRDF(FilmedCoating, Model):
         index ``coating``; ``None`` (default): the bare interface of seed 003.
     """
 
-    coating: float = param(
-        1.5,
-        "index n of the binder above the diffuser, entered through the smooth interface (real)",
-        kind="real_index",
-        low=1.0,
+    coating: float = coating_param(
+        1.5, "index n of the binder above the diffuser, entered through the smooth interface (real)"
     )
-    rho: float = param(0.93, "diffuse reflectance of the material under the interface", low=0.0, high=1.0)
-    coating_films: Films = param(
-        None, "thin films on the smooth interface (None: bare)", kind="object", check=check_films
+    rho: float = param(
+        0.93, "diffuse reflectance of the material under the interface", ScalarOrArray(Interval(0.0, 1.0))
     )
+    coating_films: Films = coating_films_param("thin films on the smooth interface (None: bare)")
 
     depolarizing = True
     aliases = {"n": "coating"}
+    correspondence = Correspondence(
+        "seed 003 Eq. 21-28", "``Diffuse_Subsurface_BRDF_Model`` (``reflectance.table`` = rho)"
+    )
+
+    @property
+    def scatmech(self):
+        """SCATMECH's ``Diffuse_Subsurface_BRDF_Model`` (``substrate`` = coating,
+        ``reflectance.table`` = rho), or ``None`` with films (it has none)."""
+        sub = scatmech_index(self.coating)
+        if sub is None or self.coating_films is not None or not isinstance(self.rho, float):
+            return None
+        return "Diffuse_Subsurface_BRDF_Model", {"substrate": sub, "reflectance.table": self.rho}
 
     @cached_property
     def rbar(self):

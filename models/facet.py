@@ -34,18 +34,21 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
 from . import kernel_specs
 from .base import Model
+from .constraints import Options
+from .facts import Correspondence, scatmech_index
 from .fresnel import coating_cos, coating_transmission, reflection_rs_k
-from .params import check_index, param
+from .params import param
 from .polarization import mueller16_from_jones
 from .shadowing import SHADOWING, check_shadowing, smith_g
-from .slopes import ExponentialSlopes, SlopeDistribution
+from .slopes import SLOPES, AnisotropicGGXSlopes, ExponentialSlopes, GGXSlopes, SlopeDistribution
 from .smooth_interface import film_transmission
-from .thin_film import FilmStack
+from .thin_film import INDEX_OR_STACK, FilmStack
 
 __all__ = ["FacetBRDF", "facet_jones", "local_cosine", "substrate_rs_k"]
 
@@ -59,13 +62,6 @@ def substrate_rs_k(cos_i, n, substrate):
         return substrate.reflection_rs_k(cos_i, n)
     m = substrate if substrate == math.inf else complex(substrate) / n
     return reflection_rs_k(cos_i, m)
-
-
-def _index_or_stack(name, value):
-    """The ``check`` of a facet model's ``substrate`` (:func:`scatterbench.models.params.param`): a
-    :class:`scatterbench.models.FilmStack` (which validated itself when built) as it is, anything else
-    validated as an index (:func:`scatterbench.models.params.check_index`)."""
-    return value if isinstance(value, FilmStack) else check_index(name, value)
 
 
 def _polar(ti, tr, n):
@@ -250,11 +246,23 @@ class _FacetModel(Model):
         return 0.5 * tot
 
     def _validate(self):
-        if not isinstance(self.slopes, SlopeDistribution):
-            raise ValueError(
-                f"slopes must be a slope distribution (e.g. models.ExponentialSlopes); got {self.slopes!r}"
-            )
         check_shadowing(self.shadowing, self.slopes)
+
+    @classmethod
+    def sweep_extras(cls):
+        """Instances the defaults' edges do not reach: GGX and anisotropic GGX slopes with
+        shadowing none and smith (the slopes swept to their edges), and film-stack substrates
+        (zero thickness, thick, an absorbing film on aluminium) with both, as they are."""
+        ggx = (GGXSlopes(0.1), AnisotropicGGXSlopes(alpha_x=0.05, alpha_y=0.2, rotation=0.3))
+        out = [(cls(slopes=g, shadowing=sh), ("slopes",)) for g in ggx for sh in ("none", "smith")]
+        films = (
+            FilmStack(layers=((2.6, 0.0),), substrate=1.58, wavelength_nm=550.0),
+            FilmStack(layers=((2.6, 1e5),), substrate=1.58, wavelength_nm=550.0),
+            FilmStack(
+                layers=((3.1 + 3.3j, 10.0), (1.46, 200.0)), substrate=1.37 + 7.62j, wavelength_nm=550.0
+            ),
+        )
+        return (*out, *((cls(substrate=f, shadowing=sh), ()) for f in films for sh in ("none", "smith")))
 
     def rotated(self, angle):
         return self._rotated_slopes(angle)
@@ -314,11 +322,26 @@ class FacetBRDF(_FacetModel):
     (2, 3)
     """
 
-    slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
+    slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", SLOPES)
     substrate: complex = param(
-        1.37 + 7.62j,
-        "substrate index n + ik (inf: perfect conductor) or a models.FilmStack",
-        kind="index",
-        check=_index_or_stack,
+        1.37 + 7.62j, "substrate index n + ik (inf: perfect conductor) or a models.FilmStack", INDEX_OR_STACK
     )
-    shadowing: str = param("none", "shadowing-masking", kind="choice", choices=SHADOWING)
+    shadowing: str = param("none", "shadowing-masking", Options(*SHADOWING))
+
+    correspondence = Correspondence(
+        "seed 000 Eq. 48-49 with coating n = 1",
+        "``Facet_BRDF_Model`` (type 0)",
+        "``roughconductor`` (``beckmann``/``ggx``) with ``shadowing='smith'``, divided by cos(theta_i)",
+    )
+    #: the kit's instance: the slopes of committed SCATMECH reference values
+    #: (references/data/scatmech_facet.csv), so that its ``scatmech`` check compares with them
+    kit_variant = MappingProxyType({"slopes": ExponentialSlopes(0.05)})
+
+    @property
+    def scatmech(self):
+        """SCATMECH's ``Facet_BRDF_Model`` (type 0) with these parameters, or ``None``: it has no
+        shadowing, no film stacks and the exponential and Gaussian families only."""
+        sdf, sub = self.slopes.scatmech_parameters(), scatmech_index(self.substrate)
+        if sdf is None or sub is None or self.shadowing != "none":
+            return None
+        return "Facet_BRDF_Model", {"type": 0, "substrate": sub, **sdf}

@@ -41,16 +41,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
 from . import kernel_specs
 from .base import Model
+from .constraints import Instance, Options, RealIndex, ScalarOrArray
+from .facts import Correspondence, scatmech_index
 from .geometry import sp_basis
 from .params import choice_alias, convention_param, param
 from .polarization import mueller16_from_jones
 from .shadowing import SHADOWING, check_shadowing, smith_g
-from .slopes import GaussianSlopes, SlopeDistribution
+from .slopes import AnisotropicGGXSlopes, GaussianSlopes, GGXSlopes, SlopeDistribution
 
 __all__ = ["FacetBTDF", "facet_transmission_jones", "ray_basis", "angle_basis", "projected_area"]
 
@@ -186,12 +189,21 @@ class FacetBTDF(Model):
         projected area without shadowing).
     """
 
-    slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", kind="object")
-    substrate: float = param(1.5, "substrate index (real, > 1)", kind="real_index", low=1.0)
+    slopes: SlopeDistribution = param(
+        GaussianSlopes(0.1),
+        "facet slope distribution",
+        Instance(SlopeDistribution, text="a slope distribution (e.g. models.GaussianSlopes)"),
+    )
+    substrate: float = param(1.5, "substrate index (real, > 1)", ScalarOrArray(RealIndex(1.0)))
     convention: str = convention_param(
         "normalization of the slopes seen by the ray: Eq. 37 (paper, SCATMECH) or exact Eq. 36 (corrected)"
     )
-    shadowing: str = param("none", "shadowing-masking", kind="choice", choices=SHADOWING)
+    shadowing: str = param("none", "shadowing-masking", Options(*SHADOWING))
+
+    correspondence = Correspondence("seed 003 Eq. 29-43 (Fig. 1)", "``Facet_BRDF_Model`` (type 1)")
+    #: the kit's instance: the slopes of committed SCATMECH reference values
+    #: (references/data/scatmech_seed003_btdf.csv), so that its ``scatmech`` check compares with them
+    kit_variant = MappingProxyType({"slopes": GaussianSlopes(0.05)})
 
     aliases = {
         "normalization": choice_alias("convention", "normalization", {"paper": "paper", "exact": "corrected"})
@@ -199,11 +211,25 @@ class FacetBTDF(Model):
     transmission = True
     _angle_names = ("theta_i", "theta_t", "phi_t")
 
+    @property
+    def scatmech(self):
+        """SCATMECH's ``Facet_BRDF_Model`` (type 1, transmission) with these parameters, or
+        ``None``: it normalizes as Eq. 37 (``convention="paper"``), has no shadowing and the
+        exponential and Gaussian families only."""
+        sdf, sub = self.slopes.scatmech_parameters(), scatmech_index(self.substrate)
+        if sdf is None or sub is None or self.shadowing != "none" or self.convention != "paper":
+            return None
+        return "Facet_BRDF_Model", {"type": 1, "substrate": sub, **sdf}
+
+    @classmethod
+    def sweep_extras(cls):
+        """Instances the defaults' edges do not reach: GGX and anisotropic GGX slopes with
+        shadowing none and smith, the slopes swept to their edges (its substrate is a real
+        index: no film stacks)."""
+        ggx = (GGXSlopes(0.1), AnisotropicGGXSlopes(alpha_x=0.05, alpha_y=0.2, rotation=0.3))
+        return tuple((cls(slopes=g, shadowing=sh), ("slopes",)) for g in ggx for sh in ("none", "smith"))
+
     def _validate(self):
-        if not isinstance(self.slopes, SlopeDistribution):
-            raise ValueError(
-                f"slopes must be a slope distribution (e.g. models.GaussianSlopes); got {self.slopes!r}"
-            )
         if self.substrate == 1.0:
             raise ValueError(
                 "substrate must be a real index > 1 (at n = 1 the interface vanishes and the BTDF is a delta)"

@@ -16,20 +16,13 @@ import math
 
 import numpy as np
 
-__all__ = ["SLOPE_KINDS", "SHADOWING_KINDS", "slope_rows", "index_rows", "shadowing_kind"]
+__all__ = ["SLOPE_CODES", "SHADOWING_KINDS", "slope_rows", "index_rows", "shadowing_kind"]
 
-# the kinds the kernels know (models.kernels.common uses the same numbers)
+# The slope kinds the kernels know (models.kernels.common uses the same numbers); each slope
+# distribution class names its own as ``kernel_code`` (models.slopes).
 EXPONENTIAL, GAUSSIAN, GGX, ANISO_EXPONENTIAL, ANISO_GAUSSIAN, ANISO_GGX, STROKE, UNIT = range(8)
-SLOPE_KINDS = {
-    "ExponentialSlopes": EXPONENTIAL,
-    "GaussianSlopes": GAUSSIAN,
-    "GGXSlopes": GGX,
-    "AnisotropicExponentialSlopes": ANISO_EXPONENTIAL,
-    "AnisotropicGaussianSlopes": ANISO_GAUSSIAN,
-    "AnisotropicGGXSlopes": ANISO_GGX,
-    "StrokeSlopes": STROKE,
-    "UnitSlopes": UNIT,
-}
+#: every slope code the kernels know
+SLOPE_CODES = (EXPONENTIAL, GAUSSIAN, GGX, ANISO_EXPONENTIAL, ANISO_GAUSSIAN, ANISO_GGX, STROKE, UNIT)
 #: slope kinds whose Smith Lambda has a closed form in the kernels
 SMITH_KINDS = (GAUSSIAN, GGX, ANISO_GAUSSIAN, ANISO_GGX)
 SHADOWING_KINDS = {"none": 0, "smith": 1, "smith-correlated": 2}
@@ -62,19 +55,12 @@ KERNEL_ROWS = {
 
 
 def slope_rows(slopes):
-    """``(kind, [sx, sy, rotation, coverage])`` of a slope distribution, or ``None``."""
-    kind = SLOPE_KINDS.get(type(slopes).__name__)
+    """``(kind, [sx, sy, rotation, coverage])`` of a slope distribution (its class's
+    ``kernel_code`` and ``kernel_row()``), or ``None`` where no kernel evaluates it."""
+    kind = getattr(slopes, "kernel_code", None)
     if kind is None:
         return None
-    if kind in (EXPONENTIAL, GAUSSIAN):
-        return kind, [slopes.sigma, slopes.sigma, 0.0, slopes.coverage]
-    if kind == GGX:
-        return kind, [slopes.alpha, slopes.alpha, 0.0, slopes.coverage]
-    if kind == STROKE:
-        return kind, [slopes.m_parallel, slopes.m_perpendicular, slopes.stroke_angle, slopes.coverage]
-    if kind == UNIT:
-        return kind, [1.0, 1.0, 0.0, 1.0]
-    return kind, [slopes.sigma_x, slopes.sigma_y, slopes.rotation, slopes.coverage]
+    return kind, slopes.kernel_row()
 
 
 def shadowing_kind(shadowing, kind):

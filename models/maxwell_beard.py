@@ -34,9 +34,11 @@ import numpy as np
 
 from . import kernel_specs
 from .base import Model
+from .constraints import ComplexIndex, Interval, Options, ScalarOrArray
 from .facet import FacetBRDF
+from .facts import Correspondence, scatmech_index
 from .params import param
-from .slopes import GaussianSlopes, SlopeDistribution
+from .slopes import SLOPES, GaussianSlopes, SlopeDistribution
 
 __all__ = ["MaxwellBeardBRDF", "maxwell_beard_shadow"]
 
@@ -86,21 +88,47 @@ class MaxwellBeardBRDF(Model):
         False: the published scalar form; True: facet Mueller matrix on the specular term.
     """
 
-    slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", kind="object")
-    substrate: complex = param(1.5 + 0j, "material index n + ik", kind="index")
-    rho_d: float = param(0.0, "Lambertian BRDF (1/sr)", low=0.0)
-    rho_v: float = param(0.0, "volumetric BRDF coefficient (1/sr)", low=0.0)
-    tau: float = param(0.25, "shadowing parameter tau (rad)", low=0.0, low_open=True)
-    omega: float = param(0.7, "obscuration parameter Omega (rad)", low=0.0, low_open=True)
-    polarized: bool = param(
-        False, "facet Mueller matrix on the specular term", kind="choice", choices=(True, False)
+    slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", SLOPES)
+    substrate: complex = param(1.5 + 0j, "material index n + ik", ScalarOrArray(ComplexIndex()))
+    # the amplitudes are BRDFs (1/sr): swept at 0 and 1/pi, a white Lambertian
+    rho_d: float = param(
+        0.0, "Lambertian BRDF (1/sr)", ScalarOrArray(Interval(0.0)), edges=(0.0, 1.0 / math.pi)
     )
+    rho_v: float = param(
+        0.0, "volumetric BRDF coefficient (1/sr)", ScalarOrArray(Interval(0.0)), edges=(0.0, 1.0 / math.pi)
+    )
+    tau: float = param(
+        0.25, "shadowing parameter tau (rad)", ScalarOrArray(Interval(0.0, closed="right")), edges=(1e-4, 2.0)
+    )
+    omega: float = param(
+        0.7,
+        "obscuration parameter Omega (rad)",
+        ScalarOrArray(Interval(0.0, closed="right")),
+        edges=(1e-4, 2.0),
+    )
+    polarized: bool = param(False, "facet Mueller matrix on the specular term", Options(True, False))
 
     depolarizing = True
+    correspondence = Correspondence(
+        "Maxwell-Beard, compared with the combination in seed 003 Sec. 3",
+        "``Shadowed_Facet_BRDF_Model`` for its specular term",
+    )
 
-    def _validate(self):
-        if not isinstance(self.slopes, SlopeDistribution):
-            raise ValueError(f"slopes must be a slope distribution; got {self.slopes!r}")
+    @property
+    def scatmech(self):
+        """SCATMECH's ``Shadowed_Facet_BRDF_Model`` with its ``Maxwell_Beard_Shadow_Function``,
+        or ``None``: it is the specular term alone (``rho_d = rho_v = 0``), polarized (the
+        facet Mueller matrix), of an exponential or Gaussian family."""
+        sdf, sub = self.slopes.scatmech_parameters(), scatmech_index(self.substrate)
+        scalars = all(isinstance(v, float) for v in (self.rho_d, self.rho_v, self.tau, self.omega))
+        if sdf is None or sub is None or not scalars or not self.polarized or self.rho_d or self.rho_v:
+            return None
+        shadow = {
+            "shadow": "Maxwell_Beard_Shadow_Function",
+            "shadow.tau": self.tau,
+            "shadow.Omega": self.omega,
+        }
+        return "Shadowed_Facet_BRDF_Model", {"substrate": sub, **sdf, **shadow}
 
     @cached_property
     def _facet(self):

@@ -1,7 +1,7 @@
 """Model sets: models whose declared real or index parameters are numpy arrays.
 
-A declared ``real``, ``real_index`` or ``index`` parameter (:mod:`scatterbench.models.params`) may be
-an array of any shape; the model then stands for one model per element (astropy's
+A declared parameter whose constraint accepts arrays (``ScalarOrArray`` of a real or index
+constraint, :mod:`scatterbench.models.constraints`) may be an array of any shape; the model then stands for one model per element (astropy's
 "model sets").  Its *parameter shape* is the broadcast of the shapes of all its array
 parameters, those of nested declared objects included (``FacetBRDF(slopes=
 GaussianSlopes(sigma=array))``), and evaluation broadcasts it against the angles:
@@ -33,26 +33,24 @@ __all__ = [
     "element",
 ]
 
-#: declared kinds whose values may be arrays
-ARRAY_KINDS = ("real", "real_index", "index")
-
 
 def _declared_fields(obj):
     return [f for f in dataclasses.fields(obj) if "scatterbench" in f.metadata]
 
 
 def _walk(obj, path, visit):
-    """Call ``visit(path, value, kind)`` for every declared real/index value under ``obj``.
+    """Call ``visit(path, value, kind)`` for every declared value under ``obj`` that may be an
+    array (its constraint's ``arrays``), and walk into every other declared value.
 
     A declared object where a value goes (a :class:`scatterbench.models.FilmStack` as a substrate
-    index) is walked into, like an ``object`` field."""
+    index) is walked into, like an object parameter."""
     if isinstance(obj, Declared) and dataclasses.is_dataclass(obj):
         for f in _declared_fields(obj):
-            kind = f.metadata["scatterbench"]["kind"]
+            constraint = f.metadata["scatterbench"].constraint
             value = getattr(obj, f.name)
-            if kind in ARRAY_KINDS and not isinstance(value, Declared):
-                visit(path + (f.name,), value, kind)
-            elif kind == "object" or isinstance(value, Declared):
+            if constraint.arrays and not isinstance(value, Declared):
+                visit(path + (f.name,), value, constraint.kind)
+            else:
                 _walk(value, path + (f.name,), visit)
     elif isinstance(obj, tuple):
         for i, item in enumerate(obj):

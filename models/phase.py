@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .constraints import Interval, Options, ScalarOrArray
 from .params import Declared, param
 
 __all__ = ["HenyeyGreenstein"]
@@ -48,12 +49,14 @@ class HenyeyGreenstein(Declared):
         True: Eq. 7 (Rayleigh-Gans polarization); False: totally depolarizing.
     """
 
+    # swept at strong back scattering, isotropic and strong forward scattering
     g: float = param(
-        0.3, "asymmetry parameter <cos theta>", low=-1.0, high=1.0, low_open=True, high_open=True
+        0.3,
+        "asymmetry parameter <cos theta>",
+        ScalarOrArray(Interval(-1.0, 1.0, closed="neither")),
+        edges=(-0.99, 0.0, 0.99),
     )
-    polarized: bool = param(
-        True, "Rayleigh-Gans polarization (Eq. 7) or depolarizing", kind="choice", choices=(True, False)
-    )
+    polarized: bool = param(True, "Rayleigh-Gans polarization (Eq. 7) or depolarizing", Options(True, False))
 
     def density(self, cos_theta):
         """Scalar HG density per steradian ``p(theta)`` (Eq. 2 with the HG sign)."""

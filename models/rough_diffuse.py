@@ -59,18 +59,21 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from types import MappingProxyType
 
 import numpy as np
 
 from . import evaluation, modelset
 from .base import Model
+from .constraints import Instance, Integer, Interval, OneOf, Options, ScalarOrArray
 from .facet import FacetBRDF
 from .facet_btdf import _dot, angle_basis, facet_transmission_jones, projected_area, ray_basis
+from .facts import Correspondence
 from .geometry import gauss_legendre
-from .params import choice_alias, convention_param, param
+from .params import choice_alias, coating_param, convention_param, param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
-from .slopes import ExponentialSlopes, SlopeDistribution
+from .slopes import SLOPES, ExponentialSlopes, SlopeDistribution
 from .smooth_interface import internal_hemispherical_reflectance
 
 __all__ = ["RoughDiffuseBRDF", "sample_normals_seen_by", "projected_area"]
@@ -129,14 +132,6 @@ def _normals(z):
     return np.stack([z[0] * inv, z[1] * inv, inv])[:, None, :]
 
 
-def _check_seed(name, s):
-    if isinstance(s, (bool, np.bool_)) or not (
-        isinstance(s, np.random.Generator) or (isinstance(s, (int, np.integer)) and s >= 0)
-    ):
-        raise ValueError(f"{name} must be an integer >= 0 or a numpy.random.Generator; got {s!r}")
-    return s
-
-
 @dataclass(frozen=True)
 class RoughDiffuseBRDF(Model):
     """Monte Carlo: volume scattering (single, Eq. 7, and totally diffuse, Eq. 21) beneath a
@@ -183,27 +178,32 @@ class RoughDiffuseBRDF(Model):
     """
 
     slopes: SlopeDistribution = param(
-        ExponentialSlopes(2.0), "isotropic facet slope distribution of the interface", kind="object"
+        ExponentialSlopes(2.0), "isotropic facet slope distribution of the interface", SLOPES
     )
-    coating: float = param(
-        1.5,
-        "index n of the binder around the scatterers, entered through the rough interface (real)",
-        kind="real_index",
-        low=1.0,
+    coating: float = coating_param(
+        1.5, "index n of the binder around the scatterers, entered through the rough interface (real)"
     )
-    phase: HenyeyGreenstein = param(HenyeyGreenstein(0.3), "single-scattering phase function", kind="object")
-    rho: float = param(0.05, "diffuse reflectance of the material under the interface", low=0.0, high=1.0)
-    pairs: int = param(5000, "facet pairs per geometry", kind="int", low=2, high=10**7)
-    seed: object = param(0, "seed (int >= 0) or numpy.random.Generator", kind="object", check=_check_seed)
-    surface: bool = param(
-        True, "add the exposed surface's facet reflection", kind="choice", choices=(True, False)
+    phase: HenyeyGreenstein = param(
+        HenyeyGreenstein(0.3),
+        "single-scattering phase function",
+        Instance(HenyeyGreenstein, text="a models.HenyeyGreenstein"),
     )
-    single: float = param(1.0, "weight of the single-scattering term", low=0.0)
+    rho: float = param(
+        0.05, "diffuse reflectance of the material under the interface", ScalarOrArray(Interval(0.0, 1.0))
+    )
+    # Monte Carlo: swept at the fewest pairs allowed and a moderate count
+    pairs: int = param(5000, "facet pairs per geometry", Integer(2, 10**7), edges=(2, 200))
+    seed: object = param(
+        0,
+        "seed (int >= 0) or numpy.random.Generator",
+        OneOf(Integer(0), Instance(np.random.Generator, text="a numpy.random.Generator")),
+    )
+    surface: bool = param(True, "add the exposed surface's facet reflection", Options(True, False))
+    single: float = param(
+        1.0, "weight of the single-scattering term", ScalarOrArray(Interval(0.0)), edges=(0.0, 1.0)
+    )
     feedback: str = param(
-        "rough",
-        "R-bar of Eq. 23: of the rough interface (MC) or of the flat one",
-        kind="choice",
-        choices=("rough", "flat"),
+        "rough", "R-bar of Eq. 23: of the rough interface (MC) or of the flat one", Options("rough", "flat")
     )
     convention: str = convention_param(
         "surface term: FacetBRDF with Eq. 37's normalization (paper) or exact Eq. 36 (corrected)"
@@ -216,20 +216,28 @@ class RoughDiffuseBRDF(Model):
         ),
     }
     depolarizing = True
+    correspondence = Correspondence("seed 003 Sec. 2.5 (Monte Carlo), Eq. 7, 21")
+    #: the kit's instance: 20 facet pairs per geometry (the kit checks shapes, finiteness,
+    #: realizability and the seed of this Monte Carlo model, not its precision)
+    kit_variant = MappingProxyType({"pairs": 20})
+
+    @classmethod
+    def sweep_base(cls):
+        """A moderate pair count: the sweep looks for non-finite values, negative or
+        unphysical matrices, not for Monte Carlo precision."""
+        return cls(pairs=200)
 
     @property
     def reciprocal(self):  # type: ignore[override]
         return not (self.surface and self.convention == "corrected")
 
     def _validate(self):
-        if not isinstance(self.slopes, SlopeDistribution) or not self.slopes.isotropic:
+        if not self.slopes.isotropic:
             raise ValueError(f"slopes must be an isotropic slope distribution; got {self.slopes!r}")
         if getattr(self.slopes, "coverage", 1.0) != 1.0:
             raise ValueError(
                 "slopes must have coverage 1 (a continuous interface: every path crosses it twice)"
             )
-        if not isinstance(self.phase, HenyeyGreenstein):
-            raise ValueError(f"phase must be a models.HenyeyGreenstein; got {self.phase!r}")
         # Draw the facet pairs now: a Generator passed in is consumed once, here.
         rng = np.random.default_rng(self.seed)
         z1 = self.slopes.sample(self.pairs, rng)

@@ -44,11 +44,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Model
-from .params import param
+from .constraints import Instance
+from .facts import Correspondence, scatmech_index
+from .params import coating_param, param
 from .phase import HenyeyGreenstein
 from .polarization import mueller16_from_jones
 from .smooth_interface import depolarized_between, film_amplitudes, interface_amplitudes, squared_modulus
-from .thin_film import FilmedCoating, Films, check_films
+from .thin_film import FilmedCoating, Films, coating_films_param
 
 __all__ = ["SingleScatterBRDF"]
 
@@ -71,22 +73,37 @@ class SingleScatterBRDF(FilmedCoating, Model):
         index ``coating``; ``None`` (default): the bare interface of seed 003.
     """
 
-    coating: float = param(
-        1.5,
-        "index n of the binder around the scatterers, entered through the smooth interface (real)",
-        kind="real_index",
-        low=1.0,
+    coating: float = coating_param(
+        1.5, "index n of the binder around the scatterers, entered through the smooth interface (real)"
     )
-    phase: HenyeyGreenstein = param(HenyeyGreenstein(0.3), "volume phase function", kind="object")
-    coating_films: Films = param(
-        None, "thin films on the smooth interface (None: bare)", kind="object", check=check_films
+    phase: HenyeyGreenstein = param(
+        HenyeyGreenstein(0.3),
+        "volume phase function",
+        Instance(HenyeyGreenstein, text="a models.HenyeyGreenstein"),
     )
+    coating_films: Films = coating_films_param("thin films on the smooth interface (None: bare)")
 
     aliases = {"n": "coating"}
+    correspondence = Correspondence(
+        "seed 003 Eq. 2-20",
+        "``First_Diffuse_BRDF_Model`` (``Unpolarized_Phase_Function``; depolarizing phase only)",
+    )
 
-    def _validate(self):
-        if not isinstance(self.phase, HenyeyGreenstein):
-            raise ValueError(f"phase must be a models.HenyeyGreenstein; got {self.phase!r}")
+    @property
+    def scatmech(self):
+        """SCATMECH's ``First_Diffuse_BRDF_Model`` with its ``Unpolarized_Phase_Function`` of a
+        Henyey-Greenstein phase (no absorption), or ``None``: current SCATMECH has no
+        polarized (Rayleigh-Gans) phase function, and no films here."""
+        sub, g = scatmech_index(self.coating), self.phase.g
+        if sub is None or self.phase.polarized or self.coating_films is not None or not isinstance(g, float):
+            return None
+        return "First_Diffuse_BRDF_Model", {
+            "substrate": sub,
+            "phase_function": "Unpolarized_Phase_Function",
+            "phase_function.phase_function": "Henyey_Greenstein_Phase_Function",
+            "phase_function.phase_function.g": g,
+            "phase_function.log_absorption": -1000,
+        }
 
     @property
     def depolarizing(self):  # type: ignore[override]

@@ -45,8 +45,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import param, width_param
-from .slopes import SlopeDistribution, _exp_neg
+from . import kernel_specs
+from .params import width_param
+from .slopes import SlopeDistribution, _exp_neg, coverage_param, rotation_param
 
 __all__ = ["StrokeSlopes", "stroke_d"]
 
@@ -85,16 +86,24 @@ class StrokeSlopes(SlopeDistribution):
     ``m_par = m_perp = m`` is :class:`scatterbench.models.GaussianSlopes` with ``sigma = m``.
     """
 
+    # swept from a near-mirror to seed 001's roughest m = 2, and a 100:1 (and 2e4:1) anisotropy
     m_parallel: float = width_param(
         0.03,
         "the paper's m along the strokes (Eq. 19); slope moment <u^2> = m_par^2 m_perp / (m_par + m_perp)",
+        edges=(1e-4, 0.3, 2.0),
     )
     m_perpendicular: float = width_param(
         0.03,
         "the paper's m across the strokes (Eq. 19); slope moment <v^2> = m_perp^2 m_par / (m_par + m_perp)",
+        edges=(1e-4, 0.3, 2.0),
     )
-    stroke_angle: float = param(0.0, "azimuth of the strokes from the sample x axis (rad)")
-    coverage: float = param(1.0, "projected coverage C", low=0.0, high=1.0, low_open=True)
+    stroke_angle: float = rotation_param("azimuth of the strokes from the sample x axis (rad)")
+    coverage: float = coverage_param()
+
+    kernel_code = kernel_specs.STROKE
+
+    def kernel_row(self):
+        return [self.m_parallel, self.m_perpendicular, self.stroke_angle, self.coverage]
 
     @property
     def isotropic(self):  # type: ignore[override]

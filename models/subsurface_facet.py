@@ -25,12 +25,15 @@ compiled kernel included.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import MappingProxyType
 
-from .facet import _FacetModel, _index_or_stack
-from .params import param
+from .constraints import Options
+from .facet import _FacetModel
+from .facts import Correspondence, scatmech_index
+from .params import coating_param, param
 from .shadowing import SHADOWING
-from .slopes import ExponentialSlopes, SlopeDistribution
-from .thin_film import FilmedCoating, Films, check_films
+from .slopes import SLOPES, ExponentialSlopes, SlopeDistribution
+from .thin_film import INDEX_OR_STACK, FilmedCoating, Films, coating_films_param
 
 __all__ = ["SubsurfaceFacetBRDF"]
 
@@ -70,18 +73,33 @@ class SubsurfaceFacetBRDF(FilmedCoating, _FacetModel):
         films' complex transmission amplitudes replace Eq. 14-15's ``t(theta; 1, n)``.
     """
 
-    slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", kind="object")
-    coating: float = param(1.5, "coating index (real, non-absorbing)", kind="real_index", low=1.0)
+    slopes: SlopeDistribution = param(ExponentialSlopes(0.1), "facet slope distribution", SLOPES)
+    coating: float = coating_param(1.5, "coating index (real, non-absorbing)")
     substrate: complex = param(
         1.37 + 7.62j,
         "flake/substrate index n + ik (inf: perfect conductor) or a models.FilmStack",
-        kind="index",
-        check=_index_or_stack,
+        INDEX_OR_STACK,
     )
-    shadowing: str = param("none", "shadowing-masking (inside the coating)", kind="choice", choices=SHADOWING)
-    coating_films: Films = param(
-        None, "thin films on the coating's top surface (None: bare)", kind="object", check=check_films
+    shadowing: str = param("none", "shadowing-masking (inside the coating)", Options(*SHADOWING))
+    coating_films: Films = coating_films_param("thin films on the coating's top surface (None: bare)")
+
+    correspondence = Correspondence(
+        "seed 000 Eq. 2-18, 49 (Table I)", "``Subsurface_Facet_BRDF_Model`` (``overcoat``)"
     )
+    #: the kit's instance: slopes and coating of committed SCATMECH reference values
+    #: (references/data/scatmech_facet.csv), so that its ``scatmech`` check compares with them
+    kit_variant = MappingProxyType({"slopes": ExponentialSlopes(0.05), "coating": 2.2})
+
+    @property
+    def scatmech(self):
+        """SCATMECH's ``Subsurface_Facet_BRDF_Model`` (``overcoat`` = coating) with these
+        parameters, or ``None``: it has no shadowing, no films and the exponential and
+        Gaussian families only."""
+        sdf, sub = self.slopes.scatmech_parameters(), scatmech_index(self.substrate)
+        coat = scatmech_index(self.coating)
+        if sdf is None or sub is None or coat is None or self.shadowing != "none" or self.coating_films:
+            return None
+        return "Subsurface_Facet_BRDF_Model", {"substrate": sub, "overcoat": coat, **sdf}
 
     def _coating(self) -> float:
         return self.coating

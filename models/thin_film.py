@@ -64,10 +64,29 @@ from functools import cached_property
 
 import numpy as np
 
+from .constraints import (
+    ComplexIndex,
+    Constraint,
+    Instance,
+    Interval,
+    OneOf,
+    ParameterError,
+    Samples,
+    ScalarOrArray,
+)
 from .fresnel import _w, fresnel_coefficients, reflection_rs_k
 from .params import Declared, check_index, check_real, param
 
-__all__ = ["FilmStack", "Films", "TabulatedIndex", "check_films"]
+__all__ = [
+    "FilmStack",
+    "Films",
+    "TabulatedIndex",
+    "check_films",
+    "coating_films_param",
+    "COATING_FILM_EDGES",
+    "ABSORBING_FILMS",
+    "INDEX_OR_STACK",
+]
 
 
 @dataclass(frozen=True)
@@ -78,20 +97,21 @@ class TabulatedIndex(Declared):
     wavelength in nm.
     """
 
-    wavelength_nm: tuple = param((400.0, 700.0), "wavelengths (nm), increasing", kind="object")
-    n: tuple = param((1.5, 1.5), "real parts at those wavelengths (> 0)", kind="object")
-    k: tuple = param((0.0, 0.0), "imaginary parts (>= 0)", kind="object")
+    wavelength_nm: tuple = param(
+        (400.0, 700.0), "wavelengths (nm), increasing", Samples(Interval(), increasing=True)
+    )
+    n: tuple = param(
+        (1.5, 1.5), "real parts at those wavelengths (> 0)", Samples(Interval(0.0, closed="right"))
+    )
+    k: tuple = param((0.0, 0.0), "imaginary parts (>= 0)", Samples(Interval(0.0)))
 
     def _validate(self):
-        w, n, k = (np.asarray(v, dtype=float) for v in (self.wavelength_nm, self.n, self.k))
-        if w.ndim != 1 or w.size < 2 or not np.all(np.isfinite(w)) or np.any(np.diff(w) <= 0):
-            raise ValueError("wavelength_nm must be at least two finite, strictly increasing values")
-        if n.shape != w.shape or not np.all(np.isfinite(n)) or np.any(n <= 0):
-            raise ValueError("n must hold one finite value > 0 per wavelength")
-        if k.shape != w.shape or not np.all(np.isfinite(k)) or np.any(k < 0):
-            raise ValueError("k must hold one finite value >= 0 per wavelength")
-        for name, v in (("wavelength_nm", w), ("n", n), ("k", k)):
-            object.__setattr__(self, name, tuple(v.tolist()))
+        for name in ("n", "k"):
+            if len(getattr(self, name)) != len(self.wavelength_nm):
+                raise ValueError(
+                    f"{name} must hold one value per wavelength ({len(self.wavelength_nm)}); "
+                    f"got {len(getattr(self, name))}"
+                )
 
     def __call__(self, wavelength_nm):
         lo, hi = self.wavelength_nm[0], self.wavelength_nm[-1]
@@ -108,16 +128,53 @@ def _resolve(name, value, wavelength_nm):
     return check_index(name, value)
 
 
-def _checked_layers(layers):
-    """``layers`` as a tuple of ``(index, thickness_nm)`` pairs, thicknesses checked (>= 0)."""
-    try:
-        pairs = tuple((idx, d) for idx, d in layers)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"layers must be a sequence of (index, thickness_nm) pairs; got {layers!r}"
-        ) from None
-    # check_real, not float(): a bool or a string is no thickness (float(True) is 1.0)
-    return tuple((idx, check_real(f"layers[{j}] thickness_nm", d, 0.0)) for j, (idx, d) in enumerate(pairs))
+class Layers(Constraint):
+    """Films as ``((index, thickness_nm), ...)``: each thickness a finite real ``>= 0``, each
+    index ``n + ik`` or a callable of the wavelength, validated (at the stack's wavelength) by
+    the stack that holds them.  Returned as a tuple of pairs, thicknesses as floats."""
+
+    kind = "sequence"
+    THICKNESS = Interval(0.0)
+
+    def describe(self) -> str:
+        return (
+            "a sequence of (index, thickness_nm) pairs (index n + ik or a callable of the wavelength "
+            f"in nm; thickness_nm {self.THICKNESS.describe()})"
+        )
+
+    def check(self, name, value) -> tuple:
+        try:
+            pairs = tuple((idx, d) for idx, d in value)
+        except (TypeError, ValueError):
+            self.fail(name, value)
+        # a constraint, not float(): a bool or a string is no thickness (float(True) is 1.0)
+        return tuple(
+            (idx, self.THICKNESS.check(f"{name}[{j}] thickness_nm", d)) for j, (idx, d) in enumerate(pairs)
+        )
+
+
+class Dispersive(Constraint):
+    """An index (:class:`scatterbench.models.constraints.ComplexIndex`; an array of them where
+    a model set puts films on an array of coatings) or a callable of the wavelength in nm
+    returning one.  A number is checked here and kept as given: the stack resolves it (as a
+    complex) at its wavelength."""
+
+    kind = "index"
+    INDEX = ScalarOrArray(ComplexIndex())
+
+    def describe(self) -> str:
+        return f"{self.INDEX.describe()}, or a callable of the wavelength in nm returning one"
+
+    def check(self, name, value):
+        if not callable(value):
+            try:
+                self.INDEX.check(name, value)
+            except ParameterError as exc:
+                raise exc.restated(self.describe()) from None
+        return value
+
+
+_LAYERS = Layers()
 
 
 def _film_indices(layers, wavelength_nm):
@@ -146,12 +203,13 @@ class FilmStack(Declared):
         Vacuum wavelength (nm) at which the indices and phases are evaluated.
     """
 
-    layers: tuple = param((), "films ((index, thickness_nm), ...) from the incident side", kind="object")
-    substrate: complex = param(1.5 + 0j, "index below the films (n + ik, inf, or callable)", kind="object")
-    wavelength_nm: float = param(550.0, "vacuum wavelength (nm)", low=0.0, low_open=True)
+    layers: tuple = param((), "films ((index, thickness_nm), ...) from the incident side", _LAYERS)
+    substrate: complex = param(1.5 + 0j, "index below the films (n + ik, inf, or callable)", Dispersive())
+    wavelength_nm: float = param(
+        550.0, "vacuum wavelength (nm)", ScalarOrArray(Interval(0.0, closed="right"))
+    )
 
     def _validate(self):
-        object.__setattr__(self, "layers", _checked_layers(self.layers))
         _ = self.indices  # validates every index at this wavelength
 
     @cached_property
@@ -288,11 +346,12 @@ class Films(Declared):
         Vacuum wavelength (nm) at which the indices and phases are evaluated.
     """
 
-    layers: tuple = param((), "films ((index, thickness_nm), ...) from the ambient side down", kind="object")
-    wavelength_nm: float = param(550.0, "vacuum wavelength (nm)", low=0.0, low_open=True)
+    layers: tuple = param((), "films ((index, thickness_nm), ...) from the ambient side down", _LAYERS)
+    wavelength_nm: float = param(
+        550.0, "vacuum wavelength (nm)", ScalarOrArray(Interval(0.0, closed="right"))
+    )
 
     def _validate(self):
-        object.__setattr__(self, "layers", _checked_layers(self.layers))
         _ = self.indices
 
     @cached_property
@@ -314,19 +373,62 @@ class FilmedCoating:
         """``coating_films`` on the coating index (a :class:`FilmStack`), or ``None``."""
         return None if self.coating_films is None else self.coating_films.on(self.coating)
 
+    @classmethod
+    def sweep_extras(cls):
+        """The stability sweep's further instances (those of the model's other bases), then the
+        coating swept to its edges once more under :data:`ABSORBING_FILMS`."""
+        absorbing = cls.sweep_base().replace(coating_films=ABSORBING_FILMS)
+        return (*super().sweep_extras(), (absorbing, ("coating",)))
+
+
+class _FilmsOrNone(Instance):
+    """``None`` (no films: the bare interface) or a :class:`Films`, which validated itself when
+    built; a :class:`FilmStack` is refused with the hint that says why."""
+
+    def __init__(self):
+        super().__init__(Films, none=True, text="None or a models.Films (layers, wavelength_nm)")
+
+    def check(self, name, value):
+        if isinstance(value, FilmStack):
+            self.fail(
+                name,
+                value,
+                "; a FilmStack states its own substrate, and the films sit on the model's coating: pass "
+                "Films(layers=..., wavelength_nm=...)",
+            )
+        return super().check(name, value)
+
+
+_FILMS_OR_NONE = _FilmsOrNone()
+
+#: A film stack whose absorption the stability sweep sweeps the coating under once more
+ABSORBING_FILMS = Films(layers=((1.8 + 0.3j, 120.0), (2.4, 60.0)), wavelength_nm=550.0)
+_AR = math.sqrt(1.5)
+#: The stability sweep's films on a coating: a zero-thickness film, a quarter-wave
+#: anti-reflection film on the default coating 1.5, a thick one and an absorbing pair
+COATING_FILM_EDGES = (
+    Films(layers=((2.0, 0.0),), wavelength_nm=550.0),
+    Films(layers=((_AR, 550.0 / (4 * _AR)),), wavelength_nm=550.0),
+    Films(layers=((2.6, 1e5),), wavelength_nm=550.0),
+    ABSORBING_FILMS,
+)
+
+
+def coating_films_param(doc):
+    """Declare a model's ``coating_films``: ``None`` or :class:`Films` on its coating, swept at
+    :data:`COATING_FILM_EDGES`."""
+    return param(None, doc, _FILMS_OR_NONE, edges=COATING_FILM_EDGES)
+
 
 def check_films(name, value):
-    """The ``check`` of a ``coating_films`` parameter (:func:`scatterbench.models.params.param`): ``None``
-    (no films: the bare interface) or a :class:`Films`, which validated itself when built."""
-    if value is None or isinstance(value, Films):
-        return value
-    hint = (
-        "; a FilmStack states its own substrate, and the films sit on the model's coating: pass "
-        "Films(layers=..., wavelength_nm=...)"
-        if isinstance(value, FilmStack)
-        else ""
-    )
-    raise ValueError(f"{name} must be None or a models.Films (layers, wavelength_nm); got {value!r}{hint}")
+    """``value`` checked as a ``coating_films`` parameter: ``None`` (no films: the bare
+    interface) or a :class:`Films`, which validated itself when built."""
+    return _FILMS_OR_NONE.check(name, value)
+
+
+#: A facet model's ``substrate``: an index (or an array of them, a model set) or a
+#: :class:`FilmStack` (which validated itself when built)
+INDEX_OR_STACK = OneOf(ScalarOrArray(ComplexIndex()), Instance(FilmStack, text="a models.FilmStack"))
 
 
 def _rouard(kz, ns, thickness, wavelength_nm, r, t):

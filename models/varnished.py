@@ -46,8 +46,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .constraints import ComplexIndex, Options, ScalarOrArray
 from .cook_torrance import (
     _INV_4PI,
+    CT_SLOPES,
     SHADOWING_CT,
     _check_m,
     _CookTorranceBase,
@@ -55,8 +57,9 @@ from .cook_torrance import (
     ct_kernel,
     fresnel_average,
 )
+from .facts import Correspondence
 from .fresnel import coating_cos
-from .params import Alias, convention_param, param
+from .params import Alias, coating_param, convention_param, param
 from .slopes import GaussianSlopes
 from .stroke_slopes import StrokeSlopes
 
@@ -140,14 +143,16 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
     """
 
     slopes: StrokeSlopes | GaussianSlopes = param(
-        StrokeSlopes(), "brushed facet slopes of D: StrokeSlopes (Eq. 19) or GaussianSlopes", kind="object"
+        StrokeSlopes(), "brushed facet slopes of D: StrokeSlopes (Eq. 19) or GaussianSlopes", CT_SLOPES
     )
-    coating: float = param(1.5, "varnish index n_v (real)", kind="real_index", low=1.0)
-    substrate: complex = param(2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", kind="index")
+    coating: float = coating_param(1.5, "varnish index n_v (real)")
+    substrate: complex = param(
+        2.29 + 3.37j, "metal index n + ik (inf: perfect conductor)", ScalarOrArray(ComplexIndex())
+    )
     convention: str = convention_param(
         "Eq. 24 as printed (paper) or divided by 4 pi with the refraction Jacobian (corrected)"
     )
-    shadowing: str = param("blinn", "geometric attenuation G", kind="choice", choices=SHADOWING_CT)
+    shadowing: str = param("blinn", "geometric attenuation G", Options(*SHADOWING_CT))
 
     aliases = {
         "varnish": "coating",
@@ -158,6 +163,7 @@ class VarnishedCookTorranceBRDF(_CookTorranceBase):
         "normalization": Alias("convention", _convention_from_old),
         "solid_angle": Alias("convention", _convention_from_old),
     }
+    correspondence = Correspondence("seed 001 Eq. 19-24")
 
     def _kernel_spec(self):
         return self._cook_spec(1, self.coating)

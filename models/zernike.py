@@ -57,6 +57,8 @@ from functools import cached_property
 import numpy as np
 
 from .base import Model
+from .constraints import Constraint, Interval, ParameterError, ScalarOrArray
+from .facts import Correspondence
 from .params import param
 
 __all__ = ["ZernikeExpansionBRDF", "radial_zernike", "check_coefficient_table", "LAMBERTIAN_TABLE"]
@@ -122,18 +124,31 @@ def _row_problem(row):
     return None, (i, j, n, m, k, l, p, a)
 
 
+class CoefficientTable(Constraint):
+    """A non-empty sequence of ``(i, j, n, m, k, l, p, a)`` rows (seven integers and a float,
+    SCATMECH's coefficient-file lines), returned as a tuple of rows."""
+
+    kind = "sequence"
+
+    def describe(self) -> str:
+        return "a non-empty sequence of (i, j, n, m, k, l, p, a) rows"
+
+    def check(self, name, value) -> tuple:
+        if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) == 0:
+            self.fail(name, value)
+        rows = []
+        for index, row in enumerate(value):
+            problem, clean = _row_problem(row)
+            if problem:
+                raise ParameterError(name, self.describe(), f"row {index} ({row!r})", f": {problem}")
+            rows.append(clean)
+        return tuple(rows)
+
+
 def check_coefficient_table(name, value):
-    """``value`` as a coefficient table (a tuple of ``(i, j, n, m, k, l, p, a)`` rows, seven ints
-    and a float), or a ``ValueError`` naming ``name``, the row and the allowed range."""
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) == 0:
-        raise ValueError(f"{name} must be a non-empty sequence of (i, j, n, m, k, l, p, a) rows")
-    rows = []
-    for index, row in enumerate(value):
-        problem, clean = _row_problem(row)
-        if problem:
-            raise ValueError(f"{name}: row {index} ({row!r}) {problem}")
-        rows.append(clean)
-    return tuple(rows)
+    """``value`` as a coefficient table, or the ``ValueError`` naming ``name``, the row and the
+    allowed range (:class:`CoefficientTable`)."""
+    return CoefficientTable().check(name, value)
 
 
 def _k_index(rows):
@@ -259,14 +274,31 @@ class ZernikeExpansionBRDF(Model):
     coefficients: tuple = param(
         LAMBERTIAN_TABLE,
         "coefficient table, rows (i, j, n, m, k, l, p, a) as in SCATMECH's coefficient files",
-        kind="object",
-        check=check_coefficient_table,
+        CoefficientTable(),
     )
     wavelength_um: float = param(
-        0.532, "wavelength (micrometres) for the lambda^p terms", low=0.0, low_open=True
+        0.532,
+        "wavelength (micrometres) for the lambda^p terms",
+        ScalarOrArray(Interval(0.0, None, closed="right")),
     )
-    scale: float = param(1.0, "overall factor r(lambda) (SCATMECH's scale)", low=0.0)
-    rotation: float = param(0.0, "azimuth of the sample's x axis (rad; SCATMECH's rotation)")
+    scale: float = param(
+        1.0, "overall factor r(lambda) (SCATMECH's scale)", ScalarOrArray(Interval(0.0, None))
+    )
+    rotation: float = param(
+        0.0, "azimuth of the sample's x axis (rad; SCATMECH's rotation)", ScalarOrArray(Interval())
+    )
+
+    correspondence = Correspondence(
+        "Koenderink & van Doorn (1998) extended to the Mueller matrix by Germer (2017): NIST's PTFE tables",
+        "``ZernikeExpansion_BRDF_Model`` (``coefficientfile``, ``scale``; xyxy basis)",
+    )
+    @property
+    def scatmech(self):
+        """``None``: SCATMECH's ``ZernikeExpansion_BRDF_Model`` takes its table as a file
+        (``coefficientfile``), not as parameters, so the kit's comparison by parameters has no
+        equivalent to name; tests/test_zernike.py holds this model to SCATMECH's definition
+        term by term instead."""
+        return None
 
     depolarizing = True
     _numpy_sets = True  # the parameters enter as arrays broadcast against the angles

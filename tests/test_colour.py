@@ -70,5 +70,8 @@ def test_pearlescent_scene_colour_travel():
 
 
 def test_import_models_does_not_load_colour_science():
-    code = "import sys, scatterbench.models, scatterbench.validation.studies.colour; assert 'colour' not in sys.modules"
+    code = (
+        "import sys, scatterbench.models, scatterbench.validation.studies.colour; "
+        "assert 'colour' not in sys.modules"
+    )
     subprocess.run([sys.executable, "-c", code], check=True, env=dict(os.environ))

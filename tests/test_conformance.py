@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from scatterbench import models, references
+from scatterbench.models.constraints import Interval
 from scatterbench.models.params import param
 from scatterbench.validation.checks.conformance import Conformant, as_model, conformance_checks
 from scatterbench.validation.checks.conformance_scatmech import (
@@ -185,7 +186,7 @@ class DeclaredLambertian(models.Model):
     """A models.Model subclass written outside scatterbench: declared parameters, out=."""
 
     depolarizing = True
-    rho: float = param(0.5, "albedo", low=0.0, high=1.0)
+    rho: float = param(0.5, "albedo", Interval(0.0, 1.0))
 
     def _mueller16(self, ti, tr, pr):
         out = np.zeros((16, ti.size))

@@ -13,6 +13,7 @@ import pytest
 from scatterbench import models, references
 from scatterbench.models import scene
 from scatterbench.models.base import Model
+from scatterbench.models.constraints import Interval
 from scatterbench.models.params import param
 from scatterbench.validation.cli import main
 from scatterbench.validation.fitting.compare import compare_fits
@@ -144,7 +145,7 @@ class Brittle(Model):
     and an inf), negative below it; a finding of each kind."""
 
     depolarizing = True
-    k: float = param(1.0, "breakage", low=0.0, high=2.0)
+    k: float = param(1.0, "breakage", Interval(0.0, 2.0))
 
     def _mueller16(self, ti, tr, pr):
         out = np.zeros((16, ti.size))

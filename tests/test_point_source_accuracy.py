@@ -206,7 +206,7 @@ def test_resolution_refusals(bad):
 
 @pytest.mark.parametrize("bad", [0.0, -1e-4, 1e-14, 0.2, float("nan"), float("inf"), True, "1e-4", None])
 def test_tol_refusals(bad):
-    with pytest.raises(ValueError, match=r"^tol must be a real number in \[1e-13, 0\.1\]"):
+    with pytest.raises(ValueError, match=r"^tol must be a finite real number in \[1e-13, 0\.1\]"):
         S.PointSourceBRDF(model=S.CookTorranceBRDF(), tol=bad)
 
 

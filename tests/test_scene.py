@@ -303,7 +303,10 @@ def test_values_are_validated_by_the_models_declared_parameters():
     assert sc.volume["g"] == 0.9999995 and sc.build().terms[0][1].phase.g == 0.9999995
     for text, message in (
         (vol + "g = 1.0\n", "v.toml: [volume] g: g must be a finite real number in (-1, 1); got 1.0"),
-        (vol + "seed = -2\n", "v.toml: [volume] seed: seed must be an integer >= 0"),
+        (
+            vol + "seed = -2\n",
+            "v.toml: [volume] seed: seed must be an integer in [0, inf) or a numpy.random.Generator; got -2",
+        ),
         (vol + "polarized = 1\n", "v.toml: [volume] polarized: polarized must be one of True, False; got 1"),
         (_MB + "tau_deg = -3\n", "v.toml: [substrate] tau_deg: tau must be a finite real number in (0, inf)"),
     ):

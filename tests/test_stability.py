@@ -8,6 +8,7 @@ import pytest
 
 from scatterbench import models
 from scatterbench.models.base import Model
+from scatterbench.models.constraints import Interval
 from scatterbench.models.params import param
 from scatterbench.validation.studies.stability import (
     classify,
@@ -51,7 +52,7 @@ class Fragile(Model):
     """Deliberately broken: NaN at retroreflection, negative at grazing, warns on division."""
 
     depolarizing = True
-    k: float = param(1.0, "a knob", low=0.0, high=2.0)
+    k: float = param(1.0, "a knob", Interval(0.0, 2.0))
 
     def _mueller16(self, ti, tr, pr):
         out = np.zeros((16, ti.size))

@@ -41,6 +41,7 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 
+from scatterbench import models
 from scatterbench.validation.checks.conformance import (
     ATTRIBUTES,
     ModelCheck,
@@ -306,8 +307,6 @@ def contributed_models() -> list[Contributed]:
 def format_contributed(contributed=None) -> str:
     """The contributed models as ``scatterbench models`` lists them: entry name, ``module:attr``,
     distribution, and the model's parameters (a :class:`scatterbench.models.Model`) or docstring summary."""
-    from scatterbench import models
-
     entries = contributed_models() if contributed is None else contributed
     lines = [f"\nContributed models (entry-point group {ENTRY_POINT_GROUP}): {len(entries) or 'none'}"]
     for c in entries:
@@ -326,32 +325,23 @@ def shipped_models() -> list[tuple[str, object]]:
     """``(label, model)``: one instance of every model class scatterbench ships, as its own
     test suite checks them.
 
-    The stability sweep's representative instance of each class (its defaults, or for a
-    wrapper a representative inner model), except where a cheaper one tests the same code:
-
-    * ``RoughDiffuseBRDF`` with 20 facet pairs per geometry (Monte Carlo; the kit checks
-      shapes, finiteness, realizability and the seed, not its precision);
-    * ``PointSourceBRDF`` with 4 radial nodes over the disc (the default, ``"auto"``, refines
-      each geometry to ``tol``, hundreds to thousands of evaluations; the kit checks the
-      wrapper's shapes and physics, not its quadrature).
+    Each class's stability-sweep representative (``Cls.sweep_base()``: its defaults, or for
+    a wrapper a representative inner model) with the changes the class names in its
+    ``kit_variant``: a cheaper instance that tests the same code (``RoughDiffuseBRDF`` with
+    20 Monte Carlo pairs, ``PointSourceBRDF`` with 4 radial nodes), or the parameters of
+    committed SCATMECH reference values, so that the ``scatmech`` check compares with them
+    where pySCATMECH is not installed (``FacetBRDF``, ``SubsurfaceFacetBRDF``, ``FacetBTDF``).
 
     Where a default is a paper's known slip (``CookTorranceBRDF``'s published
     normalization, ``FacetBTDF``'s Eq. 37), the kit reports a finding with the reason
     ``accepted_findings.toml`` gives.
     """
-    from scatterbench import models
-    from scatterbench.validation.studies.stability import edge_instances
-
-    cheaper = {
-        "RoughDiffuseBRDF": {"pairs": 20},
-        "PointSourceBRDF": {"resolution": 4},
-    }
     out = []
     for cls in models.Model.registry:
-        instances = edge_instances(cls)
-        if not instances:
+        base = cls.sweep_base()
+        if base is None:
             continue  # compositions (Sum): their terms are the other models
-        out.append((cls.__name__, instances[0].replace(**cheaper.get(cls.__name__, {}))))
+        out.append((cls.__name__, base.replace(**cls.kit_variant)))
     return out
 
 

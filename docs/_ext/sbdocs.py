@@ -2,11 +2,12 @@
 
 * Every model class page (``models.Model`` subclasses) gets its declared-parameter table,
   generated from :meth:`scatterbench.models.params.Declared.parameters` (so it follows the code), and the
-  paper equations and SCATMECH / Mitsuba 3 models it corresponds to (:data:`CORRESPONDENCE`).
+  paper equations and SCATMECH / Mitsuba 3 models it corresponds to: the class's own
+  ``correspondence`` (:class:`scatterbench.models.facts.Correspondence`).
 * ``.. sb-model-table::`` renders that correspondence for every model as one table.
 
-A model class without an entry in :data:`CORRESPONDENCE` is a build warning, so with ``-W``
-a new model cannot reach the site undocumented.
+A model class without a ``correspondence`` is a build warning, so with ``-W`` a new model
+cannot reach the site undocumented.
 """
 
 from __future__ import annotations
@@ -20,48 +21,6 @@ from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
 LOG = logging.getLogger(__name__)
-
-#: class name -> (paper equations, SCATMECH model, Mitsuba 3 plugin); from each class's
-#: docstring and DESIGN.md ("Reference implementation: SCATMECH", "A second peer: Mitsuba 3").
-CORRESPONDENCE = {
-    "Sum": ("incoherent sum ``m1 + m2``, ``w * m`` (seed 003 Sec. 2.6 combination)", "—", "—"),
-    "FacetBRDF": (
-        "seed 000 Eq. 48-49 with coating n = 1",
-        "``Facet_BRDF_Model`` (type 0)",
-        "``roughconductor`` (``beckmann``/``ggx``) with ``shadowing='smith'``, divided by cos(theta_i)",
-    ),
-    "SubsurfaceFacetBRDF": (
-        "seed 000 Eq. 2-18, 49 (Table I)",
-        "``Subsurface_Facet_BRDF_Model`` (``overcoat``)",
-        "—",
-    ),
-    "CookTorranceBRDF": ("seed 001 Eq. 7-18", "—", "—"),
-    "PointSourceBRDF": ("seed 001 Eq. 25-30", "—", "—"),
-    "VarnishedCookTorranceBRDF": ("seed 001 Eq. 19-24", "—", "—"),
-    "DiffuseSubsurfaceBRDF": (
-        "seed 003 Eq. 21-28",
-        "``Diffuse_Subsurface_BRDF_Model`` (``reflectance.table`` = rho)",
-        "—",
-    ),
-    "FacetBTDF": ("seed 003 Eq. 29-43 (Fig. 1)", "``Facet_BRDF_Model`` (type 1)", "—"),
-    "SingleScatterBRDF": (
-        "seed 003 Eq. 2-20",
-        "``First_Diffuse_BRDF_Model`` (``Unpolarized_Phase_Function``; depolarizing phase only)",
-        "—",
-    ),
-    "RoughDiffuseBRDF": ("seed 003 Sec. 2.5 (Monte Carlo), Eq. 7, 21", "—", "—"),
-    "MaxwellBeardBRDF": (
-        "Maxwell-Beard, compared with the combination in seed 003 Sec. 3",
-        "``Shadowed_Facet_BRDF_Model`` for its specular term",
-        "—",
-    ),
-    "DetectorAperture": ("detector aperture around any model (no seed equation)", "—", "—"),
-    "ZernikeExpansionBRDF": (
-        "Koenderink & van Doorn (1998) extended to the Mueller matrix by Germer (2017): NIST's PTFE tables",
-        "``ZernikeExpansion_BRDF_Model`` (``coefficientfile``, ``scale``; xyxy basis)",
-        "—",
-    ),
-}
 
 
 def _model_classes():
@@ -90,13 +49,12 @@ def _append_model_info(app, what, name, obj, options, lines):
 
     if what != "class" or obj not in models.Model.registry:
         return  # scatterbench's own model classes only (contributed ones document themselves)
-    entry = CORRESPONDENCE.get(obj.__name__)
-    if entry is None:
-        LOG.warning("%s: no entry in docs/_ext/sbdocs.py CORRESPONDENCE", name)
+    c = obj.correspondence
+    if c is None:
+        LOG.warning("%s: the class declares no correspondence (models.facts.Correspondence)", name)
         return
-    paper, scatmech, mitsuba = entry
     lines += ["", ".. rubric:: Corresponds to", ""]
-    lines += [f"* Paper: {paper}", f"* SCATMECH: {scatmech}", f"* Mitsuba 3: {mitsuba}"]
+    lines += [f"* Paper: {c.paper}", f"* SCATMECH: {c.scatmech}", f"* Mitsuba 3: {c.mitsuba}"]
     lines += _param_table(obj)
 
 
@@ -104,16 +62,16 @@ class ModelTable(SphinxDirective):
     """All model classes with their paper equations and peer models."""
 
     def run(self):
-        missing = [c.__name__ for c in _model_classes() if c.__name__ not in CORRESPONDENCE]
-        for name in missing:
-            LOG.warning("model %s has no entry in CORRESPONDENCE", name, location=self.get_location())
+        for cls in _model_classes():
+            if cls.correspondence is None:
+                LOG.warning("model %s declares no correspondence", cls.__name__, location=self.get_location())
         rows = [".. list-table::", "   :header-rows: 1", ""]
         rows += ["   * - model", "     - paper", "     - SCATMECH", "     - Mitsuba 3"]
-        for c in _model_classes():
-            if c.__name__ in CORRESPONDENCE:
-                paper, scatmech, mitsuba = CORRESPONDENCE[c.__name__]
-                rows += [f"   * - :class:`scatterbench.models.{c.__name__}`", f"     - {paper}"]
-                rows += [f"     - {scatmech}", f"     - {mitsuba}"]
+        for cls in _model_classes():
+            c = cls.correspondence
+            if c is not None:
+                rows += [f"   * - :class:`scatterbench.models.{cls.__name__}`", f"     - {c.paper}"]
+                rows += [f"     - {c.scatmech}", f"     - {c.mitsuba}"]
         node = nodes.container()
         self.state.nested_parse(StringList(rows), self.content_offset, node)
         return node.children

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench import models
+from scatterbench.models.constraints import HasMethods
 from scatterbench.models.params import param
 
 from .common import fp_warnings
@@ -220,12 +221,17 @@ def _run_one(spec, model, ctx):
 
 
 # --------------------------------------------------------------------------- the model view
-def _check_conformant(name, value):
-    if isinstance(value, models.Model) or not callable(getattr(value, "mueller", None)):
-        raise ValueError(
-            f"{name} must be an object with a mueller(theta_i, theta_r, phi_r) method; got {value!r}"
-        )
-    return value
+class _NotYetAModel(HasMethods):
+    """An object with a ``mueller`` method that is not a :class:`scatterbench.models.Model`
+    (:func:`as_model` takes those as they are)."""
+
+    def __init__(self):
+        super().__init__("mueller", text="an object with a mueller(theta_i, theta_r, phi_r) method")
+
+    def check(self, name, value):
+        if isinstance(value, models.Model):
+            self.fail(name, value)
+        return super().check(name, value)
 
 
 @dataclass(frozen=True)
@@ -234,7 +240,7 @@ class Conformant(models.Model):
     validated, broadcast and chunked angles, ``brdf``, and the optional attributes
     (:data:`ATTRIBUTES`) with the defaults the kit documents."""
 
-    model: object = param(dataclasses.MISSING, "the wrapped model", kind="object", check=_check_conformant)
+    model: object = param(dataclasses.MISSING, "the wrapped model", _NotYetAModel())
 
     @property
     def depolarizing(self):  # type: ignore[override]

@@ -60,6 +60,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from scatterbench.models.constraints import interval_notation
 from scatterbench.models.polarization import ellipsometric, stokes
 from scatterbench.models.text import is_number, long_digits, read_utf8, shown, where
 
@@ -261,10 +262,6 @@ def _sidecar_problem(key, value):
     return None
 
 
-def _range_text(lo, hi, lo_open, hi_open):
-    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
-
-
 def _read_lines(path):
     return _text_of(path, "data file").splitlines()
 
@@ -364,7 +361,10 @@ def _number(path, lineno, j, name, cell):
         raise DataFileError(path, lineno, j, f"column {name!r}: {cell!r} is not a finite number")
     if x < lo or x > hi or (lo_open and x == lo) or (hi_open and x == hi):
         raise DataFileError(
-            path, lineno, j, f"column {name!r}: {x:g} is outside {_range_text(lo, hi, lo_open, hi_open)}"
+            path,
+            lineno,
+            j,
+            f"column {name!r}: {x:g} is outside {interval_notation(lo, hi, lo_open, hi_open)}",
         )
     return x
 

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from scatterbench.models.polarization import psps_to_xyxy, xyxy_to_psps
-from scatterbench.models.scene.schema import read_utf8
+from scatterbench.models.text import read_utf8
 
 from .datafile import DataFileError
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import itertools
 import math
 import os
 import threading
@@ -59,100 +60,9 @@ __all__ = [
 
 ACCEPTED_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accepted_findings.toml")
 
-# Films on the coating's top surface (coating_films): a zero-thickness film, a quarter-wave
-# anti-reflection film on the default coating 1.5, a thick one and an absorbing pair.
-_AR = math.sqrt(1.5)
-_ABSORBING_FILMS = models.Films(layers=((1.8 + 0.3j, 120.0), (2.4, 60.0)), wavelength_nm=550.0)
-
-# Edge values by parameter name, for the names the models use; other parameters
-# fall back to their declared bounds.
-_NAMED_EDGES = {
-    "sigma": (1e-4, 1e-2, 1.0, 10.0),
-    "sigma_x": (1e-4, 10.0),
-    "sigma_y": (1e-4, 10.0),
-    # GGX widths (no rms slope: alpha is the median slope magnitude)
-    "alpha": (1e-4, 1e-2, 1.0, 10.0),
-    # anisotropic GGX to 200:1 (from the 0.05 x 0.2 base).  At 2e3:1 (1e-4 x 0.2) the
-    # unshadowed albedo at 89.99 deg is ~148 and the integrator does not reach the sweep's
-    # absolute 1e-3 within its 2e6-evaluation budget (148.39 +- 0.02; at 1e-3 x 0.2 it
-    # converges to 148.396): a limit of the energy check at large albedos, not of the model
-    "alpha_x": (1e-3, 10.0),
-    "alpha_y": (1e-3, 10.0),
-    "coverage": (1e-3, 1.0),
-    "rotation": (0.0, 1.0, -math.pi),
-    "coating": (1.0, 1.0 + 1e-9, 1.5, 3.0),
-    "n": (1.0, 1.0 + 1e-9, 1.5, 3.0),
-    "g": (-0.99, 0.0, 0.99),
-    "rho": (0.0, 1.0),
-    # Cook-Torrance rms slopes (seed 001): m -> 0 and m = 2, and a 100:1 (and 2e4:1) anisotropy
-    "m": (1e-4, 0.5, 2.0),
-    "m_parallel": (1e-4, 0.3, 2.0),
-    "m_perpendicular": (1e-4, 0.3, 2.0),
-    "varnish": (1.0, 1.0 + 1e-9, 1.5, 3.0),
-    "stroke_angle": (0.0, 1.0, -math.pi),
-    # point source: at the sample's edge, near, far and at infinity (seed 001 Eq. 25-30)
-    "distance": (1.0, 10.0, 1e4, math.inf),
-    "resolution": (1, 64),
-    # detector aperture: a point, a hair, seed 000's 0.7 deg and the widest cone allowed
-    "aperture": (0.0, 1e-6, math.radians(0.7), 0.5 * math.pi),
-    # Monte Carlo: the fewest pairs the model allows and a moderate count
-    "pairs": (2, 200),
-    "single": (0.0, 1.0),
-    # Maxwell-Beard amplitudes are BRDFs (1/sr): 1/pi is a white Lambertian
-    "rho_d": (0.0, 1.0 / math.pi),
-    "rho_v": (0.0, 1.0 / math.pi),
-    "tau": (1e-4, 2.0),
-    "omega": (1e-4, 2.0),
-    "coating_films": (
-        models.Films(layers=((2.0, 0.0),), wavelength_nm=550.0),
-        models.Films(layers=((_AR, 550.0 / (4 * _AR)),), wavelength_nm=550.0),
-        models.Films(layers=((2.6, 1e5),), wavelength_nm=550.0),
-        _ABSORBING_FILMS,
-    ),
-}
-
-# (parameter, edge value) -> parameters swept to their edges once more with that edge set:
-# the coating's edges (1, 1 + 1e-9, 3) under the absorbing films.
-_SWEPT_AT = {("coating_films", _ABSORBING_FILMS): ("coating",)}
-
-# Classes whose defaults cannot be built alone (wrappers): a representative instance.
-_BASES = {
-    # Monte Carlo at a moderate pair count: the sweep looks for non-finite values,
-    # negative or unphysical matrices, not for Monte Carlo precision
-    "RoughDiffuseBRDF": lambda: models.RoughDiffuseBRDF(pairs=200),
-    "PointSourceBRDF": lambda: models.PointSourceBRDF(
-        model=models.CookTorranceBRDF(convention="corrected"), distance=100.0, sample_radius=1.0
-    ),
-    # a narrow lobe (rms slope 0.02) under seed 000's 0.7 deg aperture: the aperture matters
-    "DetectorAperture": lambda: models.DetectorAperture(
-        model=models.SubsurfaceFacetBRDF(slopes=models.ExponentialSlopes(0.02)), aperture=math.radians(0.7)
-    ),
-}
-
-
-def _issue15_bases(name):
-    """Instances the defaults' edges do not reach (issue 15), as ``(instance, swept parameters)``:
-    GGX and anisotropic GGX slopes under each facet model with shadowing none and smith (their
-    slopes swept to the edges), and film-stack substrates (zero thickness, thick, an absorbing
-    film) as they are."""
-    cls = getattr(models, name, None)
-    if name not in ("FacetBRDF", "SubsurfaceFacetBRDF", "FacetBTDF"):
-        return []
-    ggx = (models.GGXSlopes(0.1), models.AnisotropicGGXSlopes(alpha_x=0.05, alpha_y=0.2, rotation=0.3))
-    out = [(cls(slopes=g, shadowing=sh), ("slopes",)) for g in ggx for sh in ("none", "smith")]
-    if name == "FacetBTDF":
-        return out  # its substrate is a real index: no films
-    films = (
-        models.FilmStack(layers=((2.6, 0.0),), substrate=1.58, wavelength_nm=550.0),
-        models.FilmStack(layers=((2.6, 1e5),), substrate=1.58, wavelength_nm=550.0),
-        models.FilmStack(
-            layers=((3.1 + 3.3j, 10.0), (1.46, 200.0)), substrate=1.37 + 7.62j, wavelength_nm=550.0
-        ),
-    )
-    return out + [(cls(substrate=f, shadowing=sh), ()) for f in films for sh in ("none", "smith")]
-
-
-_INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
+# What is swept is each class's own: the edge values of its declared parameters
+# (models.params.param's ``edges``, else the constraint's), its representative instance
+# (``Cls.sweep_base()``) and the instances its edges do not reach (``Cls.sweep_extras()``).
 
 
 @dataclass(frozen=True)
@@ -165,33 +75,13 @@ class Finding:
     fields: dict = field(default_factory=dict)
 
 
-def _edges_for(info, default):
-    if info.kind == "object" and info.name in _NAMED_EDGES:
-        return [v for v in _NAMED_EDGES[info.name] if v != default]
-    if info.kind == "object":
-        if isinstance(default, Declared):
-            return [inst for inst in _one_at_a_time(default) if inst != default]
-        return []
-    if info.kind == "index":
-        return [v for v in _INDEX_EDGES if v != default]
-    if info.kind == "choice":
-        return [c for c in info.low if c != default]
-    if info.name in _NAMED_EDGES:
-        vals = _NAMED_EDGES[info.name]
-    else:
-        lo, hi = info.low, info.high
-        vals = []
-        if lo is not None:
-            vals.append(lo * (1 + 1e-9) + (1e-12 if lo == 0 else 0) if info.low_open else lo)
-        if hi is not None:
-            vals.append(hi * (1 - 1e-9) if info.high_open else hi)
-        if hi is None and isinstance(default, (int, float)) and default:
-            vals.append(default * 100)
-    if info.kind == "real_index":
-        vals = [v for v in vals if v >= info.low]
-    if info.kind == "int":
-        vals = [int(v) for v in vals]
-    return [v for v in vals if v != default]
+def _edges_for(info, current):
+    """The values ``info``'s parameter is swept at from ``current``: its declared edges, or
+    for a declared object without them (a slope distribution, a phase function, an inner
+    model) that object's own variants, one parameter at a time."""
+    if info.declared_edges is None and info.kind == "object" and isinstance(current, Declared):
+        return [inst for inst in _one_at_a_time(current) if inst != current]
+    return info.edges(current)
 
 
 def _one_at_a_time(base, names=None):
@@ -211,11 +101,9 @@ def _one_at_a_time(base, names=None):
 
 def _choice_combinations(base):
     """Every combination of the ``choice`` parameters (few: normalizations, methods)."""
-    import itertools
-
-    infos = [i for i in type(base).parameters() if i.kind == "choice"]
+    infos = [i for i in type(base).parameters() if i.choices is not None]
     out = []
-    for combo in itertools.product(*(i.low for i in infos)):
+    for combo in itertools.product(*(i.choices for i in infos)):
         try:
             out.append(dataclasses.replace(base, **{i.name: v for i, v in zip(infos, combo, strict=True)}))
         except ValueError:
@@ -225,33 +113,20 @@ def _choice_combinations(base):
 
 def edge_instances(cls):
     """Model instances at the edges of each declared parameter (one at a time from the
-    defaults, or from ``cls`` when it is a model instance), plus every combination of the
-    choice parameters at the defaults."""
-    if isinstance(cls, models.Model):
-        base = cls
-    else:
-        try:
-            base = _BASES[cls.__name__]() if cls.__name__ in _BASES else cls()
-        except ValueError:
-            return []  # compositions without a default (Sum): their terms are swept
+    class's representative instance, ``cls.sweep_base()``, or from ``cls`` when it is a model
+    instance), plus every combination of the choice parameters there, plus for a class the
+    instances of ``cls.sweep_extras()`` swept at the edges of the parameters each names."""
+    base = cls if isinstance(cls, models.Model) else cls.sweep_base()
+    if base is None:
+        return []  # compositions without a default (Sum): their terms are swept
     out = _one_at_a_time(base)
     for inst in _choice_combinations(base):
         if inst not in out:
             out.append(inst)
     if not isinstance(cls, models.Model):
-        for extra, names in _issue15_bases(cls.__name__) + _swept_at(base):
+        for extra, names in cls.sweep_extras():
             out += [inst for inst in _one_at_a_time(extra, names) if inst not in out]
     return out
-
-
-def _swept_at(base):
-    """``(instance, swept parameters)`` of :data:`_SWEPT_AT` for the parameters ``base`` has."""
-    have = {info.name for info in type(base).parameters()}
-    return [
-        (dataclasses.replace(base, **{name: value}), names)
-        for (name, value), names in _SWEPT_AT.items()
-        if name in have
-    ]
 
 
 def _real_indices(obj, out=None):

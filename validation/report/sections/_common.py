@@ -28,19 +28,14 @@ def inplane(model, theta_i, x_deg, incident="unpolarized"):
 
 
 def default_models():
-    """One instance per model class: its defaults, or the stability sweep's
-    representative base (the point-source wrapper around Cook-Torrance, the Monte
-    Carlo model at 200 pairs)."""
-    from scatterbench.validation.studies.stability import _BASES
-
+    """One instance per model class: the stability sweep's representative (``Cls.sweep_base()``:
+    its defaults, or the point-source wrapper around Cook-Torrance, the Monte Carlo model at
+    200 pairs)."""
     out = []
     for cls in models.Model.registry:
-        if cls is models.Sum:
-            continue
-        try:
-            out.append(_BASES[cls.__name__]() if cls.__name__ in _BASES else cls())
-        except ValueError:
-            continue
+        base = None if cls is models.Sum else cls.sweep_base()
+        if base is not None:
+            out.append(base)
     return out
 
 
