@@ -11,7 +11,7 @@ import pytest
 
 import scatterbench.models.point_source as point_source
 from scatterbench import models
-from scatterbench.models import cubature
+from scatterbench.models import cubature, disc_cubature
 from scatterbench.models.point_source import AUTO_FACTOR, AccuracyWarning
 
 S = models
@@ -430,7 +430,7 @@ def test_evaluations_count_every_inner_evaluation():
     [(3.0, 1.0), (0.5, 1.0), (100.0, 1.0), (1e-6, 1.0), (1.0, 1e6), (1.0, 1e-300), (1e-300, 1.0)],
 )
 def test_compiled_disc_algebra_equals_the_numpy_reference(distance, radius, rng):
-    """models.kernels.disc (the numba backend's node algebra) against _Disc.angles, its numpy
+    """models.kernels.disc (the numba backend's node algebra) against Disc.angles, its numpy
     reference, on the product rule's nodes and on random points of the cubature's cells, for
     geometries in all three coordinate systems (about the source's foot, about the centre, the
     wedge) and discs from 1e-300 to 1e300 source heights wide: the local polar angle within
@@ -444,13 +444,13 @@ def test_compiled_disc_algebra_equals_the_numpy_reference(distance, radius, rng)
     n = 300
     ti = np.r_[0.0, rng.uniform(0.0, 1.5, n - 2), 0.5 * math.pi - 1e-9]
     tr, pr = rng.uniform(0.0, 1.5, n), rng.uniform(-math.pi, math.pi, n)
-    disc = point_source._Disc(ps, ti, tr, pr)
+    disc = ps._disc(ti, tr, pr)
     if (distance, radius) == (0.5, 1.0):
         assert disc.wedge.any() and disc.on_h.any() and (~disc.on_h & ~disc.wedge).any()
     rows = np.arange(n)
     cells = disc.cells(rows)
     m = cells.row.size
-    sets = [(rows, *point_source._product_nodes(8))]
+    sets = [(rows, *disc_cubature._product_nodes(8))]
     sets.append(
         (rows[cells.row], *cells.point(np.arange(m), rng.uniform(0, 1, (m, 17)), rng.uniform(0, 1, (m, 17))))
     )
