@@ -43,7 +43,7 @@ import json, math, os, resource, sys, time
 import numpy as np
 from scatterbench import models
 name, n, what = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-from scatterbench.validation.studies.stability import _BASES
+from scatterbench.validation.studies.edge_sweep import _BASES
 cls = next(c for c in models.Model.registry if c.__name__ == name)
 m = _BASES[name]() if name in _BASES else cls()
 k = int(round(math.sqrt(n / 4)))

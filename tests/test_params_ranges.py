@@ -24,7 +24,7 @@ from scatterbench.models.params import (
     check_real,
 )
 from scatterbench.models.stroke_slopes import StrokeSlopes
-from scatterbench.validation.studies import stability
+from scatterbench.validation.studies import edge_sweep
 
 _TI = np.array([0.0, 0.3, 0.3, 1.2, math.pi / 2 - 1e-9])
 _TR = np.array([0.0, 0.3, 0.5, 1.2, 0.3])
@@ -113,8 +113,8 @@ _REFUSED_IN_RANGE = {
 
 
 def _base(cls):
-    if cls.__name__ in stability._BASES:
-        return stability._BASES[cls.__name__]()
+    if cls.__name__ in edge_sweep._BASES:
+        return edge_sweep._BASES[cls.__name__]()
     return cls()
 
 
@@ -235,9 +235,9 @@ def test_a_bool_is_not_a_number(build, name, flag):
 def test_stability_edges_lie_inside_the_declared_ranges():
     widths = ("sigma", "sigma_x", "sigma_y", "alpha", "alpha_x", "alpha_y", "m_parallel", "m_perpendicular")
     for name in widths:
-        for v in stability._NAMED_EDGES[name]:
+        for v in edge_sweep._NAMED_EDGES[name]:
             assert SLOPE_WIDTH_MIN <= v <= SLOPE_WIDTH_MAX
-    for z in stability._INDEX_EDGES:
+    for z in edge_sweep._INDEX_EDGES:
         assert z == math.inf or INDEX_MIN <= abs(z) <= INDEX_MAX
 
 

@@ -340,7 +340,7 @@ def shipped_models() -> list[tuple[str, object]]:
     ``accepted_findings.toml`` gives.
     """
     from scatterbench import models
-    from scatterbench.validation.studies.stability import edge_instances
+    from scatterbench.validation.studies.edge_sweep import edge_instances
 
     cheaper = {
         "RoughDiffuseBRDF": {"pairs": 20},

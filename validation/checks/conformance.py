@@ -303,14 +303,14 @@ def accepted_reason(model, kind, fields, accepted=None):
     entries ``accepted``) that explains a ``kind`` of finding with these numeric ``fields``
     on one of scatterbench's own models, else ``None``: only scatterbench's models carry
     accepted findings."""
-    from scatterbench.validation.studies import stability
+    from scatterbench.validation.studies import edge_sweep
 
     if not type(model).__module__.startswith("scatterbench.models."):
         return None
-    f = stability.Finding(
+    f = edge_sweep.Finding(
         type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields
     )
-    entry = stability.accepted_entry(f, accepted)
+    entry = edge_sweep.accepted_entry(f, accepted)
     return None if entry is None else (entry["reason"], entry.get("condition") or "always")
 
 

@@ -31,7 +31,7 @@ def default_models():
     """One instance per model class: its defaults, or the stability sweep's
     representative base (the point-source wrapper around Cook-Torrance, the Monte
     Carlo model at 200 pairs)."""
-    from scatterbench.validation.studies.stability import _BASES
+    from scatterbench.validation.studies.edge_sweep import _BASES
 
     out = []
     for cls in models.Model.registry:
