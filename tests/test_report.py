@@ -180,7 +180,7 @@ def test_stability_findings_grouped_by_model_kind_and_verdict():
     group, not once per finding, and every finding stays in results.json."""
     from scatterbench.validation.report.core import Section, render_html
     from scatterbench.validation.report.sections import edge_findings
-    from scatterbench.validation.studies.edge_sweep import Finding
+    from scatterbench.validation.studies.findings import Finding
 
     def finding(model, kind, value, k):
         return Finding(model, f"{model}(sigma={k})", kind, value, f"theta_i = {k} deg", {"value": value})

@@ -35,9 +35,10 @@ import numpy as np
 
 from scatterbench import models
 from scatterbench.models.params import param
+from scatterbench.validation.studies.findings import Finding
 
 from .common import fp_warnings
-from .registry import Check, CheckContext, Finding, judge
+from .registry import Check, CheckContext, judge
 
 __all__ = [
     "ATTRIBUTES",
@@ -307,15 +308,13 @@ def accepted_reason(model, kind, fields, accepted=None):
 
     if not type(model).__module__.startswith("scatterbench.models."):
         return None
-    f = edge_sweep.Finding(
-        type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields
-    )
+    f = Finding(type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields)
     entry = edge_sweep.accepted_entry(f, accepted)
     return None if entry is None else (entry["reason"], entry.get("condition") or "always")
 
 
 def finding_of(reason, condition) -> Finding:
-    """The :class:`~.registry.Finding` of a result an accepted finding explains: it holds
-    (``fails=False``) and would fail if its accepted condition did not."""
+    """The :class:`~scatterbench.validation.studies.findings.Finding` of a result an accepted
+    finding explains: it holds (``fails=False``) and would fail if its accepted condition did not."""
     head = " ".join(reason.split())
     return Finding(fails=False, fails_if=f"the accepted condition `{condition}` does not hold ({head})")

@@ -20,6 +20,7 @@ import numpy as np
 from scatterbench import models
 from scatterbench.models.params import Declared
 from scatterbench.models.polarization import coherency_eigenvalues
+from scatterbench.validation.studies.findings import Finding
 
 from .common import extreme_geometries, random_geometries
 from .conformance import (
@@ -33,7 +34,6 @@ from .conformance import (
     verdict,
     where,
 )
-from .registry import Finding
 
 __all__ = [
     "kit_geometries",

@@ -33,7 +33,7 @@ import math
 import os
 import threading
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,8 +44,9 @@ from scatterbench.validation.numerics.energy import hit_fraction
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
+from .findings import Finding
+
 __all__ = [
-    "Finding",
     "edge_instances",
     "edge_geometries",
     "sweep",
@@ -153,16 +154,6 @@ def _issue15_bases(name):
 
 
 _INDEX_EDGES = (1.0 + 0j, 1.0 + 1e-9 + 0j, 1.5 + 0j, 3.88 + 0.02j, 1.37 + 7.62j, 1e6 + 1e6j, math.inf)
-
-
-@dataclass(frozen=True)
-class Finding:
-    model: str
-    params: str
-    kind: str
-    value: float
-    where: str
-    fields: dict = field(default_factory=dict)
 
 
 def _edges_for(info, default):
