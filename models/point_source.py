@@ -344,22 +344,22 @@ class PointSourceBRDF(_Wrapper):
         return Disc(self.sample_radius / self.distance, ti, tr, pr, width, spread, self._local)
 
     @cached_property
-    def _isotropic(self):
-        return is_isotropic(self.model)
-
-    @cached_property
-    def _rotates(self):
-        """True when the local models can be evaluated in one call: an isotropic inner model, or
-        one whose ``rotated`` takes an array of angles (a model set)."""
-        return self._isotropic or rotated_set(self.model, np.array([0.0, 1.0])) is not None
+    def _rotation(self):
+        """How :meth:`_local` turns the sample by the nodes' azimuths: ``"none"`` for an isotropic
+        inner model (:func:`~scatterbench.models.base.is_isotropic`), ``"set"`` where its
+        ``rotated`` takes an array of angles (a model set: one call), ``"each"`` where it takes
+        one angle (one call per distinct azimuth)."""
+        if is_isotropic(self.model):
+            return "none"
+        return "set" if rotated_set(self.model, np.array([0.0, 1.0])) is not None else "each"
 
     def _local(self, psi, Phi, tr, pr):
         """The inner model's Mueller elements ``(16, m, P)`` at local incidences ``(psi, Phi)``
         ``(m, P)`` for the observations ``(tr, pr)`` ``(m,)``: the sample rotated by ``-Phi``."""
         m, P = psi.shape
         psi, Phi, tr, pr = psi.ravel(), Phi.ravel(), np.repeat(tr, P), (pr[:, None] - Phi).ravel()
-        if self._rotates:
-            model = self.model if self._isotropic else self.model.rotated(-Phi)
+        if self._rotation != "each":
+            model = self.model if self._rotation == "none" else self.model.rotated(-Phi)
             return model._m16(psi, tr, pr).reshape(16, m, P)
         # a sample that cannot rotate by an array: one call per distinct azimuth (the product
         # rule's nodes share theirs across the geometries of an incidence; the cubature's do not)

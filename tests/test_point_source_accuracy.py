@@ -125,7 +125,9 @@ def test_anisotropic_models_are_rotated_per_node_as_a_model_set():
     tr, pr = _scan()
     a = S.PointSourceBRDF(model=iso, distance=2.0).accuracy(0.4, tr, pr)
     b = S.PointSourceBRDF(model=ani, distance=2.0).accuracy(0.4, tr, pr)
-    assert S.PointSourceBRDF(model=ani)._rotates and not S.PointSourceBRDF(model=ani)._isotropic
+    assert (
+        S.PointSourceBRDF(model=iso)._rotation == "none" and S.PointSourceBRDF(model=ani)._rotation == "set"
+    )
     err = np.max(np.abs(a.mueller - b.mueller), axis=(-2, -1))
     assert np.all(err <= 2e-4 * a.scale)
 
@@ -160,7 +162,7 @@ def test_a_model_that_cannot_rotate_by_an_array_is_rotated_node_by_node():
     inner = S.FacetBRDF(slopes=S.AnisotropicGaussianSlopes(0.05, 0.08, 0.4), substrate=2.29 + 3.37j)
     plain = S.PointSourceBRDF(model=inner, distance=3.0)
     user = S.PointSourceBRDF(model=as_model(_UserAnisotropic(inner)), distance=3.0)
-    assert plain._rotates and not user._rotates
+    assert plain._rotation == "set" and user._rotation == "each"
     tr, pr = np.array([0.0, 0.25, 0.3, 0.35, 0.6, 0.32]), np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.2])
     a, b = plain.accuracy(0.3, tr, pr), user.accuracy(0.3, tr, pr)
     assert np.any(b.evaluations > 160)  # the adaptive cubature served them
