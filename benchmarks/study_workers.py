@@ -7,7 +7,7 @@ and on local worker processes, in one run.
 ``comparison`` (the default) runs :func:`scatterbench.validation.fitting.compare.seed003_pairing` with the
 full report's settings (:func:`scatterbench.validation.checks.fitting.comparison_settings`: 8 fits, 24
 walkers, differential evolution to N >= 50 tau); ``sweep`` runs the full stability sweep
-(:func:`scatterbench.validation.studies.stability.sweep`, energy integrals included: ~300 small tasks);
+(:func:`scatterbench.validation.studies.edge_sweep.sweep`, energy integrals included: ~300 small tasks);
 ``recovery`` the full report's injection-recovery study (100 small fits to N >= 50 tau; a
 tree whose study cannot be given an executor is refused).
 Each ``--workers`` value runs in a fresh process, and prints the seconds and a digest of the
@@ -53,8 +53,13 @@ def comparison(ex):
     return h
 
 def sweep(ex):
-    sweep = mod("validation.studies.stability").sweep
-    return hashlib.sha1(repr(sweep(energy=True, executor=ex)).encode())
+    try:
+        sweep = mod("validation.studies.edge_sweep").sweep
+    except ImportError:  # a checkout from before the sweep's module was named edge_sweep
+        sweep = mod("validation.studies.stability").sweep
+    # what each finding says, not its type's repr (which a tree's Finding fields change)
+    found = [(f.model, f.params, f.kind, f.value, f.where, f.fields) for f in sweep(energy=True, executor=ex)]
+    return hashlib.sha1(repr(found).encode())
 
 def recovery(ex):
     import inspect

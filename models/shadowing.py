@@ -50,6 +50,7 @@ from .slopes import (
 
 __all__ = [
     "azimuthal_width",
+    "is_elliptical",
     "SHADOWING",
     "LambdaTable",
     "lambda_gaussian",
@@ -79,7 +80,14 @@ def check_shadowing(shadowing, slopes):
 
 
 def _supported(slopes):
-    return slopes.isotropic or hasattr(slopes, "_isotropic_unit")
+    return slopes.isotropic or is_elliptical(slopes)
+
+
+def is_elliptical(slopes) -> bool:
+    """True for elliptical slopes, an isotropic density stretched along rotated axes (the
+    anisotropic Gaussian, GGX and exponential families): they give that unit density
+    (``_isotropic_unit()``), to which :func:`azimuthal_width` reduces them along an azimuth."""
+    return hasattr(slopes, "_isotropic_unit")
 
 
 def lambda_gaussian(mu, sigma):

@@ -292,6 +292,7 @@ class ZernikeExpansionBRDF(Model):
         "Koenderink & van Doorn (1998) extended to the Mueller matrix by Germer (2017): NIST's PTFE tables",
         "``ZernikeExpansion_BRDF_Model`` (``coefficientfile``, ``scale``; xyxy basis)",
     )
+
     @property
     def scatmech(self):
         """``None``: SCATMECH's ``ZernikeExpansion_BRDF_Model`` takes its table as a file

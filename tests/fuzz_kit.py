@@ -1,5 +1,5 @@
-"""Helpers of the fuzz tests (test_fuzz_loaders, test_scene_issue15): mostly well-formed inputs,
-and a check that a fuzz ran both its success branch and its refusals."""
+"""Helpers of the fuzz tests (test_fuzz_loaders, test_scene_slopes_shadowing_films): mostly
+well-formed inputs, and a check that a fuzz ran both its success branch and its refusals."""
 
 from __future__ import annotations
 

@@ -16,7 +16,6 @@ from scatterbench.validation.checks import registry
 from scatterbench.validation.checks.registry import (
     CheckContext,
     CheckSpec,
-    Finding,
     judge,
     registered,
     run_checks,
@@ -24,6 +23,7 @@ from scatterbench.validation.checks.registry import (
 from scatterbench.validation.checks.table1 import compute_table1
 from scatterbench.validation.cli import main
 from scatterbench.validation.cli import validate as validate_cmd
+from scatterbench.validation.studies.findings import Finding
 
 QUICK = registered(quick=True)
 
@@ -184,9 +184,21 @@ def test_limit_check_goes_red_above_its_tolerance_and_on_nan():
     assert judge("x", 11.0, 10.0, op=">").status == "pass"
     assert judge("x", 10.0, 10.0, op=">").status == "fail"
     # a finding with a NaN measurement is a failure, not a finding
-    assert judge("x", math.nan, 1.0, finding=Finding(False, "never")).status == "fail"
+    assert judge("x", math.nan, 1.0, finding=Finding(fails=False, fails_if="never")).status == "fail"
     with pytest.raises(ValueError, match="op"):
         judge("x", 1.0, 1.0, op="=")
+
+
+def test_a_finding_without_its_verdict_is_refused():
+    """One Finding type serves the checks and the stability sweep, whose findings carry no
+    verdict (accepted_findings.toml gives it): judged as a check's, one would count as holding
+    (``fails`` None is false), so the judge refuses it."""
+    swept = Finding("FacetBRDF", "FacetBRDF()", "energy", 1.2, "theta_i = 0 deg")
+    for finding in (swept, Finding(fails=False), Finding(fails_if="never")):
+        with pytest.raises(ValueError, match="verdict"):
+            judge("x", 2.0, 1.0, finding=finding)
+    assert judge("x", 2.0, 1.0, finding=Finding(fails=False, fails_if="never")).status == "finding"
+    assert judge("x", 2.0, 1.0, finding=Finding(fails=True, fails_if="always")).status == "fail"
 
 
 def test_a_real_limit_check_goes_red_on_a_broken_input():
@@ -206,7 +218,7 @@ def test_run_checks_names_raising_broken_and_undeclared_checks():
         raise ZeroDivisionError("boom")
 
     def undeclared(ctx):
-        return judge("u", 2.0, 1.0, finding=Finding(False, "never"))
+        return judge("u", 2.0, 1.0, finding=Finding(fails=False, fails_if="never"))
 
     def missing(ctx):
         return judge("m", 0.0, 1.0)

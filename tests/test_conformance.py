@@ -400,7 +400,7 @@ def test_example_package_is_contributed(installed_example):
     listed = _cli("models", env_path=installed_example)
     assert listed.returncode == 0 and "lambert-specular = lambert_specular:LambertSpecular" in listed.stdout
     code = (
-        "from scatterbench.validation.studies.stability import _default_targets, sweep_model, edge_instances\n"
+        "from scatterbench.validation.studies.edge_sweep import _default_targets, sweep_model, edge_instances\n"
         "from scatterbench.validation.testing import contributed_models\n"
         "c = contributed_models(); assert [x.name for x in c] == ['lambert-specular'], c\n"
         "names = [n for n, _ in _default_targets() if n]; assert names == ['lambert-specular'], names\n"

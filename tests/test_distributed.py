@@ -31,7 +31,7 @@ from scatterbench.validation.fitting.fitspec import fitspec_from
 from scatterbench.validation.fitting.likelihood import Likelihood
 from scatterbench.validation.fitting.recovery import recovery_study, subsample
 from scatterbench.validation.fitting.settings import ChainSettings
-from scatterbench.validation.studies.stability import classify, sweep
+from scatterbench.validation.studies.edge_sweep import classify, sweep
 
 COATED = references.scene_path("aluminium_flakes_clearcoat.toml")
 DATA = references.data_path("scatmech_flake_measurement.csv")

@@ -165,7 +165,9 @@ def test_in_range_parameters_give_finite_values(cls, backend):
         lambda: models.CookTorranceBRDF(slopes=models.GaussianSlopes(1e-300)),
     ],
 )
-def test_issue_examples_are_refused_with_the_reason(build):
+def test_extreme_indices_and_widths_are_refused_naming_the_bound(build):
+    """A substrate index of 1e300 and slope widths of 1e-160 and 1e-300 (issue 13's examples)
+    are refused, the message naming the parameter and its bound."""
     with pytest.raises(ValueError, match=r"substrate|sigma") as info:
         build()
     assert "1e-08" in str(info.value) or "1.8e+16" in str(info.value)

@@ -11,7 +11,7 @@ import pytest
 
 import scatterbench.models.point_source as point_source
 from scatterbench import models
-from scatterbench.models import cubature
+from scatterbench.models import cubature, disc_cubature
 from scatterbench.models.point_source import AUTO_FACTOR, AccuracyWarning
 
 S = models
@@ -125,7 +125,9 @@ def test_anisotropic_models_are_rotated_per_node_as_a_model_set():
     tr, pr = _scan()
     a = S.PointSourceBRDF(model=iso, distance=2.0).accuracy(0.4, tr, pr)
     b = S.PointSourceBRDF(model=ani, distance=2.0).accuracy(0.4, tr, pr)
-    assert S.PointSourceBRDF(model=ani)._rotates and not S.PointSourceBRDF(model=ani)._isotropic
+    assert (
+        S.PointSourceBRDF(model=iso)._rotation == "none" and S.PointSourceBRDF(model=ani)._rotation == "set"
+    )
     err = np.max(np.abs(a.mueller - b.mueller), axis=(-2, -1))
     assert np.all(err <= 2e-4 * a.scale)
 
@@ -160,7 +162,7 @@ def test_a_model_that_cannot_rotate_by_an_array_is_rotated_node_by_node():
     inner = S.FacetBRDF(slopes=S.AnisotropicGaussianSlopes(0.05, 0.08, 0.4), substrate=2.29 + 3.37j)
     plain = S.PointSourceBRDF(model=inner, distance=3.0)
     user = S.PointSourceBRDF(model=as_model(_UserAnisotropic(inner)), distance=3.0)
-    assert plain._rotates and not user._rotates
+    assert plain._rotation == "set" and user._rotation == "each"
     tr, pr = np.array([0.0, 0.25, 0.3, 0.35, 0.6, 0.32]), np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.2])
     a, b = plain.accuracy(0.3, tr, pr), user.accuracy(0.3, tr, pr)
     assert np.any(b.evaluations > 160)  # the adaptive cubature served them
@@ -430,7 +432,7 @@ def test_evaluations_count_every_inner_evaluation():
     [(3.0, 1.0), (0.5, 1.0), (100.0, 1.0), (1e-6, 1.0), (1.0, 1e6), (1.0, 1e-300), (1e-300, 1.0)],
 )
 def test_compiled_disc_algebra_equals_the_numpy_reference(distance, radius, rng):
-    """models.kernels.disc (the numba backend's node algebra) against _Disc.angles, its numpy
+    """models.kernels.disc (the numba backend's node algebra) against Disc.angles, its numpy
     reference, on the product rule's nodes and on random points of the cubature's cells, for
     geometries in all three coordinate systems (about the source's foot, about the centre, the
     wedge) and discs from 1e-300 to 1e300 source heights wide: the local polar angle within
@@ -444,13 +446,13 @@ def test_compiled_disc_algebra_equals_the_numpy_reference(distance, radius, rng)
     n = 300
     ti = np.r_[0.0, rng.uniform(0.0, 1.5, n - 2), 0.5 * math.pi - 1e-9]
     tr, pr = rng.uniform(0.0, 1.5, n), rng.uniform(-math.pi, math.pi, n)
-    disc = point_source._Disc(ps, ti, tr, pr)
+    disc = ps._disc(ti, tr, pr)
     if (distance, radius) == (0.5, 1.0):
         assert disc.wedge.any() and disc.on_h.any() and (~disc.on_h & ~disc.wedge).any()
     rows = np.arange(n)
     cells = disc.cells(rows)
     m = cells.row.size
-    sets = [(rows, *point_source._product_nodes(8))]
+    sets = [(rows, *disc_cubature._product_nodes(8))]
     sets.append(
         (rows[cells.row], *cells.point(np.arange(m), rng.uniform(0, 1, (m, 17)), rng.uniform(0, 1, (m, 17))))
     )

@@ -179,8 +179,8 @@ def test_stability_findings_grouped_by_model_kind_and_verdict():
     group's largest magnitude (with its parameters and geometry), each reason is shown once per
     group, not once per finding, and every finding stays in results.json."""
     from scatterbench.validation.report.core import Section, render_html
-    from scatterbench.validation.report.sections import stability
-    from scatterbench.validation.studies.stability import Finding
+    from scatterbench.validation.report.sections import edge_findings
+    from scatterbench.validation.studies.findings import Finding
 
     def finding(model, kind, value, k):
         return Finding(model, f"{model}(sigma={k})", kind, value, f"theta_i = {k} deg", {"value": value})
@@ -198,9 +198,9 @@ def test_stability_findings_grouped_by_model_kind_and_verdict():
         },
         {"model": "*", "kind": "energy", "condition": "value > 7", "reason": "the paper's 4 pi"},
     ]
-    d = stability.summarize(findings, accepted)
+    d = edge_findings.summarize(findings, accepted)
     sec = Section("stability", "Stability")
-    stability.render(sec, d)
+    edge_findings.render(sec, d)
     page = render_html(
         {"date": "", "git_commit": "", "quick": False, "seconds": 0.0},
         [sec],

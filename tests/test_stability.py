@@ -10,7 +10,7 @@ from scatterbench import models
 from scatterbench.models.base import Model
 from scatterbench.models.constraints import Interval
 from scatterbench.models.params import param
-from scatterbench.validation.studies.stability import (
+from scatterbench.validation.studies.edge_sweep import (
     classify,
     edge_geometries,
     edge_instances,

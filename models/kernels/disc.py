@@ -1,10 +1,10 @@
 """The node algebra of :class:`scatterbench.models.PointSourceBRDF`'s ``"auto"`` quadrature, compiled:
 each quadrature point of the disc turned into the local incidence ``(psi, Phi)`` and the
-irradiance weight ``J`` (:meth:`scatterbench.models.point_source._Disc.angles`, the numpy reference the
+irradiance weight ``J`` (:meth:`scatterbench.models.disc_cubature.Disc.angles`, the numpy reference the
 tests hold this to).
 
 A geometry's points all lie in one of the three coordinate systems of
-:class:`scatterbench.models.point_source._Disc` (polar about the source's foot ``H``, polar about the
+:class:`scatterbench.models.disc_cubature.Disc` (polar about the source's foot ``H``, polar about the
 centre, or the wedge of rays from ``H``), so the choice is made once per geometry and the
 loop over its points has no branch and no C library call
 (:mod:`~scatterbench.models.kernels.vector_math`'s sines, cosines and arctangents, the ``sqrt``
@@ -27,7 +27,7 @@ _TWO_PI = 2.0 * math.pi
 
 @njit(error_model="numpy", inline="always")
 def _t_of_v(v, h, krho):
-    """:func:`scatterbench.models.point_source._t_of_v`."""
+    """:func:`scatterbench.models.disc_cubature._t_of_v`."""
     a = (krho / h) * (krho / (h + 1.0))
     s = max(1.0 - v * v * a, 1.0 / h)
     return min(v * sqrt(2.0 - v * v * a) / (sqrt(h) * sqrt(h + 1.0) * s), 1.0)
@@ -54,13 +54,13 @@ def _polar(k, h1, tan_c, sec_c, about_h, ox, v, chi, w):
 
 @njit(error_model="numpy", inline="always")
 def _share(r, h):
-    """:func:`scatterbench.models.point_source._share`."""
+    """:func:`scatterbench.models.disc_cubature._share`."""
     return r * (r / (h * (h + 1.0)))
 
 
 @njit(error_model="numpy", inline="always")
 def _wedge(k, xc, u, alpha, w):
-    """``(psi, Phi, J)`` of the wedge's point ``(u, alpha)`` (:func:`scatterbench.models.point_source._wedge`)."""
+    """``(psi, Phi, J)`` of the wedge's point ``(u, alpha)`` (:func:`scatterbench.models.disc_cubature._wedge`)."""
     phi = 0.5 * (np.remainder(alpha + math.pi, _TWO_PI) - math.pi)
     sp, cp = sincos(phi)
     sc = sp / xc
@@ -82,7 +82,7 @@ def points(k, h1, tan_c, sec_c, on_h, ox, xc, v, chi, w, psi, phi, jac):
     written) of the points ``(v, chi)`` with quadrature weights ``w`` (each ``(m, P)``) of
     ``m`` geometries, each given by its row of ``tan_c``, ``sec_c = hypot(1, tan_c)``,
     ``on_h``, ``ox`` and ``xc`` (nan: not the wedge); ``k``, ``h1``: the disc's
-    (:class:`scatterbench.models.point_source._Disc`)."""
+    (:class:`scatterbench.models.disc_cubature.Disc`)."""
     m, P = v.shape
     for i in range(m):
         if not math.isnan(xc[i]):

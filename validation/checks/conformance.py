@@ -36,9 +36,10 @@ import numpy as np
 from scatterbench import models
 from scatterbench.models.constraints import HasMethods
 from scatterbench.models.params import param
+from scatterbench.validation.studies.findings import Finding
 
 from .common import fp_warnings
-from .registry import Check, CheckContext, Finding, judge
+from .registry import Check, CheckContext, judge
 
 __all__ = [
     "ATTRIBUTES",
@@ -309,19 +310,17 @@ def accepted_reason(model, kind, fields, accepted=None):
     entries ``accepted``) that explains a ``kind`` of finding with these numeric ``fields``
     on one of scatterbench's own models, else ``None``: only scatterbench's models carry
     accepted findings."""
-    from scatterbench.validation.studies import stability
+    from scatterbench.validation.studies import edge_sweep
 
     if not type(model).__module__.startswith("scatterbench.models."):
         return None
-    f = stability.Finding(
-        type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields
-    )
-    entry = stability.accepted_entry(f, accepted)
+    f = Finding(type(model).__name__, repr(model), kind, float(fields.get("value", math.nan)), "", fields)
+    entry = edge_sweep.accepted_entry(f, accepted)
     return None if entry is None else (entry["reason"], entry.get("condition") or "always")
 
 
 def finding_of(reason, condition) -> Finding:
-    """The :class:`~.registry.Finding` of a result an accepted finding explains: it holds
-    (``fails=False``) and would fail if its accepted condition did not."""
+    """The :class:`~scatterbench.validation.studies.findings.Finding` of a result an accepted
+    finding explains: it holds (``fails=False``) and would fail if its accepted condition did not."""
     head = " ".join(reason.split())
     return Finding(fails=False, fails_if=f"the accepted condition `{condition}` does not hold ({head})")

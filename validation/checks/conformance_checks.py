@@ -20,6 +20,7 @@ import numpy as np
 from scatterbench import models
 from scatterbench.models.params import Declared
 from scatterbench.models.polarization import coherency_eigenvalues
+from scatterbench.validation.studies.findings import Finding
 
 from .common import extreme_geometries, random_geometries
 from .conformance import (
@@ -33,7 +34,6 @@ from .conformance import (
     verdict,
     where,
 )
-from .registry import Finding
 
 __all__ = [
     "kit_geometries",
@@ -70,7 +70,7 @@ def kit_geometries(model):
     30, 60, 89.99, 90 deg; exact specular and retroreflection; phi 0, +-pi, pi/2, 1e-12),
     the stability sweep's edge geometries of ``model`` (critical angles of its declared
     indices +- 1e-9), and 200 seeded random interior ones."""
-    from scatterbench.validation.studies.stability import edge_geometries
+    from scatterbench.validation.studies.edge_sweep import edge_geometries
 
     parts = [extreme_geometries(), edge_geometries(model), random_geometries(200, seed=14, max_deg=89.0)]
     return tuple(np.concatenate(p) for p in zip(*parts, strict=True))
@@ -387,9 +387,9 @@ def _energy_bound(model):
 def _energy_reason(model, ti, r, bound):
     """The accepted finding (``(reason, condition)`` or ``None``) that explains the
     integrated reflectance ``r`` above ``bound`` at ``ti``, from the fields the stability
-    sweep gives its energy findings (:func:`scatterbench.validation.studies.stability.energy_fields`);
+    sweep gives its energy findings (:func:`scatterbench.validation.studies.edge_sweep.energy_fields`);
     the hit fraction (an integral) only when needed."""
-    from scatterbench.validation.studies.stability import energy_fields, load_accepted, model_hit_fraction
+    from scatterbench.validation.studies.edge_sweep import energy_fields, load_accepted, model_hit_fraction
 
     accepted = load_accepted()
     fields = energy_fields(model, ti, r.value, r.error, bound, hit=False)
@@ -490,13 +490,18 @@ def check_pickle(model, ctx):
 
 # --------------------------------------------------------------------------- parameter extremes
 @model_check(
-    tests="the stability sweep (validation/studies/stability.py) on the model: each declared parameter at "
+    tests="the stability sweep (validation/studies/edge_sweep.py) on the model: each declared parameter at "
     "its edges, at edge geometries: no fp warning, non-finite, negative or unrealizable value, no "
     "reciprocity violation (findings accepted in accepted_findings.toml are findings)",
     slow=True,
 )
 def check_parameter_extremes(model, ctx):
-    from scatterbench.validation.studies.stability import classify, edge_instances, load_accepted, sweep_model
+    from scatterbench.validation.studies.edge_sweep import (
+        classify,
+        edge_instances,
+        load_accepted,
+        sweep_model,
+    )
 
     if not isinstance(model, Declared) or not type(model).parameters():
         return skipped(

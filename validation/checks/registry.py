@@ -32,9 +32,10 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from scatterbench.validation.studies.findings import Finding
+
 __all__ = [
     "Check",
-    "Finding",
     "judge",
     "check",
     "CheckSpec",
@@ -55,18 +56,6 @@ SEED = 20261122
 
 #: comparison operators a limit may use: ``measured OP tolerance`` is "within"
 _OPS = {"<=": operator.le, "<": operator.lt, ">=": operator.ge, ">": operator.gt}
-
-
-@dataclass(frozen=True)
-class Finding:
-    """A paper's property that a check establishes when its measured value is outside
-    the limit, and the condition, computed from the measurement, that makes it a failure.
-
-    ``fails``: whether that condition holds in this run; ``fails_if``: it in words.
-    """
-
-    fails: bool
-    fails_if: str
 
 
 @dataclass(frozen=True)
@@ -103,8 +92,9 @@ def judge(name, measured, tolerance, detail="", *, op="<=", finding=None) -> Che
     op : {"<=", "<", ">=", ">"}
         ``measured op tolerance`` is within the limit.
     finding : Finding, optional
-        For a finding-type result: outside the limit is a ``finding`` (a property
-        of the paper), unless ``finding.fails``; within the limit is a ``pass``.
+        For a finding-type result (:class:`~scatterbench.validation.studies.findings.Finding`
+        with its verdict, ``fails`` and ``fails_if``): outside the limit is a ``finding`` (a
+        property of the paper), unless ``finding.fails``; within the limit is a ``pass``.
 
     Returns
     -------
@@ -114,6 +104,8 @@ def judge(name, measured, tolerance, detail="", *, op="<=", finding=None) -> Che
         raise ValueError(f"op must be one of {', '.join(_OPS)}; got {op!r}")
     if finding is not None and not isinstance(finding, Finding):
         raise ValueError(f"finding must be a Finding or None; got {type(finding).__name__}")
+    if finding is not None and (finding.fails is None or finding.fails_if is None):
+        raise ValueError(f"a check's finding states its verdict, fails and fails_if; got {finding!r}")
     m, t = float(measured), float(tolerance)
     within = math.isfinite(m) and bool(_OPS[op](m, t))
     if not math.isfinite(m) or (finding is not None and finding.fails):
@@ -130,7 +122,8 @@ class CheckSpec:
     """A registered check: ``id`` is ``module.function`` below ``validation.checks``.
 
     ``findings``: the names of the results that are finding-type (may be
-    ``finding`` rather than ``pass``; each must carry a :class:`Finding`).
+    ``finding`` rather than ``pass``; each must carry a
+    :class:`~scatterbench.validation.studies.findings.Finding`).
     """
 
     id: str

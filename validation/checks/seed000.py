@@ -15,6 +15,7 @@ from scatterbench import models, references
 from scatterbench.validation.numerics.energy import exposed_reflectance, hit_fraction
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
+from scatterbench.validation.studies.findings import Finding
 
 from .common import (
     count_extremes,
@@ -25,7 +26,7 @@ from .common import (
     slope_normalization_errors,
 )
 from .conformance_scatmech import scatmech_tolerance
-from .registry import Finding, check, judge, text_section
+from .registry import check, judge, text_section
 from .table1 import compute_table1, format_table1
 
 __all__ = ["scatmech_facet_model", "scatmech_facet_errors", "extreme_models", "energy_samples"]

@@ -17,10 +17,11 @@ from scatterbench.models.facet import local_cosine
 from scatterbench.models.geometry import refracted_cos
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 from scatterbench.validation.numerics.reciprocity import reciprocity_error, reversed_mueller
+from scatterbench.validation.studies.findings import Finding
 
 from .common import count_extremes, extreme_geometries, slope_normalization_errors
 from .common import random_geometries as _geoms
-from .registry import Finding, check, judge, text_section
+from .registry import check, judge, text_section
 
 __all__ = [
     "energy_published",

@@ -20,11 +20,12 @@ from scatterbench.models.smooth_interface import internal_hemispherical_reflecta
 from scatterbench.validation.numerics.grid import grid_reflectance
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
+from scatterbench.validation.studies.findings import Finding
 
 from .common import count_extremes, random_geometries
 from .conformance_scatmech import SCATMECH_FLOOR, scatmech_tolerance
 from .fig1 import N_INDEX, SIGMAS, THETA_I, fig1
-from .registry import Finding, check, judge, text_section
+from .registry import check, judge, text_section
 
 __all__ = ["scatmech_seed003_errors", "scatmech_error_distributions", "mc_energy_samples"]
 

@@ -1,5 +1,5 @@
 """The stability sweep as a check: every model at the extremes of its parameters and
-geometries (:mod:`scatterbench.validation.studies.stability`), no finding left unaccepted.
+geometries (:mod:`scatterbench.validation.studies.edge_sweep`), no finding left unaccepted.
 
 The sweep runs once per run (:func:`sweep_findings`); the report's stability section
 draws the same one.  Quick runs skip its energy integrals, as the quick report does.
@@ -14,7 +14,7 @@ __all__ = ["sweep_findings"]
 
 def sweep_findings(ctx):
     """The sweep's findings for the run (energy integrals only in full runs), once per run."""
-    from scatterbench.validation.studies.stability import sweep
+    from scatterbench.validation.studies.edge_sweep import sweep
 
     return ctx.compute(sweep, energy=not ctx.quick)
 
@@ -22,7 +22,7 @@ def sweep_findings(ctx):
 @check(paper="every model at its extremes (stability sweep, accepted_findings.toml)")
 def check_stability(ctx, findings=None):
     """``findings``: :func:`sweep_findings`; each must be accepted, with its reason."""
-    from scatterbench.validation.studies.stability import classify
+    from scatterbench.validation.studies.edge_sweep import classify
 
     ok, bad = classify(sweep_findings(ctx) if findings is None else findings)
     shown = "; ".join(f"{f.model} {f.kind} at {f.where}" for f, _ in bad[:3])

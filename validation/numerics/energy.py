@@ -47,7 +47,7 @@ import math
 import numpy as np
 
 from scatterbench.models.fresnel import fresnel_reflectance
-from scatterbench.models.shadowing import azimuthal_width
+from scatterbench.models.shadowing import azimuthal_width, is_elliptical
 from scatterbench.models.slopes import AnisotropicGGXSlopes, GGXSlopes
 
 __all__ = ["hit_fraction", "exposed_reflectance", "tail_radius", "TAIL_TOL"]
@@ -107,7 +107,7 @@ def hit_fraction(slopes, theta_i, coating=1.0):
     """
     ti = math.asin(math.sin(theta_i) / coating)
     tan = math.tan(ti)
-    if hasattr(slopes, "_isotropic_unit"):
+    if is_elliptical(slopes):
         unit, alpha_b = azimuthal_width(slopes, 1.0, 0.0)  # the beam's azimuth, phi = 0
         return slopes.coverage * _hit_fraction(unit, tan * float(alpha_b))
     return _hit_fraction(slopes, tan)

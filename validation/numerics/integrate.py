@@ -136,7 +136,7 @@ def integrated_reflectance(
     rects = _initial_rectangles(model.lobe(theta_i) if hasattr(model, "lobe") else None, symmetric, theta_i)
     factor = 2.0 if symmetric else 1.0
     # the half-range integral is doubled, and so is its error
-    got = _refine(_integrand(model, theta_i, s_in, rects), len(rects), tol / factor, max_evaluations)
+    got = _one_row(_integrand(model, theta_i, s_in, rects), len(rects), tol / factor, max_evaluations)
     return IntegralResult(
         value=factor * float(got.value[0, 0]),
         error=factor * float(got.error[0]),
@@ -145,10 +145,12 @@ def integrated_reflectance(
     )
 
 
-def _refine(f, n_cells, goal, max_evaluations):
-    """:func:`scatterbench.models.cubature.adaptive` on one row of ``n_cells`` cells: absolute error ``goal``,
-    regions capped so that the evaluations (each region's, and its parent's before it) stay
-    within about ``max_evaluations``."""
+def _one_row(f, n_cells, goal, max_evaluations):
+    """:func:`scatterbench.models.cubature.adaptive` (the one adaptive rectangle integrator, which
+    :class:`scatterbench.models.PointSourceBRDF` also refines with) on one row of ``n_cells``
+    cells: absolute error ``goal`` on the integral (the weight's own integral, the last, has no
+    budget), regions capped so that the evaluations (each region's, and its parent's before it)
+    stay within about ``max_evaluations``."""
     return cubature.adaptive(
         f,
         np.zeros(n_cells, dtype=int),

@@ -12,6 +12,7 @@ from ..core import SectionSpec
 from . import (
     conservation,
     contributed,
+    edge_findings,
     model_comparison,
     provenance,
     scatmech,
@@ -21,7 +22,6 @@ from . import (
     seed003_fig1,
     seed003_presets,
     speed,
-    stability,
     summary,
     table1,
     thin_film,
@@ -53,7 +53,7 @@ SECTIONS = (
         "model_comparison", "Model comparison: seed 003's combination against Maxwell-Beard", model_comparison
     ),
     _spec("speed", "Speed and accuracy", speed),
-    _spec("stability", "Stability sweep at the extremes", stability),
+    _spec("stability", "Stability sweep at the extremes", edge_findings),
     _spec("scenes", "Scenes and the mechanisms they build", scenes),
     _spec("contributed", "Contributed models (scatterbench.models entry points)", contributed),
     _spec("provenance", "Provenance", provenance, stage=1),

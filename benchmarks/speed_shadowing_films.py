@@ -1,6 +1,7 @@
-"""Print the per-geometry cost of the issue-15 code paths beside the existing ones, with ratios.
+"""Print the per-geometry cost of Smith shadowing, film-stack substrates and the shadowed BTDF (the
+paths issue 15 added) beside the existing ones, with ratios.
 
-    python benchmarks/speed_issue15.py
+    python benchmarks/speed_shadowing_films.py
 
 10^5 random geometries (polar angles up to 85 deg, every azimuth), Mueller
 matrices, one call each, best of 5 runs in one process, on both backends

@@ -34,7 +34,7 @@ import math
 import os
 import threading
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -45,8 +45,9 @@ from scatterbench.validation.numerics.energy import hit_fraction
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
+from .findings import Finding
+
 __all__ = [
-    "Finding",
     "edge_instances",
     "edge_geometries",
     "sweep",
@@ -63,16 +64,6 @@ ACCEPTED_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accept
 # What is swept is each class's own: the edge values of its declared parameters
 # (models.params.param's ``edges``, else the constraint's), its representative instance
 # (``Cls.sweep_base()``) and the instances its edges do not reach (``Cls.sweep_extras()``).
-
-
-@dataclass(frozen=True)
-class Finding:
-    model: str
-    params: str
-    kind: str
-    value: float
-    where: str
-    fields: dict = field(default_factory=dict)
 
 
 def _edges_for(info, current):

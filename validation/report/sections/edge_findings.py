@@ -48,8 +48,8 @@ def _group_row(g):
 
 def summarize(findings, accepted, quick=False):
     """The section's data from the sweep's ``findings`` and the ``accepted`` entries
-    (:func:`scatterbench.validation.studies.stability.load_accepted`)."""
-    from scatterbench.validation.studies.stability import classify, group_findings
+    (:func:`scatterbench.validation.studies.edge_sweep.load_accepted`)."""
+    from scatterbench.validation.studies.edge_sweep import classify, group_findings
 
     ok, bad = classify(findings, accepted)
     rows = tuple(
@@ -69,7 +69,7 @@ def summarize(findings, accepted, quick=False):
 
 def compute(ctx):
     from scatterbench.validation.checks.stability import sweep_findings
-    from scatterbench.validation.studies.stability import load_accepted
+    from scatterbench.validation.studies.edge_sweep import load_accepted
 
     return summarize(sweep_findings(ctx), load_accepted(), ctx.quick)  # the stability check's sweep
 

@@ -10,7 +10,7 @@ __all__ = ["register"]
 
 
 def _cmd_stability(args) -> int:
-    from scatterbench.validation.studies.stability import classify, format_sweep, sweep
+    from scatterbench.validation.studies.edge_sweep import classify, format_sweep, sweep
 
     _check_executor(args)
     t0 = time.perf_counter()
