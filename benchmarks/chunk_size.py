@@ -19,7 +19,7 @@ import argparse  # noqa: E402
 from benchmarks.speed import best_of  # noqa: E402
 from scatterbench import models  # noqa: E402
 from scatterbench.models import evaluation  # noqa: E402
-from scatterbench.validation.checks.common import random_geometries  # noqa: E402
+from scatterbench.validation.numerics.probes import random_geometries  # noqa: E402
 
 SIZES = (1024, 2048, 4096, 8192, 16384, 32768)
 

@@ -35,7 +35,7 @@ from benchmarks.speed import best_of
 
 try:
     from scatterbench import models
-    from scatterbench.validation.checks.common import random_geometries
+    from scatterbench.validation.numerics.probes import random_geometries
     from scatterbench.validation.studies.tradeoff import precision_error
 except ImportError:  # benchmarks/kernel_ab.py runs this file in a checkout from before the namespace
     import models

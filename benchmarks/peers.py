@@ -60,7 +60,7 @@ import numpy as np
 
 from scatterbench import models
 from scatterbench.models.geometry import incident_direction, scattered_direction
-from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.numerics.probes import random_geometries
 from scatterbench.validation.studies.tradeoff import time_call
 
 DEFAULT_OUT = os.path.join(

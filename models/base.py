@@ -70,9 +70,12 @@ class Model(Declared, ModelFacts):
     #: every public model class, in definition order (for listings and sweeps)
     registry: list = []
 
-    def __init_subclass__(cls, **kwargs):
+    def __init_subclass__(cls, registry=True, **kwargs):
+        """Public classes of :mod:`scatterbench.models` join :attr:`registry`; ``registry=False``
+        keeps one out (a view of another object, :class:`scatterbench.models.contributed.Conformant`)."""
         super().__init_subclass__(**kwargs)
-        if not cls.__name__.startswith("_") and cls.__module__.startswith("scatterbench.models"):
+        public = not cls.__name__.startswith("_") and cls.__module__.startswith("scatterbench.models")
+        if public and registry:
             Model.registry.append(cls)
 
     #: True when ``_mueller16``/``_brdf_flat`` take array parameters (flat, one per

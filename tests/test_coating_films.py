@@ -21,8 +21,8 @@ from scatterbench.models.smooth_interface import (
     internal_hemispherical_reflectance,
 )
 from scatterbench.models.thin_film import Films, FilmStack
-from scatterbench.validation.checks.common import random_geometries
 from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import random_geometries
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 N = 1.5  # the clear coat

@@ -13,8 +13,8 @@ import pytest
 from scatterbench import models
 from scatterbench.models.cook_torrance import smith_slopes
 from scatterbench.models.shadowing import lambda_gaussian, smith_g1
-from scatterbench.validation.checks.common import random_geometries
 from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import random_geometries
 
 
 def _geometries(n=3000, seed=3):

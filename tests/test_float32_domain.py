@@ -12,7 +12,7 @@ from scatterbench.models import float32_domain as fd
 from scatterbench.models.evaluation import raw_float32
 from scatterbench.models.kernels import common, drive
 from scatterbench.models.params import INDEX_MIN
-from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.numerics.probes import random_geometries
 from scatterbench.validation.studies import tradeoff
 
 G, X = S.GaussianSlopes, S.ExponentialSlopes

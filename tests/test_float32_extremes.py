@@ -10,7 +10,7 @@ import pytest
 from scatterbench import models
 from scatterbench.models.evaluation import raw_float32
 from scatterbench.models.params import INDEX_MAX, INDEX_MIN
-from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.numerics.probes import random_geometries
 
 S = models
 HALF = 0.5 * math.pi

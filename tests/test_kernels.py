@@ -9,8 +9,8 @@ import pytest
 from scatterbench import models
 from scatterbench.models import kernel_specs
 from scatterbench.models.evaluation import backend
-from scatterbench.validation.checks.common import extreme_geometries, random_geometries
 from scatterbench.validation.checks.conformance_checks import _relative as relative_per_geometry
+from scatterbench.validation.numerics.probes import extreme_geometries, random_geometries
 
 AL = 1.37 + 7.62j
 TOL = 1e-12
@@ -42,7 +42,8 @@ def _configs():
         for sh in ("smith", "smith-correlated"):
             out.append(S.FacetBRDF(slopes=s, substrate=AL, shadowing=sh))
             out.append(S.SubsurfaceFacetBRDF(slopes=s, coating=1.5, substrate=AL, shadowing=sh))
-            out.append(S.FacetBTDF(slopes=s, substrate=1.7, shadowing=sh))
+            if sh == "smith":  # the correlated transmission form (a Beta function) is numpy's
+                out.append(S.FacetBTDF(slopes=s, substrate=1.7, shadowing=sh))
     for g, pol in ((0.3, True), (-0.9, False), (0.95, True), (0.0, False)):
         out.append(S.SingleScatterBRDF(coating=1.5, phase=S.HenyeyGreenstein(g, pol)))
         out.append(S.SingleScatterBRDF(coating=1.0, phase=S.HenyeyGreenstein(g, pol)))
@@ -127,6 +128,7 @@ def test_uncovered_options_fall_back_to_numpy():
             substrate=models.FilmStack(layers=((1.5, 100.0),), substrate=AL, wavelength_nm=550.0)
         ),
         models.FacetBTDF(convention="corrected"),
+        models.FacetBTDF(slopes=models.GaussianSlopes(0.3), shadowing="smith-correlated"),
     ):
         assert m._kernel_spec() is None
         assert models.evaluation.compiled(m) is None

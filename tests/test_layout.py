@@ -125,3 +125,28 @@ def test_a_user_s_own_models_and_validation_modules_do_not_shadow_the_kit(tmp_pa
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-2000:]
     # one test per (model, check), and the user's own module test
     assert " passed" in r.stdout and " failed" not in r.stdout
+
+
+# the lint-imports command (its console script need not be on PATH)
+_LINT = "import sys; from importlinter.cli import lint_imports_command; sys.exit(lint_imports_command())"
+
+
+def test_the_import_contract_holds(wheel, tmp_path):
+    """pyproject.toml's import-linter contracts (the layers of validation and models, references
+    as data, no cycle between the members of any package) hold for the built package: an
+    import that breaks a layer or closes a cycle fails the test command."""
+    pytest.importorskip("importlinter")
+    site = tmp_path / "site"
+    with zipfile.ZipFile(wheel) as zf:
+        zf.extractall(site)
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    r = subprocess.run(
+        [sys.executable, "-c", _LINT, "--no-cache", os.path.join(ROOT, "pyproject.toml")],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stdout[-6000:] + r.stderr[-2000:]
+    assert "broken" in r.stdout and " 0 broken" in r.stdout

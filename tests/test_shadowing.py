@@ -18,7 +18,7 @@ from scatterbench.models.shadowing import (
     smith_g1,
     smith_lambda,
 )
-from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.numerics.probes import random_geometries
 
 TABLE_TOL = 1e-10
 

@@ -13,7 +13,7 @@ import pytest
 from scatterbench import models, references
 from scatterbench.models.fresnel import fresnel_coefficients
 from scatterbench.models.thin_film import FilmStack, TabulatedIndex
-from scatterbench.validation.checks.common import random_geometries
+from scatterbench.validation.numerics.probes import random_geometries
 
 # Ours and tmm are both float64 transfer-matrix products over at most 4 films with |r|, |t|
 # <= 2.11 in the 400 cases: they differ by round-off, measured worst 6.2e-14 (~280 eps, a

@@ -143,7 +143,7 @@ def file_lock(path, wait=None, poll=0.2, on_wait=None):
     OSError
         The lock file cannot be created or opened.
     """
-    import fcntl
+    import fcntl  # fcntl (POSIX only)
 
     with open(path, "a+", encoding="utf-8") as fh:
         t0 = time.monotonic()

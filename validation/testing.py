@@ -42,6 +42,7 @@ import importlib
 from dataclasses import dataclass
 
 from scatterbench import models
+from scatterbench.models.contributed import ENTRY_POINT_GROUP, Contributed, contributed_models, resolve
 from scatterbench.validation.checks.conformance import (
     ATTRIBUTES,
     ModelCheck,
@@ -66,7 +67,6 @@ __all__ = [
 ]
 
 #: the entry-point group other packages register their models in
-ENTRY_POINT_GROUP = "scatterbench.models"
 
 
 @dataclass(frozen=True)
@@ -172,7 +172,7 @@ class _Check:
         return self.spec.name
 
     def __call__(self, model):
-        import pytest
+        import pytest  # pytest (optional: the kit's pytest helpers only)
 
         results = run_model_checks(model, self.ctx, [self.spec], self.label)
         failed = [r.message for r in results if r.status == "fail"]
@@ -204,7 +204,7 @@ def parametrize_with_checks(models_, *, checks=None, quick=False, ids=None):
     as :func:`check_model`; ``ids``: the models' names (default: class names, numbered when
     repeated).
     """
-    import pytest
+    import pytest  # pytest (optional: the kit's pytest helpers only)
 
     models_ = list(models_)
     ctx = CheckContext(quick=quick)  # shared: the grid evaluations of a model run once
@@ -218,27 +218,6 @@ def parametrize_with_checks(models_, *, checks=None, quick=False, ids=None):
 
 
 # --------------------------------------------------------------------------- finding models
-def _resolve(obj, what):
-    """A model from an instance, a class or a callable returning one."""
-    if not isinstance(obj, type) and callable(getattr(obj, "mueller", None)):
-        return obj
-    if callable(obj):
-        try:
-            made = obj()
-        except Exception as exc:  # noqa: BLE001 - reported as a bad argument, not a traceback
-            raise ValueError(
-                f"{what}: calling it with no arguments raised {type(exc).__name__}: {exc}"
-            ) from exc
-        if callable(getattr(made, "mueller", None)):
-            return made
-        raise ValueError(
-            f"{what}: calling it returned {type(made).__name__}, not a model (no mueller method)"
-        )
-    raise ValueError(
-        f"{what}: {type(obj).__name__} is not a model (no mueller method) nor a callable returning one"
-    )
-
-
 def load_model(spec: str):
     """The model ``MODULE:NAME`` names: an instance, or a class or callable returning one.
 
@@ -271,37 +250,7 @@ def load_model(spec: str):
         if not hasattr(obj, part):
             raise ValueError(f"model {spec!r}: {module!r} has no attribute {name!r}")
         obj = getattr(obj, part)
-    return _resolve(obj, f"model {spec!r}")
-
-
-@dataclass(frozen=True)
-class Contributed:
-    """A model another package registers in the ``scatterbench.models`` entry-point group:
-    the entry's name, its ``module:attr``, the distribution that ships it, and the model
-    (``None``, with ``error``, when it cannot be loaded)."""
-
-    name: str
-    value: str
-    dist: str
-    model: object = None
-    error: str | None = None
-
-
-def contributed_models() -> list[Contributed]:
-    """Every model registered in the ``scatterbench.models`` entry-point group, sorted by name;
-    an entry that fails to load is listed with its error, not raised."""
-    from importlib.metadata import entry_points
-
-    out = []
-    for ep in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
-        dist = f"{ep.dist.name} {ep.dist.version}" if ep.dist is not None else "?"
-        try:
-            model = _resolve(ep.load(), f"entry point {ep.name!r}")
-        except Exception as exc:  # noqa: BLE001 - a broken plug-in is reported, not fatal
-            out.append(Contributed(ep.name, ep.value, dist, None, f"{type(exc).__name__}: {exc}"))
-            continue
-        out.append(Contributed(ep.name, ep.value, dist, model))
-    return out
+    return resolve(obj, f"model {spec!r}")
 
 
 def format_contributed(contributed=None) -> str:

@@ -33,12 +33,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scatterbench import models
-from scatterbench.models.constraints import HasMethods
-from scatterbench.models.params import param
+from scatterbench.models.contributed import Conformant, as_model
+from scatterbench.validation.numerics.probes import fp_warnings
+from scatterbench.validation.studies import edge_sweep
 from scatterbench.validation.studies.findings import Finding
 
-from .common import fp_warnings
 from .registry import Check, CheckContext, judge
 
 __all__ = [
@@ -142,10 +141,9 @@ def model_check(*, tests, slow=False):
 
 def conformance_checks(names=None):
     """The registered conformance checks in run order, or those named (``ValueError``
-    naming an unknown one)."""
-    from . import conformance_checks as _checks  # noqa: F401  (registers the checks)
-    from . import conformance_scatmech as _scatmech  # noqa: F401
-
+    naming an unknown one).  (The package's ``__init__`` imports the modules that register
+    them, :mod:`.conformance_checks` and :mod:`.conformance_scatmech`, before this one can be
+    called.)"""
     if names is None:
         return list(_MODEL_CHECKS.values())
     unknown = [n for n in names if n not in _MODEL_CHECKS]
@@ -222,67 +220,6 @@ def _run_one(spec, model, ctx):
 
 
 # --------------------------------------------------------------------------- the model view
-class _NotYetAModel(HasMethods):
-    """An object with a ``mueller`` method that is not a :class:`scatterbench.models.Model`
-    (:func:`as_model` takes those as they are)."""
-
-    def __init__(self):
-        super().__init__("mueller", text="an object with a mueller(theta_i, theta_r, phi_r) method")
-
-    def check(self, name, value):
-        if isinstance(value, models.Model):
-            self.fail(name, value)
-        return super().check(name, value)
-
-
-@dataclass(frozen=True)
-class Conformant(models.Model):
-    """Any object with ``mueller(theta_i, theta_r, phi_r)``, seen as a :class:`scatterbench.models.Model`:
-    validated, broadcast and chunked angles, ``brdf``, and the optional attributes
-    (:data:`ATTRIBUTES`) with the defaults the kit documents."""
-
-    model: object = param(dataclasses.MISSING, "the wrapped model", _NotYetAModel())
-
-    @property
-    def depolarizing(self):  # type: ignore[override]
-        return not callable(getattr(self.model, "jones", None))
-
-    @property
-    def reciprocal(self):  # type: ignore[override]
-        return bool(getattr(self.model, "reciprocal", True))
-
-    @property
-    def transmission(self):  # type: ignore[override]
-        return bool(getattr(self.model, "transmission", False))
-
-    @property
-    def mirror_symmetric(self):  # type: ignore[override]
-        return bool(getattr(self.model, "mirror_symmetric", False))
-
-    def _mueller16(self, ti, tr, pr):
-        M = np.asarray(self.model.mueller(ti, tr, pr), dtype=float)
-        return M.reshape(len(ti), 16).T
-
-    def _jones_flat(self, ti, tr, pr):
-        return np.asarray(self.model.jones(ti, tr, pr), dtype=complex).reshape(len(ti), 2, 2)
-
-    def rotated(self, angle):
-        rot = getattr(self.model, "rotated", None)
-        return self if rot is None else Conformant(model=rot(angle))
-
-    def lobe(self, theta_i):
-        lobe = getattr(self.model, "lobe", None)
-        return None if lobe is None else lobe(theta_i)
-
-    def __repr__(self):
-        return repr(self.model)
-
-
-def as_model(obj):
-    """``obj`` itself if it is a :class:`scatterbench.models.Model`, else its :class:`Conformant` view."""
-    return obj if isinstance(obj, models.Model) else Conformant(model=obj)
-
-
 def claims(model, attribute, default):
     """The model's optional ``attribute`` (:data:`ATTRIBUTES`), ``default`` when unset."""
     return getattr(model, attribute, default)
@@ -310,7 +247,6 @@ def accepted_reason(model, kind, fields, accepted=None):
     entries ``accepted``) that explains a ``kind`` of finding with these numeric ``fields``
     on one of scatterbench's own models, else ``None``: only scatterbench's models carry
     accepted findings."""
-    from scatterbench.validation.studies import edge_sweep
 
     if not type(model).__module__.startswith("scatterbench.models."):
         return None

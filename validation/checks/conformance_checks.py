@@ -20,9 +20,20 @@ import numpy as np
 from scatterbench import models
 from scatterbench.models.params import Declared
 from scatterbench.models.polarization import coherency_eigenvalues
+from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import extreme_geometries, random_geometries
+from scatterbench.validation.numerics.reciprocity import reciprocity_errors
+from scatterbench.validation.studies.edge_sweep import (
+    classify,
+    edge_geometries,
+    edge_instances,
+    energy_fields,
+    load_accepted,
+    model_hit_fraction,
+    sweep_model,
+)
 from scatterbench.validation.studies.findings import Finding
 
-from .common import extreme_geometries, random_geometries
 from .conformance import (
     accepted_reason,
     as_model,
@@ -70,7 +81,6 @@ def kit_geometries(model):
     30, 60, 89.99, 90 deg; exact specular and retroreflection; phi 0, +-pi, pi/2, 1e-12),
     the stability sweep's edge geometries of ``model`` (critical angles of its declared
     indices +- 1e-9), and 200 seeded random interior ones."""
-    from scatterbench.validation.studies.edge_sweep import edge_geometries
 
     parts = [extreme_geometries(), edge_geometries(model), random_geometries(200, seed=14, max_deg=89.0)]
     return tuple(np.concatenate(p) for p in zip(*parts, strict=True))
@@ -320,7 +330,6 @@ def _reciprocity_errors(model, ctx):
     """``(geometry, errors, note)``: :func:`scatterbench.validation.numerics.reciprocity.reciprocity_errors`
     on the grid, kept where both paths are finite (non-finite values are the finite check's
     failure), with the geometries they belong to."""
-    from scatterbench.validation.numerics.reciprocity import reciprocity_errors
 
     ti, tr, pr, M, J, _ = _grid(model, ctx)
     e = reciprocity_errors(as_model(model), ti, tr, pr, mueller=M, jones=J)
@@ -389,7 +398,6 @@ def _energy_reason(model, ti, r, bound):
     integrated reflectance ``r`` above ``bound`` at ``ti``, from the fields the stability
     sweep gives its energy findings (:func:`scatterbench.validation.studies.edge_sweep.energy_fields`);
     the hit fraction (an integral) only when needed."""
-    from scatterbench.validation.studies.edge_sweep import energy_fields, load_accepted, model_hit_fraction
 
     accepted = load_accepted()
     fields = energy_fields(model, ti, r.value, r.error, bound, hit=False)
@@ -400,7 +408,6 @@ def _energy_reason(model, ti, r, bound):
 
 
 def _energy_ladder(model, ctx):
-    from scatterbench.validation.numerics.integrate import integrated_reflectance
 
     view = as_model(model)
     out = []
@@ -496,12 +503,6 @@ def check_pickle(model, ctx):
     slow=True,
 )
 def check_parameter_extremes(model, ctx):
-    from scatterbench.validation.studies.edge_sweep import (
-        classify,
-        edge_instances,
-        load_accepted,
-        sweep_model,
-    )
 
     if not isinstance(model, Declared) or not type(model).parameters():
         return skipped(

@@ -24,7 +24,22 @@ import tempfile
 import numpy as np
 
 from scatterbench import models, references
+from scatterbench.models import scene
+from scatterbench.models import scene as scene_mod
 from scatterbench.models.geometry import signed_inplane
+from scatterbench.validation.fitting.compare import seed003_pairing
+from scatterbench.validation.fitting.datafile import Dataset, load_data
+from scatterbench.validation.fitting.executors import make_executor
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.inversion import fit_curve, invert
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.recovery import recovery_study, subsample
+from scatterbench.validation.fitting.sampling import (
+    ChainSettings,
+    CheckpointBackend,
+    initial_ball,
+    run_chain,
+)
 
 from .registry import check, judge
 
@@ -51,7 +66,6 @@ def _synthetic(model):
         ]
     )
     inc = np.tile([1.0, 0.0, 1.0, 0.0], (len(g), 1))
-    from scatterbench.validation.fitting.datafile import Dataset
 
     b = np.einsum("nij,nj->ni", model.mueller(g[:, 0], g[:, 1], g[:, 2]), inc)[:, 0]
     k = b > 0
@@ -60,7 +74,6 @@ def _synthetic(model):
 
 @check(paper="seed 000 Sec. 4 (slope distribution from the BRDF)")
 def check_inversion_round_trip(ctx):
-    from scatterbench.validation.fitting.inversion import fit_curve, invert
 
     out = []
     for slopes in (models.ExponentialSlopes(0.1), models.GaussianSlopes(0.15, coverage=0.8)):
@@ -97,17 +110,6 @@ class InterruptAfter:
 
 @check(paper="fitting machinery (emcee checkpoints)")
 def check_resume_identity(ctx):
-    from scatterbench.models import scene
-    from scatterbench.validation.fitting.datafile import load_data
-    from scatterbench.validation.fitting.fitspec import fitspec_from
-    from scatterbench.validation.fitting.likelihood import Likelihood
-    from scatterbench.validation.fitting.recovery import subsample
-    from scatterbench.validation.fitting.sampling import (
-        ChainSettings,
-        CheckpointBackend,
-        initial_ball,
-        run_chain,
-    )
 
     sc = scene.load(
         os.path.join(os.path.dirname(references.__file__), "scenes", "aluminium_flakes_clearcoat.toml")
@@ -151,7 +153,6 @@ STUDY_WORKERS = 2
 def recovery_settings(quick, seed=0):
     """The recovery study's configuration (its chain a :class:`ChainSettings` with ``seed``):
     quick runs use that of tests/test_recovery.py."""
-    from scatterbench.validation.fitting.settings import ChainSettings
 
     if quick:
         return dict(
@@ -177,11 +178,6 @@ def recovery_settings(quick, seed=0):
 
 def _recovery(quick, seed, executor=None):
     """The recovery study of the run (on ``executor``, default: :func:`recovery_settings`' workers)."""
-    from scatterbench.models import scene as scene_mod
-    from scatterbench.validation.fitting.datafile import load_data
-    from scatterbench.validation.fitting.executors import make_executor
-    from scatterbench.validation.fitting.fitspec import fitspec_from
-    from scatterbench.validation.fitting.recovery import recovery_study
 
     rs = recovery_settings(quick, seed)
     sc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
@@ -231,7 +227,6 @@ STRONG_DBIC = 10.0
 def comparison_settings(quick):
     """Seed 003's model comparison, ``dict(rows, settings)``: quick runs use the configuration of
     tests/test_recovery.py (the same seed, so a test session fits it once)."""
-    from scatterbench.validation.fitting.settings import ChainSettings
 
     if quick:
         return dict(
@@ -247,8 +242,6 @@ def comparison_settings(quick):
 
 
 def _comparison(quick):
-    from scatterbench.validation.fitting.compare import seed003_pairing
-    from scatterbench.validation.fitting.executors import make_executor
 
     # the full run's 8 fits on both cores: 63.1 s in-process, 34.3 s on 2 workers
     # (benchmarks/study_workers.py); the quick run's take seconds, less than starting workers

@@ -161,9 +161,9 @@ def check(*, paper, slow=False, findings=()):
 
 
 def registered(quick=False):
-    """The registered checks in run order; ``quick`` leaves out the slow ones."""
-    import scatterbench.validation.checks  # noqa: F401  (importing the package registers every check module)
-
+    """The registered checks in run order; ``quick`` leaves out the slow ones.  (This module
+    is imported through its package, whose ``__init__`` imports every check module first: the
+    registry is complete whenever it can be read.)"""
     return [s for s in _CHECKS.values() if not (quick and s.slow)]
 
 
@@ -288,6 +288,4 @@ def text_section(fn):
 
 def texts():
     """The registered text sections, in order."""
-    import scatterbench.validation.checks  # noqa: F401
-
     return list(_TEXTS)

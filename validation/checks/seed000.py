@@ -14,17 +14,11 @@ import numpy as np
 from scatterbench import models, references
 from scatterbench.validation.numerics.energy import exposed_reflectance, hit_fraction
 from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import extreme_geometries, random_geometries
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
 from scatterbench.validation.studies.findings import Finding
 
-from .common import (
-    count_extremes,
-    extreme_geometries,
-    facet_suite,
-    random_geometries,
-    slope_conversion_errors,
-    slope_normalization_errors,
-)
+from .common import count_extremes, facet_suite, slope_conversion_errors, slope_normalization_errors
 from .conformance_scatmech import scatmech_tolerance
 from .registry import check, judge, text_section
 from .table1 import compute_table1, format_table1

@@ -10,17 +10,19 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import integrate
 
 from scatterbench import models, references
 from scatterbench.models.cook_torrance import fresnel_real_printed
 from scatterbench.models.facet import local_cosine
 from scatterbench.models.geometry import refracted_cos
 from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import extreme_geometries
+from scatterbench.validation.numerics.probes import random_geometries as _geoms
 from scatterbench.validation.numerics.reciprocity import reciprocity_error, reversed_mueller
 from scatterbench.validation.studies.findings import Finding
 
-from .common import count_extremes, extreme_geometries, slope_normalization_errors
-from .common import random_geometries as _geoms
+from .common import count_extremes, slope_normalization_errors
 from .registry import check, judge, text_section
 
 __all__ = [
@@ -647,7 +649,6 @@ def cauchy_disc_integrals(radii=(10.0, 100.0, 1000.0), d=1.0):
     """Integrals over discs of radius X (centred below the source) of Eq. 25's
     ``d / (pi (d^2 + x^2))`` and of a point source's irradiance on the plane,
     ``d / (2 pi (d^2 + x^2)^{3/2})`` (per unit emitted power), by quadrature."""
-    from scipy import integrate
 
     out = {}
     for X in radii:

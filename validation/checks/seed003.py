@@ -19,10 +19,11 @@ from scatterbench.models.polarization import reciprocal_mueller
 from scatterbench.models.smooth_interface import internal_hemispherical_reflectance
 from scatterbench.validation.numerics.grid import grid_reflectance
 from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import random_geometries
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
 from scatterbench.validation.studies.findings import Finding
 
-from .common import count_extremes, random_geometries
+from .common import count_extremes
 from .conformance_scatmech import SCATMECH_FLOOR, scatmech_tolerance
 from .fig1 import N_INDEX, SIGMAS, THETA_I, fig1
 from .registry import check, judge, text_section

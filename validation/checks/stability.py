@@ -7,6 +7,8 @@ draws the same one.  Quick runs skip its energy integrals, as the quick report d
 
 from __future__ import annotations
 
+from scatterbench.validation.studies.edge_sweep import classify, sweep
+
 from .registry import check, judge
 
 __all__ = ["sweep_findings"]
@@ -14,7 +16,6 @@ __all__ = ["sweep_findings"]
 
 def sweep_findings(ctx):
     """The sweep's findings for the run (energy integrals only in full runs), once per run."""
-    from scatterbench.validation.studies.edge_sweep import sweep
 
     return ctx.compute(sweep, energy=not ctx.quick)
 
@@ -22,7 +23,6 @@ def sweep_findings(ctx):
 @check(paper="every model at its extremes (stability sweep, accepted_findings.toml)")
 def check_stability(ctx, findings=None):
     """``findings``: :func:`sweep_findings`; each must be accepted, with its reason."""
-    from scatterbench.validation.studies.edge_sweep import classify
 
     ok, bad = classify(sweep_findings(ctx) if findings is None else findings)
     shown = "; ".join(f"{f.model} {f.kind} at {f.where}" for f, _ in bad[:3])

@@ -6,6 +6,9 @@ import os
 import sys
 import time
 
+from scatterbench.validation.atomic import atomic_write_json
+from scatterbench.validation.testing import check_model, load_model
+
 from .args import UsageError, writable_file
 
 __all__ = ["register", "run"]
@@ -15,8 +18,6 @@ def run(spec, json_path=None, quick=False, checks=None) -> int:
     """Check the model ``spec`` names, print the table, write ``json_path`` (strict JSON,
     atomically) if given; 0 when no check fails, 1 when one does.  A bad argument raises
     :class:`~scatterbench.validation.cli.args.UsageError` (the command line: ``error: ...``, exit 2)."""
-    from scatterbench.validation.atomic import atomic_write_json
-    from scatterbench.validation.testing import check_model, load_model
 
     # like pytest, a module beside the user is importable: `scatterbench check mybrdf:Model`
     if os.getcwd() not in sys.path:

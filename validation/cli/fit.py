@@ -13,6 +13,15 @@ import os
 import sys
 import time
 
+from scatterbench.models import scene as scene_mod
+from scatterbench.validation.fitting.checkpoint import saved_steps
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.executors import make_executor
+from scatterbench.validation.fitting.fit import run_fit, write_fit
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.settings import MOVES, ChainSettings
+
 from .args import MAX_WORKERS, UsageError, int_in, scheduler_address, writable_folder
 
 __all__ = ["register"]
@@ -41,7 +50,6 @@ def _check_executor(args):
 def _open_executor(args):
     """The executor ``--workers``/``--scheduler`` ask for, its description printed.  A
     scheduler that does not answer raises ``SchedulerError``, an input error (exit 2)."""
-    from scatterbench.validation.fitting.executors import make_executor
 
     ex = make_executor(args.workers, args.scheduler)
     print(f"executor: {ex.describe()}")
@@ -93,7 +101,6 @@ def _spec_args(p):
 
 def _mcmc_args(p, walkers=None, max_steps=None):
     """The sampler flags; defaults: :class:`ChainSettings`' unless ``walkers``/``max_steps`` given."""
-    from scatterbench.validation.fitting.settings import MOVES, ChainSettings
 
     d = ChainSettings()
     p.add_argument("--walkers", type=int, default=walkers or d.walkers)
@@ -115,10 +122,6 @@ def _mcmc_args(p, walkers=None, max_steps=None):
 def _load(args):
     """The scene, data, fit spec and likelihood of the command line, every one checked
     (and against each other) before any work."""
-    from scatterbench.models import scene as scene_mod
-    from scatterbench.validation.fitting.datafile import load_data
-    from scatterbench.validation.fitting.fitspec import fitspec_from
-    from scatterbench.validation.fitting.likelihood import Likelihood
 
     sc = scene_mod.load(args.scene)
     data = load_data(args.data)
@@ -145,7 +148,6 @@ def _load_and_describe(args):
 def _chain_settings(args):
     """The sampler settings of fit and the studies, built from their flags here and only
     here; a flag out of range is a :class:`UsageError` naming it."""
-    from scatterbench.validation.fitting.settings import ChainSettings
 
     try:
         return ChainSettings(
@@ -170,7 +172,6 @@ def _require_walkers(settings, ndim):
 
 def _interrupted(ck, final):
     """The one line Ctrl-C prints: where the chain is and how to continue it."""
-    from scatterbench.validation.fitting.checkpoint import saved_steps
 
     saved = ck if os.path.exists(ck) else final if os.path.exists(final) else None
     if saved is None:
@@ -192,7 +193,6 @@ def _run_fit(args, lik, settings):
     posterior summary, or the exit code 130 after Ctrl-C.  The running checkpoint is
     chain.partial.npz; it becomes chain.npz when the run ends, so a failed --force
     run never replaces a previous complete chain."""
-    from scatterbench.validation.fitting.fit import run_fit, write_fit
 
     os.makedirs(args.out, exist_ok=True)
     ck = os.path.join(args.out, "chain.partial.npz")

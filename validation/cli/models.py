@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from scatterbench import models
+from scatterbench.validation.testing import format_contributed
+
 __all__ = ["register"]
 
 
 def _cmd_models(args) -> int:
-    from scatterbench import models
-    from scatterbench.validation.testing import format_contributed
 
     print(models.list_models())
     print(format_contributed())

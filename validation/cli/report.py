@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import os
 
+from scatterbench.validation.report import nightly, write_report
+
 from .args import nonneg_float, writable_folder
 
 
 def _report(args) -> int:
-    from scatterbench.validation.report import write_report
 
     writable_folder(args.out, "--out")
     res = write_report(args.out, quick=args.quick)
@@ -23,7 +24,6 @@ def _report(args) -> int:
 
 
 def _nightly(args) -> int:
-    from scatterbench.validation.report import nightly
 
     run = nightly(args.history, quick=args.quick, wait=args.wait)
     print(f"nightly run written to {run.run_dir}; latest -> {os.path.relpath(run.run_dir, args.history)}")

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
+from scatterbench.models import scene as scene_mod
+from scatterbench.validation.studies.scenes import write_scene_outputs
+
 from .args import positive_float, writable_folder
 
 __all__ = ["register"]
 
 
 def _cmd_scene(args) -> int:
-    from scatterbench.models import scene as scene_mod
-    from scatterbench.validation.studies.scenes import write_scene_outputs
 
     writable_folder(args.out, "--out")
     sc = scene_mod.load(args.file)

@@ -17,6 +17,16 @@ import time
 
 import numpy as np
 
+from scatterbench.models import DetectorAperture
+from scatterbench.models import scene as scene_mod
+from scatterbench.validation.atomic import atomic_savefig, atomic_write_json
+from scatterbench.validation.fitting.compare import check_comparable, compare_fits, format_comparison
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.fitspec import fitspec_from, masked_rows
+from scatterbench.validation.fitting.inversion import inversion_figure, inversion_study
+from scatterbench.validation.fitting.likelihood import Likelihood, scene_for_data
+from scatterbench.validation.fitting.recovery import check_inputs, recovery_study
+
 from .args import UsageError, int_at_least, ints_at_least, positive_floats
 from .fit import (
     _chain_settings,
@@ -56,8 +66,6 @@ def _print_recovery(cells, injections):
 
 
 def _cmd_recovery(args) -> int:
-    from scatterbench.validation.atomic import atomic_write_json
-    from scatterbench.validation.fitting.recovery import check_inputs, recovery_study
 
     _check_out(args.out, args.force)
     _check_executor(args)
@@ -106,12 +114,10 @@ def _cmd_recovery(args) -> int:
 
 
 def _recovery_plot(cells, out):
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from scatterbench.validation.atomic import atomic_savefig
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     keys = list(cells[0]["summary"])
     fig, axes = plt.subplots(3, len(keys), figsize=(4.5 * len(keys), 8), squeeze=False)
@@ -147,11 +153,6 @@ def _recovery_plot(cells, out):
 # ----------------------------------------------------------------------------- inversion
 def _inversion_model(args):
     """The data (masked) and the scene's model for them, at a point detector."""
-    from scatterbench.models import DetectorAperture
-    from scatterbench.models import scene as scene_mod
-    from scatterbench.validation.fitting.datafile import load_data
-    from scatterbench.validation.fitting.fitspec import masked_rows
-    from scatterbench.validation.fitting.likelihood import scene_for_data
 
     sc = scene_mod.load(args.scene)
     data = masked_rows(load_data(args.data), args.near_specular_deg, args.exclude)
@@ -183,13 +184,10 @@ def _print_inversion(study):
 
 
 def _cmd_inversion(args) -> int:
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from scatterbench.validation.atomic import atomic_savefig, atomic_write_json
-    from scatterbench.validation.fitting.inversion import inversion_figure, inversion_study
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     _check_out(args.out, args.force)
     data, model = _inversion_model(args)
@@ -212,10 +210,6 @@ def _cmd_inversion(args) -> int:
 # ----------------------------------------------------------------------------- compare
 def _compare_likelihoods(args):
     """One likelihood per ``--scene`` on the data, named by the scene file."""
-    from scatterbench.models import scene as scene_mod
-    from scatterbench.validation.fitting.datafile import load_data
-    from scatterbench.validation.fitting.fitspec import fitspec_from
-    from scatterbench.validation.fitting.likelihood import Likelihood
 
     data = load_data(args.data)
     liks, names = [], []
@@ -228,8 +222,6 @@ def _compare_likelihoods(args):
 
 
 def _cmd_compare(args) -> int:
-    from scatterbench.validation.atomic import atomic_write_json
-    from scatterbench.validation.fitting.compare import check_comparable, compare_fits, format_comparison
 
     _check_out(args.out, args.force)
     _check_executor(args)

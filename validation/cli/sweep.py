@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import time
 
+from scatterbench.validation.studies.edge_sweep import classify, format_sweep, sweep
+
 from .fit import _check_executor, _executor_args, _open_executor
 
 __all__ = ["register"]
 
 
 def _cmd_stability(args) -> int:
-    from scatterbench.validation.studies.edge_sweep import classify, format_sweep, sweep
 
     _check_executor(args)
     t0 = time.perf_counter()

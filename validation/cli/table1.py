@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+from scatterbench.validation.checks.table1 import compute_table1, format_table1
+
 from .args import positive_float
 
 __all__ = ["register"]
 
 
 def _cmd_table1(args) -> int:
-    from scatterbench.validation.checks.table1 import compute_table1, format_table1
 
     rows, seconds = compute_table1(tol=args.tol)
     print(format_table1(rows))

@@ -2,19 +2,21 @@
 
 from __future__ import annotations
 
+import os
+
+from scatterbench.validation.atomic import atomic_savefig, atomic_write_json
+from scatterbench.validation.studies.tradeoff import BATCH, MIN_BATCHES, MIN_WORK, choose, pareto, study
+
 from .args import positive_float, writable_folder
 
 __all__ = ["register"]
 
 
 def _plot(results, path):
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from scatterbench.validation.atomic import atomic_savefig
-    from scatterbench.validation.studies.tradeoff import pareto
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 4.2), squeeze=False)
     for ax, r in zip(axes[0], results, strict=True):
@@ -37,7 +39,6 @@ def _plot(results, path):
 
 
 def _print_knob(r, tol):
-    from scatterbench.validation.studies.tradeoff import choose, pareto
 
     print(f"{r.knob}: {r.quantity}")
     print(f"  reference: {r.reference}")
@@ -60,10 +61,6 @@ def _print_knob(r, tol):
 
 
 def _cmd_tradeoff(args) -> int:
-    import os
-
-    from scatterbench.validation.atomic import atomic_write_json
-    from scatterbench.validation.studies.tradeoff import BATCH, MIN_BATCHES, MIN_WORK, study
 
     writable_folder(args.out, "--out")  # refused before the study, not after
     skipped = {}

@@ -8,6 +8,18 @@ from __future__ import annotations
 
 import time
 
+from scatterbench.validation.atomic import atomic_write_json
+from scatterbench.validation.checks.registry import (
+    CheckContext,
+    check_record,
+    format_checks,
+    run_checks,
+    tally,
+    texts,
+)
+
+from .args import writable_file
+
 __all__ = ["register", "run"]
 
 
@@ -19,15 +31,6 @@ def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
     (e.g. with a report built on it); ``specs``: the checks (default: every registered
     check, less the slow ones when ``quick``).
     """
-    from scatterbench.validation.atomic import atomic_write_json
-    from scatterbench.validation.checks.registry import (
-        CheckContext,
-        check_record,
-        format_checks,
-        run_checks,
-        tally,
-        texts,
-    )
 
     t0 = time.perf_counter()
     ctx = ctx if ctx is not None else CheckContext(quick=quick)
@@ -51,8 +54,6 @@ def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
 
 def _cmd_validate(args) -> int:
     if args.json:
-        from .args import writable_file
-
         writable_file(args.json, "--json")
     return run(quick=args.quick, json_path=args.json)
 

@@ -16,7 +16,15 @@ import math
 import numpy as np
 from scipy.special import logsumexp
 
+from scatterbench import references
+from scatterbench.models import scene as scene_mod
+
+from .datafile import load_data
+from .executors import SerialExecutor
 from .fit import information_criteria, predictive, predictive_checks, run_fit
+from .fitspec import fitspec_from
+from .likelihood import Likelihood
+from .recovery import subsample
 from .settings import ChainSettings
 
 __all__ = ["waic", "check_comparable", "compare_fits", "format_comparison", "seed003_pairing"]
@@ -86,7 +94,6 @@ def _ranked(rows):
 def _compare_groups(groups, settings, executor):
     """:func:`compare_fits` of several ``(liks, names)`` groups with one map over all
     their fits (so every worker has a fit to run), results regrouped in order."""
-    from .executors import SerialExecutor
 
     jobs = [(lik, nm, settings) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
     done = (executor or SerialExecutor()).map(_fit_and_row, jobs, tasks=len(jobs))
@@ -174,13 +181,6 @@ def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf")
 def _pairing_cases(rows, terms):
     """The pairing's cases (``{"data", "generator", "terms"}``) and, for each, the
     ``(likelihoods, hypothesis names)`` to compare."""
-    from scatterbench import references
-    from scatterbench.models import scene as scene_mod
-
-    from .datafile import load_data
-    from .fitspec import fitspec_from
-    from .likelihood import Likelihood
-    from .recovery import subsample
 
     scenes = {h: scene_mod.load(references.scene_path(f)) for h, f in SEED003_PAIRING["scenes"].items()}
     cases, groups = [], []

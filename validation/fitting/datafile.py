@@ -63,6 +63,7 @@ import numpy as np
 from scatterbench.models.constraints import interval_notation
 from scatterbench.models.polarization import ellipsometric, stokes
 from scatterbench.models.text import is_number, long_digits, read_utf8, shown, where
+from scatterbench.validation.atomic import atomic_write_json, atomic_write_text
 
 __all__ = ["DataFileError", "Dataset", "load_data", "write_data", "COLUMNS", "SIDECAR_KEYS"]
 
@@ -460,7 +461,6 @@ def write_data(path, columns: dict, meta: dict | None = None, comments=()):
     for ``incident``, to a list of strings.  Numbers are written with 17
     significant digits so a round trip is exact.
     """
-    from scatterbench.validation.atomic import atomic_write_json, atomic_write_text
 
     names = list(columns)
     for n in names:

@@ -29,7 +29,12 @@ import concurrent.futures as cf
 import contextlib
 import hashlib
 import multiprocessing
+import os
 import pickle
+import signal
+import threading
+
+from threadpoolctl import threadpool_limits
 
 from .settings import _integer
 
@@ -66,7 +71,6 @@ _WORKER_FNS: dict = {}
 
 def _local_cores() -> int:
     """The cores this process may run on (its affinity: a container's limit, not the host's)."""
-    import os
 
     try:
         return len(os.sched_getaffinity(0))
@@ -97,12 +101,11 @@ def _share_cores(threads):
     per thread (a Dask worker's task threads each set theirs); the BLAS limit is per process
     and applied once."""
     global _LIMITED
-    import numba
+    import numba  # numba (heavy): loaded only in a worker that runs kernels
 
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     if _LIMITED != threads:
         import scipy.linalg  # noqa: F401  (loads scipy's own BLAS now, so that the limit covers it)
-        from threadpoolctl import threadpool_limits
 
         threadpool_limits(limits=threads)
         _LIMITED = threads
@@ -112,7 +115,6 @@ def _worker_init(threads):
     """A local worker's set-up: it leaves Ctrl-C to the parent (which stops the pool and says
     how to resume: the terminal sends it to every process of the group, and each would print
     a traceback) and runs on its share of the cores (:func:`_share_cores`)."""
-    import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _share_cores(threads)
@@ -132,8 +134,6 @@ def _sigint_between_calls():
     """Ctrl-C during the block is held until the caller asks (``pending()``): a
     KeyboardInterrupt raised inside emcee's wrapper of the log-probability makes it print
     a traceback; raised between calls, the fit stops with one line saying how to resume."""
-    import signal
-    import threading
 
     got = []
     if (
@@ -217,7 +217,7 @@ class DaskExecutor(SerialExecutor):
     kind = "dask"
 
     def __init__(self, address_or_client, timeout=None):
-        from dask.distributed import Client
+        from dask.distributed import Client  # dask.distributed (heavy): loaded only for a cluster
 
         timeout = SCHEDULER_TIMEOUT if timeout is None else timeout
 
@@ -264,7 +264,7 @@ def _dask_kernel_threads(info, cores):
 def _run_chunk_dask(fn, chunk, threads):
     """A chunk on a Dask worker, on the worker's share of its host's cores (:func:`_share_cores`;
     one thread for a worker that joined after the executor was made)."""
-    from dask.distributed import get_worker
+    from dask.distributed import get_worker  # dask.distributed (heavy): loaded only for a cluster
 
     _share_cores(threads.get(get_worker().address, 1))
     return _run_chunk(fn, chunk)

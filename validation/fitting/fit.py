@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench.models.polarization import wrap_axis
+from scatterbench.validation.atomic import atomic_savefig, atomic_write_json
 
 from .checkpoint import CheckpointBackend
 from .likelihood import TERMS, Likelihood, replicate, term_variances
@@ -218,7 +219,6 @@ def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", p
     """Write posterior.json (strict JSON; the wall-clock measurements under ``timing``, so
     the rest is the same, byte for byte, for the same inputs and seed) and the plots into
     ``out`` (atomic writes)."""
-    from scatterbench.validation.atomic import atomic_write_json
 
     os.makedirs(out, exist_ok=True)
     pp = predictive(fit, n_draws=n_draws, seed=fit.settings.seed)
@@ -254,10 +254,10 @@ def write_fit(fit: FitResult, out, *, data_path, scene_path, executor_desc="", p
 
 def corner_figure(fit: FitResult):
     """Corner plot of the posterior (physical units), truths from the data's sidecar if any."""
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import corner
+    import corner  # corner (with matplotlib, heavy): loaded only where a corner plot is drawn
 
     spec = fit.spec
     u = fit.chain.samples()
@@ -277,10 +277,10 @@ def corner_figure(fit: FitResult):
 
 def predictive_figure(fit: FitResult, pp):
     """Posterior-predictive 95% bands (model and replicated data) with the data, per scan and term."""
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     data = fit.lik.data_all
     xs, labels = scan_x(data)
@@ -318,12 +318,10 @@ def predictive_figure(fit: FitResult, pp):
 
 
 def _plots(fit, pp, out):
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from scatterbench.validation.atomic import atomic_savefig
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     spec = fit.spec
     fig = corner_figure(fit)

@@ -33,6 +33,8 @@ from scatterbench.models.base import Sum
 from scatterbench.models.facet import _FacetModel, facet_slopes
 from scatterbench.models.slopes import UnitSlopes
 
+from .fit import scan_x
+
 __all__ = [
     "UnitSlopes",
     "probed_slopes",
@@ -248,7 +250,6 @@ def inversion_study(model, data, bins=None, n_bootstrap=200, seed=0) -> Inversio
     -------
     InversionStudy
     """
-    from .fit import scan_x
 
     inv = invert(model, data)
     curve = fit_curve(inv, bins=bins)
@@ -259,10 +260,10 @@ def inversion_study(model, data, bins=None, n_bootstrap=200, seed=0) -> Inversio
 
 def inversion_figure(study: InversionStudy, model):
     """The P3 estimates per scan, the common curve and, for reference, the model's own P3."""
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     inv, curve = study.inversion, study.curve
     fig, ax = plt.subplots(figsize=(6, 4.2))

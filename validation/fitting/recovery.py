@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .executors import SerialExecutor
 from .fit import run_fit
 from .fitspec import FitSpec
 from .likelihood import Likelihood, replicate, term_variances
@@ -261,7 +262,6 @@ def recovery_study(
         One per cell: its level, geometries, truth, coverage summary, chain
         diagnostics and members.
     """
-    from .executors import SerialExecutor
 
     check_inputs(spec, chain, noise_extra, injections)
     cells, members = [], []

@@ -34,8 +34,10 @@ from types import SimpleNamespace
 import emcee
 import numpy as np
 from scipy import optimize as _opt
+from tqdm import tqdm
 
 from .checkpoint import CheckpointBackend, CheckpointError
+from .executors import _sigint_between_calls
 from .settings import ChainSettings
 
 __all__ = [
@@ -276,7 +278,6 @@ def _progress_bar(show, total, initial=0, unit="step", desc="emcee"):
     if not show:
         yield SimpleNamespace(update=lambda n: None)
         return
-    from tqdm import tqdm
 
     bar = tqdm(total=total, initial=initial, unit=unit, desc=desc, mininterval=1.0)
     try:
@@ -371,7 +372,6 @@ def _segment(sampler, state, n, bar, hold_sigint):
     """``n`` steps from ``state``.  ``hold_sigint``: Ctrl-C is held until the step ends and
     raised there, as the executors do between per-walker calls: a vectorized log-probability
     runs inside emcee's wrapper, which prints a traceback for an exception raised in it."""
-    from .executors import _sigint_between_calls
 
     with _sigint_between_calls() if hold_sigint else contextlib.nullcontext(lambda: False) as pending:
         for _ in sampler.sample(state, iterations=n, store=True):

@@ -9,6 +9,8 @@ import sys
 import time
 import traceback
 
+from tqdm import tqdm
+
 from scatterbench.validation.atomic import atomic_write_json, atomic_write_text
 from scatterbench.validation.checks.registry import SEED, check_record, judge, select, tally
 
@@ -21,7 +23,6 @@ __all__ = ["build_report", "write_report", "read_results_checked"]
 
 def _progress(total, label):
     """A tqdm bar on a terminal; silent in CI or when stderr is not a terminal."""
-    from tqdm import tqdm
 
     quiet = bool(os.environ.get("CI")) or not sys.stderr.isatty()
     return tqdm(total=total, desc=label, disable=quiet, unit="section", leave=False)

@@ -93,7 +93,7 @@ def figure_block(fig, caption, dpi=90):
     """A matplotlib figure embedded as a PNG data URI (no external file, no fetch)."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     plt.close(fig)
     return {

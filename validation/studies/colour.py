@@ -77,7 +77,7 @@ def film_reflectance(stack, cos_local, wavelengths_nm=WAVELENGTHS_NM, n_incident
 
 def _cmfs_d65(wavelengths_nm):
     """``(xbar, ybar, zbar)`` rows and D65 at ``wavelengths_nm`` (colour-science data)."""
-    import colour
+    import colour  # colour-science (heavy, optional): loaded only for thin-film colour
 
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     d65 = colour.SDS_ILLUMINANTS["D65"]
@@ -94,7 +94,7 @@ def _xyz(wavelengths_nm, reflectance):
 
 def srgb(wavelengths_nm, reflectance):
     """Gamma-encoded sRGB in [0, 1] (clipped) of reflectance spectra ``(..., n)`` under D65."""
-    import colour
+    import colour  # colour-science (heavy, optional): loaded only for thin-film colour
 
     rgb = colour.XYZ_to_sRGB(_xyz(wavelengths_nm, reflectance))
     return np.clip(rgb, 0.0, 1.0)
@@ -103,7 +103,7 @@ def srgb(wavelengths_nm, reflectance):
 def dominant_wavelength(wavelengths_nm, reflectance):
     """Dominant wavelength (nm) of a reflectance spectrum under D65 (colour-science's, from
     the chromaticity and the D65 white point; negative for a complementary one)."""
-    import colour
+    import colour  # colour-science (heavy, optional): loaded only for thin-film colour
 
     xy = colour.XYZ_to_xy(_xyz(wavelengths_nm, reflectance))
     white = colour.XYZ_to_xy(_xyz(wavelengths_nm, np.ones(len(wavelengths_nm))))

@@ -1,7 +1,7 @@
 """Stability sweep: every model at the edges of its parameter space and geometry.
 
 For each public model class (``models.Model.registry``), and each model another package
-contributes (``scatterbench.models`` entry points, :func:`scatterbench.validation.testing.contributed_models`),
+contributes (``scatterbench.models`` entry points, :func:`scatterbench.models.contributed.contributed_models`),
 the sweep builds instances at the edges of each declared parameter, one parameter at a time
 from the defaults (nested declared objects, such as slope distributions, are
 swept the same way), and evaluates them on edge geometries: polar angles 0,
@@ -39,10 +39,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench import models
+from scatterbench.models.contributed import as_model, contributed_models
 from scatterbench.models.params import Declared
 from scatterbench.models.polarization import coherency_eigenvalues
+from scatterbench.validation.fitting.executors import SerialExecutor
 from scatterbench.validation.numerics.energy import hit_fraction
 from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import fp_warnings
 from scatterbench.validation.numerics.reciprocity import reciprocity_error
 
 from .findings import Finding
@@ -162,7 +165,6 @@ def _label(ti, tr, pr):
 
 
 def _evaluate(model, ti, tr, pr, found, name, params):
-    from scatterbench.validation.checks.common import fp_warnings  # not at import: it loads every check
 
     with fp_warnings() as caught:
         M = model.mueller(ti, tr, pr)
@@ -316,7 +318,6 @@ def sweep(classes=None, energy=True, executor=None):
         default in-process).  The findings, and their order, are the same on any
         executor: each instance is swept alone and they are collected in order.
     """
-    from scatterbench.validation.fitting.executors import SerialExecutor
 
     targets = [(None, c) for c in classes] if classes is not None else _default_targets()
     tasks = [(name, inst) for name, cls in targets for inst in edge_instances(cls)]
@@ -326,8 +327,6 @@ def sweep(classes=None, energy=True, executor=None):
 
 
 def _default_targets():
-    from scatterbench.validation.checks.conformance import as_model
-    from scatterbench.validation.testing import contributed_models
 
     own = [(None, c) for c in models.Model.registry if c is not models.Sum]
     return own + [(c.name, as_model(c.model)) for c in contributed_models() if c.model is not None]

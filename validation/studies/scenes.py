@@ -9,6 +9,7 @@ The in-plane curve runs over the signed scattering angle from -89 to +89 deg
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import math
@@ -16,9 +17,12 @@ import os
 
 import numpy as np
 
+from scatterbench.models import PointSourceBRDF, RoughDiffuseBRDF
 from scatterbench.models.geometry import signed_inplane
 from scatterbench.models.polarization import ellipsometric
 from scatterbench.validation.atomic import atomic_savefig, atomic_write_text
+
+from .tradeoff import KNOBS, at_precision, choose, float32_unavailable
 
 __all__ = ["scan", "scene_csv", "write_scene_outputs"]
 
@@ -27,7 +31,6 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
     """The in-plane curve and the out-of-plane scan of ``model`` (default the scene's),
     evaluated at ``precision`` (``"float32"`` only where a float32 kernel evaluates the
     model, :func:`scatterbench.validation.studies.tradeoff.at_precision`).  Returns ``(model, rows)``."""
-    from .tradeoff import at_precision
 
     model = scene.build() if model is None else model
     mueller = model.mueller if precision == "float64" else at_precision(model, precision)
@@ -57,7 +60,6 @@ def scan(scene, n_inplane=357, n_azimuth=181, model=None, precision="float64"):
 def _pick(knob, tol, notes, **kw):
     """The cheapest measured setting of ``knob`` (run with ``kw``) meeting ``tol`` (the most
     accurate when none does, said so in ``notes``)."""
-    from .tradeoff import KNOBS, choose
 
     r = KNOBS[knob](quick=True, **kw)
     p = choose(r, tol)
@@ -74,7 +76,6 @@ def _pick(knob, tol, notes, **kw):
 def _choose_precision(model, tol, notes):
     """``"float32"`` when a float32 kernel evaluates ``model`` and its float32 error,
     measured on ``model`` itself, meets ``tol`` at a lower cost, else ``"float64"``."""
-    from .tradeoff import float32_unavailable
 
     reason = float32_unavailable(model)
     if reason is not None:
@@ -93,9 +94,6 @@ def choose_settings(scene, tol):
     tradeoff study, the precision on the scene's own model), or the most accurate
     measured setting, said so, when none does.
     """
-    import dataclasses
-
-    from scatterbench.models import PointSourceBRDF, RoughDiffuseBRDF
 
     notes = []
     n_inplane = int(_pick("in-plane grid", tol, notes))
@@ -179,10 +177,10 @@ def _plot_scan(axes, label, r, ti_deg):
 def write_scene_outputs(scene, out_dir, tol=None):
     """Write ``<stem>.csv`` and ``<stem>.png``; returns their paths (and notes on the
     settings chosen for ``tol``)."""
-    import matplotlib
+    import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     notes = []
     if tol is None:

@@ -46,6 +46,9 @@ from scatterbench.models import evaluation
 from scatterbench.models.geometry import signed_inplane
 from scatterbench.validation.numerics.energy import exposed_reflectance
 from scatterbench.validation.numerics.integrate import integrated_reflectance
+from scatterbench.validation.numerics.probes import (
+    random_geometries,  # not at import: it loads every check
+)
 
 __all__ = [
     "Point",
@@ -345,7 +348,6 @@ def knob_precision(quick=False, model=None):
             f"{reason}: it evaluates in float64 (and rounds a float32 request), so there is no "
             "float32 cost to measure"
         )
-    from scatterbench.validation.checks.common import random_geometries  # not at import: it loads every check
 
     ti, tr, pr = random_geometries(4096, seed=12, max_deg=85.0)
     measured = {

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from scatterbench.validation.testing import ENTRY_POINT_GROUP, contributed_section
+
 from ..core import table_block, text_block
 
 __all__ = ["ContributedData", "compute", "render"]
@@ -33,7 +35,6 @@ class ContributedData:
 
 
 def compute(ctx):
-    from scatterbench.validation.testing import ENTRY_POINT_GROUP, contributed_section
 
     return ContributedData(ENTRY_POINT_GROUP, tuple(contributed_section(ctx)))
 

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from scatterbench.validation.checks.stability import sweep_findings
+from scatterbench.validation.studies.edge_sweep import classify, group_findings, load_accepted
+
 from ..core import store_rows, table_block, text_block
 
 __all__ = ["StabilityData", "summarize", "compute", "render"]
@@ -49,7 +52,6 @@ def _group_row(g):
 def summarize(findings, accepted, quick=False):
     """The section's data from the sweep's ``findings`` and the ``accepted`` entries
     (:func:`scatterbench.validation.studies.edge_sweep.load_accepted`)."""
-    from scatterbench.validation.studies.edge_sweep import classify, group_findings
 
     ok, bad = classify(findings, accepted)
     rows = tuple(
@@ -68,8 +70,6 @@ def summarize(findings, accepted, quick=False):
 
 
 def compute(ctx):
-    from scatterbench.validation.checks.stability import sweep_findings
-    from scatterbench.validation.studies.edge_sweep import load_accepted
 
     return summarize(sweep_findings(ctx), load_accepted(), ctx.quick)  # the stability check's sweep
 

@@ -15,6 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from scatterbench.validation.checks.fitting import comparison_cases, comparison_settings
+from scatterbench.validation.fitting.compare import SEED003_PAIRING
+
 from ..core import figure_block, table_block, text_block
 from ._common import plt
 
@@ -115,8 +118,6 @@ def _comparison_rows(cases):
 
 
 def compute(ctx):
-    from scatterbench.validation.checks.fitting import comparison_cases, comparison_settings
-    from scatterbench.validation.fitting.compare import SEED003_PAIRING
 
     st = comparison_settings(ctx.quick)
     cases = comparison_cases(ctx)  # the model-comparison check's fits, run once

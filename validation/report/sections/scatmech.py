@@ -7,6 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench import models
+from scatterbench.validation.checks.seed000 import scatmech_facet_errors
+from scatterbench.validation.checks.seed003 import scatmech_error_distributions
 
 from ..core import figure_block, table_block, text_block
 from ._common import AL, finish, plt
@@ -25,7 +27,9 @@ class ScatmechData:
 
 
 def _live_scatmech(ctx):
-    from pySCATMECH.brdf import BRDF_Model
+    from pySCATMECH.brdf import (
+        BRDF_Model,  # pySCATMECH (optional peer: most machines have only the committed data)
+    )
 
     rng = np.random.default_rng(ctx.seed)
     out = []
@@ -53,8 +57,6 @@ def _row(label, e):
 
 
 def compute(ctx):
-    from scatterbench.validation.checks.seed000 import scatmech_facet_errors
-    from scatterbench.validation.checks.seed003 import scatmech_error_distributions
 
     errs = {f"{k} (committed)": v for k, v in scatmech_facet_errors().items()}
     errs.update(scatmech_error_distributions())

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench import references
+from scatterbench.models import scene as scene_mod
 
 from ..core import figure_block, table_block
 from ._common import finish, inplane, plt
@@ -27,7 +28,6 @@ class ScenesData:
 
 def _scene(path, x):
     """The row of one scene file and its curve (None if it builds nothing or fails to load)."""
-    from scatterbench.models import scene as scene_mod
 
     try:
         sc = scene_mod.load(path)

@@ -8,7 +8,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench import models, references
-from scatterbench.validation.checks.seed001 import RATIO_GEOMETRIES
+from scatterbench.validation.checks.seed001 import (
+    RATIO_GEOMETRIES,
+    _pair,
+    iron_plate_models,
+    point_source_collimated_error,
+    published_albedos,
+    published_over_energy_error,
+    varnish_ratio_map,
+)
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 
 from ..core import figure_block, table_block, text_block
@@ -89,7 +97,6 @@ def _ratio(a, b):
 
 def _varnish(n_t, n_p):
     """The varnish ratio maps and their summary rows (validation.checks.seed001.varnish_ratio_map)."""
-    from scatterbench.validation.checks.seed001 import _pair, varnish_ratio_map
 
     rows = [
         {
@@ -145,7 +152,6 @@ def point_source_scan(vn, lo, hi):
 def _point_source():
     """The iron plate (references.IRON_PLATE) under each printed incidence range, and the
     point source's approach to the collimated beam as it recedes."""
-    from scatterbench.validation.checks.seed001 import iron_plate_models, point_source_collimated_error
 
     _, vn = iron_plate_models()
     scans, rows = zip(
@@ -158,7 +164,6 @@ def _point_source():
 
 
 def compute(ctx):
-    from scatterbench.validation.checks.seed001 import published_albedos, published_over_energy_error
 
     ratio_err = ctx.compute(published_over_energy_error)  # the check's value, computed once
     albedo_rows = ct_albedo_rows(ctx.compute(published_albedos))  # the energy check's integrals

@@ -8,6 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench import models
+from scatterbench.validation.checks.fig1 import EFFECTIVE_INDEX_DEG, N_INDEX, SIGMAS, THETA_I
+from scatterbench.validation.checks.seed003 import fig1_rows
 
 from ..core import figure_block, table_block, text_block
 from ._common import finish, plt, signed
@@ -43,7 +45,6 @@ class Fig1Data:
 def _curves(rows, x):
     """Per sigma: the in-plane BTDF over ``x`` divided by its peak, and sin(mean theta_t) at
     :data:`scatterbench.validation.checks.fig1.EFFECTIVE_INDEX_DEG`."""
-    from scatterbench.validation.checks.fig1 import N_INDEX, THETA_I
 
     curves = []
     for r in rows:
@@ -64,8 +65,6 @@ def _table_row(r, snell):
 
 
 def compute(ctx):
-    from scatterbench.validation.checks.fig1 import EFFECTIVE_INDEX_DEG, N_INDEX, SIGMAS, THETA_I
-    from scatterbench.validation.checks.seed003 import fig1_rows
 
     rows = [dict(r) for r in fig1_rows()]  # the Fig. 1 check's analysis (validation/checks/fig1.py)
     snell = math.degrees(math.asin(math.sin(THETA_I) / N_INDEX))

@@ -9,6 +9,7 @@ import numpy as np
 from scipy import optimize as _opt
 
 from scatterbench import models, references
+from scatterbench.models import scene as scene_mod
 from scatterbench.models.combination import mueller_with_error
 from scatterbench.models.polarization import ellipsometric, stokes
 
@@ -147,7 +148,6 @@ def _preset(name, pre, sc, model, x):
 
 
 def compute(ctx):
-    from scatterbench.models import scene as scene_mod
 
     x = np.linspace(-85.0, 85.0, 69 if ctx.quick else 171)
     presets = references.seed003_presets()

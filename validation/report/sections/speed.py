@@ -11,6 +11,7 @@ import numpy as np
 
 from scatterbench import references
 from scatterbench.models.kernels import PARALLEL_MIN
+from scatterbench.validation.studies.tradeoff import pareto, study, time_call
 
 from ..core import figure_block, table_block
 from ._common import default_models, is_heavy, plt
@@ -55,7 +56,6 @@ def _throughput(n, seed):
     """Per model, the cost of one ``mueller`` call on ``n`` random geometries
     (:data:`HEAVY_GEOMETRIES` for the Monte Carlo and wrapper models), timed by the
     trade-off study's :func:`time_call`."""
-    from scatterbench.validation.studies.tradeoff import time_call
 
     rng = np.random.default_rng(seed)
     ti, tr = rng.uniform(0, 1.45, (2, n))
@@ -109,7 +109,6 @@ def _peers():
 
 
 def compute(ctx):
-    from scatterbench.validation.studies.tradeoff import pareto, study
 
     knobs = tuple(study(quick=ctx.quick))
     fronts = tuple(

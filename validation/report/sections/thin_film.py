@@ -9,6 +9,7 @@ import numpy as np
 
 from scatterbench import references
 from scatterbench.models import scene
+from scatterbench.validation.studies.colour import colour_travel
 
 from ..core import figure_block, table_block, text_block
 from ._common import plt
@@ -30,7 +31,6 @@ class ThinFilmData:
 
 
 def compute(ctx):
-    from scatterbench.validation.studies.colour import colour_travel
 
     sc = scene.load(references.scene_path(SCENE))
     model = sc.mechanisms()[0].model  # the flakes: a facet model whose substrate is the stack

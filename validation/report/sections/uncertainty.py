@@ -6,6 +6,19 @@ import tempfile
 from dataclasses import dataclass
 
 from scatterbench import references
+from scatterbench.models import scene as scene_mod
+from scatterbench.validation.checks.fitting import RECOVERY_SCENE, recovery_cells, recovery_settings
+from scatterbench.validation.fitting.datafile import load_data
+from scatterbench.validation.fitting.fit import (
+    corner_figure,
+    predictive,
+    predictive_figure,
+    run_fit,
+    write_fit,
+)
+from scatterbench.validation.fitting.fitspec import fitspec_from
+from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.settings import ChainSettings
 
 from ..core import figure_block, table_block, text_block
 
@@ -56,7 +69,6 @@ class UncertaintyData:
 
 
 def _fit_settings(quick, seed):
-    from scatterbench.validation.fitting.settings import ChainSettings
 
     if quick:
         return ChainSettings(walkers=16, seed=seed, max_steps=1000, check_every=100, starts=2)
@@ -87,7 +99,6 @@ def _recovery_row(cell, name, v):
 
 def _recovery(ctx):
     """The injection-recovery coverage: the recovery-coverage check's study, run once."""
-    from scatterbench.validation.checks.fitting import RECOVERY_SCENE, recovery_cells, recovery_settings
 
     rs = recovery_settings(ctx.quick, ctx.seed)
     rows = tuple(_recovery_row(c, k, v) for c in recovery_cells(ctx) for k, v in c["summary"].items())
@@ -98,11 +109,6 @@ def _recovery(ctx):
 
 def _fit(ctx):
     """The example fit, its posterior.json summary (truth check, predictive checks) and data."""
-    from scatterbench.models import scene as scene_mod
-    from scatterbench.validation.fitting.datafile import load_data
-    from scatterbench.validation.fitting.fit import run_fit, write_fit
-    from scatterbench.validation.fitting.fitspec import fitspec_from
-    from scatterbench.validation.fitting.likelihood import Likelihood
 
     sc = scene_mod.load(references.scene_path(FIT_SCENE))
     data = load_data(references.data_path(FIT_DATA))
@@ -166,7 +172,6 @@ def _sampling_row(samp, timing):
 
 
 def compute(ctx):
-    from scatterbench.validation.fitting.fit import predictive
 
     fit, post, data, spec, st = _fit(ctx)
     pp = predictive(fit, n_draws=200, seed=ctx.seed)
@@ -224,7 +229,6 @@ def _recovery_text(d):
 
 
 def _render_figures(s, d):
-    from scatterbench.validation.fitting.fit import corner_figure, predictive_figure
 
     samp = d.sampling
     s.blocks.append(
