@@ -116,7 +116,7 @@ class DetectorAperture(_Wrapper):
 
     def _mueller16(self, ti, tr, pr):
         if self.aperture == 0.0:
-            return self.model._m16(ti, tr, pr)
+            return self.model.flat_mueller16(ti, tr, pr)
         if evaluation.current_backend() == "numba":
             return self._mueller16_compiled(ti, tr, pr)
         n = ti.size
@@ -126,7 +126,7 @@ class DetectorAperture(_Wrapper):
         for g0 in range(0, n, step):
             g = slice(g0, min(n, g0 + step))
             th, ph, wt, c2, s2 = _Frame(tr[g], pr[g]).nodes(*self._nodes)
-            M = self.model._m16(np.repeat(ti[g], K), th.ravel(), ph.ravel()).reshape(16, -1, K)
+            M = self.model.flat_mueller16(np.repeat(ti[g], K), th.ravel(), ph.ravel()).reshape(16, -1, K)
             out[:, g] = _rotate_rows_and_sum(M, wt, c2, s2) / wt.sum(axis=1)
         return out
 
@@ -148,7 +148,7 @@ class DetectorAperture(_Wrapper):
             at = np.empty((kernel.ROWS, K * m))
             g = slice(g0, g0 + m)
             kernel.nodes(ti[g], tr[g], pr[g], a, b, cos_u, w, at)
-            M = self.model._m16(at[kernel.TI], at[kernel.THETA], at[kernel.PHI])
+            M = self.model.flat_mueller16(at[kernel.TI], at[kernel.THETA], at[kernel.PHI])
             kernel.rotate_sum(M, at, m, out, g0)
         return out
 
@@ -158,7 +158,7 @@ class DetectorAperture(_Wrapper):
         bases built and the analyzer basis carried over by projection, and
         each node's full ``4 x 4`` rotation applied by a matrix product."""
         if self.aperture == 0.0:
-            return self.model._m16(ti, tr, pr)
+            return self.model.flat_mueller16(ti, tr, pr)
         n = ti.size
         out = np.zeros((16, n))
         wsum = np.zeros(n)
@@ -180,7 +180,7 @@ class DetectorAperture(_Wrapper):
             s = np.sum(sa * p_k, axis=-1)
             zero = np.zeros_like(c)
             R = mueller16_from_jones((c, zero), (s, zero), (-s, zero), (c, zero)).reshape(4, 4, n, kb)
-            M = self.model._m16(np.repeat(ti, kb), th.ravel(), ph.ravel()).reshape(4, 4, n, kb)
+            M = self.model.flat_mueller16(np.repeat(ti, kb), th.ravel(), ph.ravel()).reshape(4, 4, n, kb)
             out += np.einsum("ijnk,jlnk,nk->iln", R, M, wt).reshape(16, n)
             wsum += wt.sum(axis=1)
         return out / wsum

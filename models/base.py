@@ -133,12 +133,15 @@ class Model(Declared, ModelFacts):
 
         return kernels.Compiled(self, *spec)
 
-    def _m16(self, ti, tr, pr):
-        """:func:`scatterbench.models.evaluation.flat`, Mueller elements ``(16, n)``."""
+    def flat_mueller16(self, ti, tr, pr):
+        """The named internal entry for angles validated already: Mueller elements ``(16, n)``
+        of flat float64 angles (length 1 or ``n``), by :func:`scatterbench.models.evaluation.flat`'s
+        choice of kernel or numpy.  Wrappers, sums and fits evaluate their inner models
+        through it; users call :meth:`mueller`, which validates and broadcasts."""
         return evaluation.flat(self, ti, tr, pr, 16)
 
-    def _m00(self, ti, tr, pr):
-        """:func:`scatterbench.models.evaluation.flat`, ``M00`` ``(n,)``."""
+    def flat_brdf(self, ti, tr, pr):
+        """:meth:`flat_mueller16`'s ``M00`` ``(n,)`` alone."""
         return evaluation.flat(self, ti, tr, pr, 1)
 
     # -- the public evaluation: every route is chosen in models.evaluation --------------
@@ -326,7 +329,7 @@ class Sum(Model):
     def _mueller16(self, ti, tr, pr):
         total = None
         for w, m in self.terms:
-            block = w * m._m16(ti, tr, pr)
+            block = w * m.flat_mueller16(ti, tr, pr)
             total = block if total is None else total + block
         return total
 

@@ -13,8 +13,8 @@ treat a contributed model as they treat their own.
 from __future__ import annotations
 
 import dataclasses
+import importlib.metadata
 from dataclasses import dataclass
-from importlib.metadata import entry_points
 
 import numpy as np
 
@@ -66,7 +66,7 @@ def contributed_models() -> list[Contributed]:
     """Every model registered in the ``scatterbench.models`` entry-point group, sorted by name;
     an entry that fails to load is listed with its error, not raised."""
     out = []
-    for ep in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
+    for ep in sorted(importlib.metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
         dist = f"{ep.dist.name} {ep.dist.version}" if ep.dist is not None else "?"
         try:
             model = resolve(ep.load(), f"entry point {ep.name!r}")

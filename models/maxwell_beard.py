@@ -152,10 +152,10 @@ class MaxwellBeardBRDF(Model):
     def _mueller16(self, ti, tr, pr):
         so = maxwell_beard_shadow(ti, tr, pr, self.tau, self.omega)
         if self.polarized:
-            out = self._facet._m16(ti, tr, pr) * so
+            out = self._facet.flat_mueller16(ti, tr, pr) * so
         else:
             out = np.zeros((16, ti.size))
-            out[0] = self._facet._m00(ti, tr, pr) * so
+            out[0] = self._facet.flat_brdf(ti, tr, pr) * so
         ci, cr = np.cos(ti), np.cos(tr)
         den = ci + cr
         vol = 2.0 * self.rho_v / np.where(den > 0, den, 1.0)

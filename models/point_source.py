@@ -239,7 +239,7 @@ class PointSourceBRDF(_Wrapper):
     # -- evaluation -----------------------------------------------------------------------
     def _mueller16(self, ti, tr, pr):
         if self.distance == math.inf or self.sample_radius / self.distance == 0.0:
-            return self.model._m16(ti, tr, pr)
+            return self.model.flat_mueller16(ti, tr, pr)
         if self.resolution == "auto" and self.method == "exact":
             res = self._auto(ti, tr, pr)
             if res.capped.any():
@@ -277,7 +277,7 @@ class PointSourceBRDF(_Wrapper):
         )
         shape, (ti, tr, pr) = auto._angles(theta_i, theta_r, phi_r)
         if auto.distance == math.inf or auto.sample_radius / auto.distance == 0.0:
-            M = auto.model._m16(ti, tr, pr)
+            M = auto.model.flat_mueller16(ti, tr, pr)
             res = Accuracy(M, np.zeros(ti.size), np.abs(M[0]), np.ones(ti.size, int), np.zeros(ti.size, bool))
         else:
             res = auto._auto(ti, tr, pr)
@@ -357,7 +357,7 @@ class PointSourceBRDF(_Wrapper):
         psi, Phi, tr, pr = psi.ravel(), Phi.ravel(), np.repeat(tr, P), (pr[:, None] - Phi).ravel()
         if self._rotation != "each":
             model = self.model if self._rotation == "none" else self.model.rotated(-Phi)
-            return model._m16(psi, tr, pr).reshape(16, m, P)
+            return model.flat_mueller16(psi, tr, pr).reshape(16, m, P)
         # a sample that cannot rotate by an array: one call per distinct azimuth (the product
         # rule's nodes share theirs across the geometries of an incidence; the cubature's do not)
         out = np.empty((16, psi.size))
@@ -366,7 +366,7 @@ class PointSourceBRDF(_Wrapper):
         ends = np.searchsorted(inv[order], np.arange(uniq.size + 1))
         for j, phi in enumerate(uniq.tolist()):
             idx = order[ends[j] : ends[j + 1]]
-            out[:, idx] = self.model.rotated(-phi)._m16(psi[idx], tr[idx], pr[idx])
+            out[:, idx] = self.model.rotated(-phi).flat_mueller16(psi[idx], tr[idx], pr[idx])
         return out.reshape(16, m, P)
 
     def _superpose(self, ti, tr, pr, resolution):
@@ -401,7 +401,7 @@ class PointSourceBRDF(_Wrapper):
         for k0 in range(0, K, step):
             sl = slice(k0, min(K, k0 + step))
             kb = sl.stop - sl.start
-            M = model._m16(a[:, sl].ravel(), b[:, sl].ravel(), c[:, sl].ravel())
+            M = model.flat_mueller16(a[:, sl].ravel(), b[:, sl].ravel(), c[:, sl].ravel())
             out += np.einsum("eik,ik->ei", M.reshape(16, n, kb), w[:, sl])
 
     def brdf_grid(self, theta_i, theta_r, phi_r):

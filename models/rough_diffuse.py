@@ -442,7 +442,7 @@ class RoughDiffuseBRDF(Model):
         return mean, err
 
     def _surface16(self, ti, tr, pr):
-        out = self._surface_model._m16(ti, tr, pr)
+        out = self._surface_model.flat_mueller16(ti, tr, pr)
         if self.convention == "corrected":
             ci = np.cos(ti)
             out = out * (ci / np.maximum(projected_area(self.slopes, ci), 1e-300))

@@ -415,9 +415,9 @@ def test_evaluations_count_every_inner_evaluation():
     count = []
 
     class Counted(type(inner)):
-        def _m16(self, ti, tr, pr):
+        def flat_mueller16(self, ti, tr, pr):
             count.append(np.broadcast(ti, tr, pr).size)
-            return super()._m16(ti, tr, pr)
+            return super().flat_mueller16(ti, tr, pr)
 
     ps = S.PointSourceBRDF(model=Counted(slopes=inner.slopes), distance=3.0)
     ps.accuracy(0.3, np.array([0.0]), np.array([0.0]))  # the incidence's scale

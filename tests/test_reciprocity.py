@@ -78,7 +78,7 @@ class _TurnsOneAngleAtATime(Model):
         return _TurnsOneAngleAtATime(inner=self.inner.rotated(float(angle)))
 
     def _mueller16(self, ti, tr, pr):
-        return self.inner._m16(ti, tr, pr)
+        return self.inner.flat_mueller16(ti, tr, pr)
 
     def _jones_flat(self, ti, tr, pr):
         return self.inner._jones_flat(ti, tr, pr)

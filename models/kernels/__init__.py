@@ -180,7 +180,7 @@ class Compiled:
         fn(self.code, ti, tr, pr, self.params(precision), self.iopt, out, start)
 
     def run(self, ti, tr, pr, rows):
-        """``(rows, n)`` float64 of flat float64 angles (the model's dispatch, ``Model._m16``)."""
+        """``(rows, n)`` float64 of flat float64 angles (:func:`scatterbench.models.evaluation.flat`'s kernel route)."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
         out = np.empty((rows, n))
         self.call(ti, tr, pr, out, 0)
