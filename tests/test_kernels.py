@@ -282,7 +282,10 @@ def test_one_compiled_specialization_per_entry_and_precision():
         m.mueller(frozen[:100], 0.3, 0.2)
         m.mueller(frozen[:3], 0.3, 0.2)
         m.mueller(0.3, 0.2, 0.1)
-    for entry in (drive.run, drive.run_parallel, drive.run_checked, vector.run, vector.run_parallel):
+    entries = [e for c in (drive.FACET, drive.MAXWELL) for e in drive.ENTRIES[c][:3]]
+    entries += [e for k in vector._ENTRIES.values() for e in k[:3]]
+    assert len(entries) > 6  # the vector entries the calls above made
+    for entry in entries:
         for sig in entry.signatures:
             assert "readonly" not in str(sig) and "Literal" not in str(sig), (entry, sig)
             assert all(t.mutable for t in sig if hasattr(t, "ndim")), (entry, sig)

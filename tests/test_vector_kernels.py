@@ -38,8 +38,8 @@ def _both(kernel, ti, tr, pr):
     prm = kernel.params("float64")
     n = max(ti.size, prm.shape[1])
     a, b = np.empty((16, n)), np.empty((16, n))
-    drive.run(kernel.code, ti, tr, pr, prm, kernel.iopt, a, 0)
-    vector.run(kernel.code, ti, tr, pr, prm, kernel.iopt, b, 0)
+    kernel.scalar.run(ti, tr, pr, prm, kernel.iopt, a, 0)
+    kernel.lanes.run(ti, tr, pr, prm, kernel.iopt, b, 0)
     return a, b
 
 
@@ -98,14 +98,14 @@ _PROBE = """
 import re
 import numpy as np
 from scatterbench import models
-from scatterbench.models.kernels import Compiled, drive, vector
+from scatterbench.models.kernels import Compiled
 for m in (models.FacetBRDF(), models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
-    Compiled(m, *m._kernel_spec()).run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
-drive.run(0, np.zeros(4), np.zeros(4), np.zeros(4), np.ones((drive.PARAM_ROWS, 1)),
-          np.zeros(3, dtype=np.int64), np.empty((16, 4)), 0)
-for name, fn in (("lanes", vector.lanes), ("scalar", drive.run_range)):
-    ir = "".join(fn.inspect_llvm().values())
-    print(name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
+    k = Compiled(m, *m._kernel_spec())
+    k.run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
+    k.scalar.run(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], k.iopt, np.empty((16, 4)), 0)
+    for name, fn in (("lanes", k.lanes.run), ("scalar", k.scalar.run)):
+        ir = "".join(fn.inspect_llvm().values())
+        print(type(m).__name__, name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
 """
 
 
@@ -123,21 +123,20 @@ common.stroke_d(0.1, 0.2, 0.9, 0.3, 0.3, 1.0, 0.0)
 def test_the_lanes_are_vectorized_loops(tmp_path):
     """In a process that compiles the vector loop (its IR is inspected: a function loaded
     from the cache has none), after an earlier process filled the cache with some of the
-    kernels' helpers: :func:`scatterbench.models.kernels.vector.lanes` holds LLVM's vectorized loops
-    (their ``vector.body`` blocks, on ``<N x double>`` values), one per facet slope kind,
-    single scattering, diffuse and Cook-Torrance loop; the scalar loop of
-    :mod:`~scatterbench.models.kernels.drive` has none.  Fails when a change puts a call or an exception
+    kernels' helpers: each model's vector entry (:func:`scatterbench.models.kernels.vector.lane_entries`)
+    holds LLVM's vectorized loops (their ``vector.body`` blocks, on ``<N x double>`` values);
+    its scalar entry (:mod:`~scatterbench.models.kernels.drive`) has none.  Fails when a change puts a call or an exception
     back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     subprocess.run([sys.executable, "-c", _EARLIER], env=env, check=True)
     res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
-    counts = {ln.split()[0]: tuple(int(x) for x in ln.split()[1:]) for ln in res.stdout.splitlines()}
-    # lanes is one compiled function holding every specialization: 3 facet slope kinds,
-    # 2 single scattering, 1 diffuse, 2 x 2 Cook-Torrance (bare or varnished x blinn, none),
-    # 3 Maxwell-Beard slope kinds (scalar or polarized a select inside): a vector.body each
-    # (labels vector.body.i, vector.body.i5, ... once inlined)
-    assert counts["lanes"][0] >= 13 and counts["lanes"][1] > 0
-    assert counts["scalar"][0] == 0
+    counts = {tuple(ln.split()[:2]): tuple(int(x) for x in ln.split()[2:]) for ln in res.stdout.splitlines()}
+    assert len(counts) == 6, res.stdout
+    for (model, loop), (bodies, vectors) in counts.items():
+        if loop == "lanes":  # one option set per entry: its loop, and LLVM's remainder copies
+            assert bodies >= 1 and vectors > 0, (model, bodies, vectors)
+        else:
+            assert bodies == 0, (model, bodies)
 
 
 @njit
@@ -223,8 +222,7 @@ def test_only_the_entry_points_are_cached():
     import scatterbench.models.kernels as kernels
 
     entries = {
-        "drive": {"run", "run_parallel", "run_checked", "run_one", "angles_ok"},
-        "vector": {"run", "run_parallel", "run_checked"},
+        "drive": {"angles_ok"},  # and the entries per kernel, below
         "montecarlo": {"_serial", "_parallel", "exit_transmittance"},
         "aperture": {"nodes", "rotate_sum"},
         "disc": {"points"},
@@ -242,3 +240,13 @@ def test_only_the_entry_points_are_cached():
                     where = fn._cache._cache_path
                     assert where.startswith(models.kernels.cache_dir()), f"{name}.{attr} caches in {where}"
     assert seen > 40
+    # the entries per kernel (and per option set on SIMD lanes): closures, not module names
+    per_kernel = [e for es in drive.ENTRIES for e in es]
+    per_kernel += [
+        e for es in (vector.lane_entries(c, np.zeros(3, dtype=np.int64)) for c in (0, 2, 3, 4, 5)) for e in es
+    ]
+    for fn in (e for e in per_kernel if e is not None):
+        assert type(fn._cache).__name__ != "NullCache", fn
+        assert fn._cache._cache_path.startswith(models.kernels.cache_dir()), fn
+    names = {fn.py_func.__qualname__ for fn in per_kernel if fn is not None}
+    assert len(names) == len([e for e in per_kernel if e is not None])  # cache files of their own

@@ -26,11 +26,13 @@ to an installed, read-only package.  ``<hash>`` covers every kernel source file,
 edit to a shared helper recompiles the kernels that inline it (numba alone only notices
 changes to the file of the function itself).
 
-Only the entry points that Python calls are cached (``run``, ``run_parallel``,
-``run_checked``, ``run_one`` and ``angles_ok`` of :mod:`~scatterbench.models.kernels.drive`, the first
-three of :mod:`~scatterbench.models.kernels.vector`, :mod:`~scatterbench.models.kernels.montecarlo`'s
+Only the entry points that Python calls are cached: per kernel, ``run``, ``run_parallel``,
+``run_checked`` and ``run_one`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel
+and option set the first three of :func:`~scatterbench.models.kernels.vector.lane_entries` (closures
+over the kernel's code, so that a run compiles only the kernels its models use), ``angles_ok``
+of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
 ``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~scatterbench.models.kernels.aperture`'s
-``nodes`` and ``rotate_sum``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``); a cached entry
+``nodes`` and ``rotate_sum``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
 holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached
 function as object code, without the LLVM IR that inlining needs: an entry compiled in a
@@ -157,6 +159,18 @@ class Compiled:
         self.iopt[: len(options)] = options
         self.vectorized = vector.vectorized(self.code, self.iopt)
 
+    # looked up, not held: a model pickled to a worker process carries its Compiled, and
+    # numba's dispatchers do not pickle to the same (cached) functions
+    @property
+    def scalar(self) -> drive.Entries:
+        """The kernel's scalar loops (:data:`scatterbench.models.kernels.drive.ENTRIES`)."""
+        return drive.ENTRIES[self.code]
+
+    @property
+    def lanes(self) -> drive.Entries:
+        """The kernel's loops on SIMD lanes (:func:`scatterbench.models.kernels.vector.lane_entries`)."""
+        return vector.lane_entries(self.code, self.iopt)
+
     def params(self, precision):
         """The parameter rows in ``precision``; float32 rows take the angle rows (rotations)
         reduced to (-pi, pi] in float64 first, so that rounding keeps their cosines and sines."""
@@ -172,12 +186,12 @@ class Compiled:
     def call(self, ti, tr, pr, out, start, precision="float64"):
         """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
-        loops = vector if precision == "float64" and self.vectorized else drive
+        loops = self.lanes if precision == "float64" and self.vectorized else self.scalar
         fn = loops.run_parallel if n >= PARALLEL_MIN else loops.run
         # contiguous, writable inputs: one compiled specialization per entry and precision
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
-        fn(self.code, ti, tr, pr, self.params(precision), self.iopt, out, start)
+        fn(ti, tr, pr, self.params(precision), self.iopt, out, start)
 
     def run(self, ti, tr, pr, rows):
         """``(rows, n)`` float64 of flat float64 angles (:func:`scatterbench.models.evaluation.flat`'s kernel route)."""
@@ -224,8 +238,8 @@ class Compiled:
         elif not out.flags.c_contiguous:
             return None
         if dtype is _FLOAT64 and n < PARALLEL_MIN:
-            loops = vector if self.vectorized and n >= VECTOR_MIN else drive
-            if not loops.run_checked(self.code, ti, tr, pr, self.prm["float64"], self.iopt, out):
+            loops = self.lanes if self.vectorized and n >= VECTOR_MIN else self.scalar
+            if not loops.run_checked(ti, tr, pr, self.prm["float64"], self.iopt, out):
                 return None
         else:
             if not drive.angles_ok(ti, tr, pr):
@@ -248,5 +262,5 @@ class Compiled:
         if not (0.0 <= a <= _HALF_PI and 0.0 <= b <= _HALF_PI and math.isfinite(c)):
             return None
         out = np.empty((rows, 1))
-        drive.run_one(self.code, a, b, c, self.prm["float64"], self.iopt, out)
+        self.scalar.run_one(a, b, c, self.prm["float64"], self.iopt, out)
         return out.reshape(4, 4) if rows == 16 else out.reshape(())

@@ -12,9 +12,11 @@ over the cores with ``prange``.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import errors, njit, prange, types
+from numba.extending import overload
 
 from ..kernel_specs import KERNEL_ROWS
 from .common import azimuth
@@ -25,6 +27,7 @@ from .volume import diffuse, single
 
 FACET, BTDF, SINGLE, DIFFUSE, COOK, MAXWELL = range(6)
 CODES = {"facet": FACET, "btdf": BTDF, "single": SINGLE, "diffuse": DIFFUSE, "cook": COOK, "maxwell": MAXWELL}
+NAMES = {c: name for name, c in CODES.items()}
 #: each kernel's parameter rows, in order (``Compiled`` checks a model's spec against them)
 ROWS = KERNEL_ROWS
 
@@ -83,60 +86,101 @@ def _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi):
         store(out, start + i, kernel(g, params(prm, i * p), o))
 
 
-@njit(error_model="numpy")
-def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
-    """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``, serially."""
-    o = options(iopt)
-    if code == FACET:
-        _serial(facet, ti, tr, pr, prm, o, out, start, lo, hi)
-    elif code == BTDF:
-        _serial(btdf, ti, tr, pr, prm, o, out, start, lo, hi)
-    elif code == SINGLE:
-        _serial(single, ti, tr, pr, prm, o, out, start, lo, hi)
-    elif code == DIFFUSE:
-        _serial(diffuse, ti, tr, pr, prm, o, out, start, lo, hi)
-    elif code == COOK:
-        _serial(cook, ti, tr, pr, prm, o, out, start, lo, hi)
-    else:
-        _serial(maxwell, ti, tr, pr, prm, o, out, start, lo, hi)
+#: the one-geometry functions by code
+KERNELS = (facet, btdf, single, diffuse, cook, maxwell)
+assert [KERNELS[c] for c in CODES.values()] == [facet, btdf, single, diffuse, cook, maxwell]
 
 
-@njit(cache=True, error_model="numpy")
-def run(code, ti, tr, pr, prm, iopt, out, start):
-    """Serial loop over the geometries ``0 .. len - 1`` of the inputs, into ``out[:, start + i]``."""
-    n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-    # np.int64(0), not 0: numba gives a literal argument a specialization of its own
-    # (Literal[int](0)), which compiled every kernel a second time
-    run_range(code, ti, tr, pr, prm, iopt, out, start, np.int64(0), n)
+def serial(code, ti, tr, pr, prm, o, out, start, lo, hi):
+    """:func:`_serial` for kernel ``code``, in compiled code only (see :func:`_serial_of`)."""
+    raise NotImplementedError("compiled code only")
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
-def run_parallel(code, ti, tr, pr, prm, iopt, out, start):
-    """:func:`run` with blocks of :data:`BLOCK` geometries spread over the cores (``prange``;
-    each block the serial loop, which compiles to tighter code than a ``prange`` body)."""
-    n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-    for blk in prange((n + BLOCK - 1) // BLOCK):
-        lo = blk * BLOCK
-        run_range(code, ti, tr, pr, prm, iopt, out, start, lo, min(lo + BLOCK, n))
+@overload(serial, prefer_literal=True)
+def _serial_of(code, ti, tr, pr, prm, o, out, start, lo, hi):
+    """``serial`` with ``code`` a constant (an entry's closure cell, typed as a literal): the
+    loop over that one kernel, picked while typing, so that numba types and compiles it alone
+    (a branch on the code compiles every kernel; a tuple of them indexed in compiled code
+    becomes a tuple of function pointers, called without inlining)."""
+    if not isinstance(code, types.IntegerLiteral):
+        raise errors.RequireLiteralValue("serial's kernel code must be a constant")
+    kernel = KERNELS[code.literal_value]
+
+    def impl(code, ti, tr, pr, prm, o, out, start, lo, hi):
+        _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi)
+
+    return impl
 
 
-@njit(cache=True, error_model="numpy")
-def run_checked(code, ti, tr, pr, prm, iopt, out):
-    """:func:`run` from column 0 when every angle is valid (:func:`angles_ok`), returning True;
-    False, writing nothing, otherwise (one call into numba for a small call)."""
-    if not angles_ok(ti, tr, pr):
-        return False
-    run(code, ti, tr, pr, prm, iopt, out, np.int64(0))  # int64: see run
-    return True
+class Entries(NamedTuple):
+    """One kernel's cached entry points (:func:`entries`)."""
+
+    run: object
+    run_parallel: object
+    run_checked: object
+    run_one: object
 
 
-@njit(cache=True, error_model="numpy")
-def run_one(code, ti, tr, pr, prm, iopt, out):
-    """One geometry given as scalars (the small-call path), through :func:`run_range`'s loop:
-    the code every other serial call already compiled (a dispatch of its own over the
-    kernels compiled them all once more, 14.5 s on a cold cache, to save ~0.1 us a call)."""
-    a, b, c = np.full(1, ti), np.full(1, tr), np.full(1, pr)
-    run_range(code, a, b, c, prm, iopt, out, np.int64(0), np.int64(0), np.int64(1))
+def named(code, tag=""):
+    """A decorator that renames a function after kernel ``code``, before numba sees it: numba
+    names a function's cache files after its qualified name, so each kernel's entries get
+    files of their own (in shared ones, two processes compiling two kernels at once could pair
+    one's index with the other's code)."""
+
+    def rename(fn):
+        fn.__name__ = fn.__qualname__ = f"{fn.__name__}_{NAMES[code]}{'_' + tag if tag else ''}"
+        return fn
+
+    return rename
+
+
+def entries(code) -> Entries:
+    """The entry points of kernel ``code`` (built once, at import: :data:`ENTRIES`).
+
+    Each is a closure over ``code``, an int: numba folds it as a constant, so the entry
+    compiles only its own kernel (one entry over every kernel compiled all six on a first
+    call: 23 s of CPU for one geometry of FacetBRDF on a cold cache), and its cache key (the
+    closure's pickled cells) is the same in every process."""
+
+    @njit(cache=True, error_model="numpy")
+    @named(code)
+    def run(ti, tr, pr, prm, iopt, out, start):
+        """Serial loop over the geometries ``0 .. len - 1`` of the inputs, into ``out[:, start + i]``."""
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
+        # np.int64(0), not 0: numba gives a literal argument a specialization of its own
+        # (Literal[int](0)), which compiled the kernel a second time
+        serial(code, ti, tr, pr, prm, options(iopt), out, start, np.int64(0), n)
+
+    @njit(cache=True, error_model="numpy", parallel=True)
+    @named(code)
+    def run_parallel(ti, tr, pr, prm, iopt, out, start):
+        """:func:`run` with blocks of :data:`BLOCK` geometries spread over the cores (``prange``;
+        each block the serial loop, which compiles to tighter code than a ``prange`` body)."""
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
+        o = options(iopt)
+        for blk in prange((n + BLOCK - 1) // BLOCK):
+            lo = blk * BLOCK
+            serial(code, ti, tr, pr, prm, o, out, start, lo, min(lo + BLOCK, n))
+
+    @njit(cache=True, error_model="numpy")
+    @named(code)
+    def run_checked(ti, tr, pr, prm, iopt, out):
+        """:func:`run` from column 0 when every angle is valid (:func:`angles_ok`), returning
+        True; False, writing nothing, otherwise (one call into numba for a small call)."""
+        if not angles_ok(ti, tr, pr):
+            return False
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
+        serial(code, ti, tr, pr, prm, options(iopt), out, np.int64(0), np.int64(0), n)
+        return True
+
+    @njit(cache=True, error_model="numpy")
+    @named(code)
+    def run_one(ti, tr, pr, prm, iopt, out):
+        """One geometry given as scalars (the small-call path), through the serial loop."""
+        a, b, c = np.full(1, ti), np.full(1, tr), np.full(1, pr)
+        serial(code, a, b, c, prm, options(iopt), out, np.int64(0), np.int64(0), np.int64(1))
+
+    return Entries(run, run_parallel, run_checked, run_one)
 
 
 @njit(cache=True, error_model="numpy")
@@ -154,3 +198,7 @@ def angles_ok(ti, tr, pr):
         if not math.isfinite(pr[k]):
             return False
     return True
+
+
+#: every kernel's entry points, by code
+ENTRIES = tuple(entries(c) for c in range(len(KERNELS)))

@@ -1,7 +1,7 @@
 """The float64 loops that run on SIMD lanes: the kernels of :mod:`~scatterbench.models.kernels.drive`
 over a block of geometries at a time, compiled so that the compiler vectorizes them.
 
-:func:`scatterbench.models.kernels.drive.run` calls a model's one-geometry function in a loop the
+The scalar entries of :mod:`~scatterbench.models.kernels.drive` call a model's one-geometry function in a loop the
 compiler keeps scalar: the function branches on the model and its options, calls the C
 library, and reads and writes several arrays the compiler must assume overlap.  Here, per
 block of :data:`VBLOCK` geometries:
@@ -10,7 +10,7 @@ block of :data:`VBLOCK` geometries:
    array and takes the azimuths' cosines and sines there with the polynomial
    :func:`~scatterbench.models.kernels.vector_math.sincos` (the C library beyond its range:
    :func:`~scatterbench.models.kernels.common.azimuths`);
-2. :func:`lanes` runs the kernel over the scratch: one loop per model and slope kind, with
+2. :func:`blocks` runs the kernel over the scratch: one loop per model and option set (:func:`lane_options`), with
    the code and options constants, so that the branches left are selects; no call remains
    (the kernels use :mod:`~scatterbench.models.kernels.vector_math`, and ``error_model="numpy"`` lets a
    division by zero give inf, as numpy's, instead of raising); all reads and writes are in
@@ -27,15 +27,25 @@ shadowing, anisotropic slopes, unit slopes); :class:`scatterbench.models.kernels
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import errors, njit, prange, types
+from numba.core import config
+from numba.extending import overload
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX
 from .common import NO_SHADOWING, azimuths
-from .cook import cook
-from .drive import BLOCK, COOK, DIFFUSE, FACET, MAXWELL, PARAM_ROWS, SINGLE, angles_ok, options
-from .facet import facet
-from .maxwell import maxwell
-from .volume import diffuse, single
+from .drive import (
+    BLOCK,
+    COOK,
+    DIFFUSE,
+    FACET,
+    KERNELS,
+    MAXWELL,
+    PARAM_ROWS,
+    SINGLE,
+    Entries,
+    angles_ok,
+    named,
+)
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (55 kB), stays
 #: in the L2 cache
@@ -99,55 +109,11 @@ def _store(sc, k, m):
 
 @njit(error_model="numpy", forceinline=True)
 def _loop(kernel, sc, m, o):
-    """The loop of :func:`lanes` for one kernel and its options: compiled once per kernel,
-    inlined by LLVM into :func:`lanes`, where the options are constants and fold (numba's
-    own inlining would type the kernel once per call: minutes of compilation)."""
+    """The loop over a block for one kernel: compiled once per kernel, inlined by LLVM into
+    :func:`blocks`, where the options are constants and fold (numba's own inlining would
+    type the kernel once per call: minutes of compilation)."""
     for k in range(m):
         _store(sc, k, kernel(_geometry(sc, k), _scratch_params(sc, k), o))
-
-
-@njit(error_model="numpy")
-def lanes(code, sc, m, o):
-    """Geometries ``0 .. m - 1`` of the scratch through kernel ``code`` (:func:`vectorized`
-    models only): one loop per kernel, slope kind and option set, each with them constant."""
-    if code == FACET:
-        kind = o[0]
-        if kind == EXPONENTIAL:
-            _loop(facet, sc, m, (EXPONENTIAL, NO_SHADOWING, 0))
-        elif kind == GAUSSIAN:
-            _loop(facet, sc, m, (GAUSSIAN, NO_SHADOWING, 0))
-        else:
-            _loop(facet, sc, m, (GGX, NO_SHADOWING, 0))
-    elif code == SINGLE:
-        if o[0] == 0:
-            _loop(single, sc, m, (0, 0, 0))
-        else:
-            _loop(single, sc, m, (1, 0, 0))
-    elif code == DIFFUSE:
-        _loop(diffuse, sc, m, (0, 0, 0))
-    elif code == MAXWELL:
-        _maxwell_lanes(sc, m, o)
-    elif o[0] == 1:
-        if o[2] == BLINN:
-            _loop(cook, sc, m, (1, o[1], BLINN))
-        else:
-            _loop(cook, sc, m, (1, o[1], NO_COOK_SHADOWING))
-    elif o[2] == BLINN:
-        _loop(cook, sc, m, (0, o[1], BLINN))
-    else:
-        _loop(cook, sc, m, (0, o[1], NO_COOK_SHADOWING))
-
-
-@njit(error_model="numpy", forceinline=True)
-def _maxwell_lanes(sc, m, o):
-    """:func:`lanes` for Maxwell-Beard: one loop per facet slope kind."""
-    kind, pol = o[0], o[2]
-    if kind == EXPONENTIAL:
-        _loop(maxwell, sc, m, (EXPONENTIAL, NO_SHADOWING, pol))
-    elif kind == GAUSSIAN:
-        _loop(maxwell, sc, m, (GAUSSIAN, NO_SHADOWING, pol))
-    else:
-        _loop(maxwell, sc, m, (GGX, NO_SHADOWING, pol))
 
 
 @njit(error_model="numpy")
@@ -165,42 +131,104 @@ def gather(sc, ti, tr, pr, prm, lo, m):
             sc[(_PRM + r) * VBLOCK + k] = prm[r, (lo + k) * p]
 
 
-@njit(error_model="numpy")
-def run_range(code, ti, tr, pr, prm, iopt, out, start, lo, hi):
-    """Geometries ``lo .. hi - 1`` into ``out[:, start + i]``, a block at a time."""
-    o = options(iopt)
-    sc = np.empty(_ROWS * VBLOCK)
-    for blo in range(lo, hi, VBLOCK):
-        m = min(VBLOCK, hi - blo)
-        gather(sc, ti, tr, pr, prm, blo, m)
-        lanes(code, sc, m, o)
-        for r in range(out.shape[0]):
-            for k in range(m):
-                out[r, start + blo + k] = sc[(_OUT + r) * VBLOCK + k]
+def lane_options(code, iopt) -> tuple:
+    """The options kernel ``code``'s lanes are compiled for: those its kernel reads, as
+    constants (a loop per slope kind, phase, varnish, convention, shadowing), so that the
+    branches left in the loop are selects and each variant compiles only when a model uses it."""
+    o0, o1, o2 = (int(x) for x in iopt[:3])
+    kind = o0 if o0 in (EXPONENTIAL, GAUSSIAN) else GGX
+    if code == FACET:
+        return (kind, NO_SHADOWING, 0)
+    if code == SINGLE:
+        return (int(o0 != 0), 0, 0)
+    if code == DIFFUSE:
+        return (0, 0, 0)
+    if code == COOK:
+        return (int(o0 == 1), o1, BLINN if o2 == BLINN else NO_COOK_SHADOWING)
+    return (kind, NO_SHADOWING, o2)  # MAXWELL
 
 
-@njit(cache=True, error_model="numpy")
-def run(code, ti, tr, pr, prm, iopt, out, start):
-    """:func:`scatterbench.models.kernels.drive.run` (same arguments, float64) on SIMD lanes."""
-    n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-    # np.int64(0), not 0: numba gives a literal argument a specialization of its own
-    # (Literal[int](0)), which compiled every kernel a second time
-    run_range(code, ti, tr, pr, prm, iopt, out, start, np.int64(0), n)
+def blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+    """Geometries ``lo .. hi - 1`` into ``out[:, start + i]``, a block at a time, through
+    kernel ``code`` with options ``(k0, k1, k2)`` (:func:`lane_options`), all constants; in
+    compiled code only (see :func:`scatterbench.models.kernels.drive.serial`)."""
+    raise NotImplementedError("compiled code only")
 
 
-@njit(cache=True, error_model="numpy")
-def run_checked(code, ti, tr, pr, prm, iopt, out):
-    """:func:`scatterbench.models.kernels.drive.run_checked` (same arguments, float64) on SIMD lanes."""
-    if not angles_ok(ti, tr, pr):
-        return False
-    run(code, ti, tr, pr, prm, iopt, out, np.int64(0))  # int64: see run
-    return True
+@overload(blocks, prefer_literal=True)
+def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+    if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
+        raise errors.RequireLiteralValue("blocks' kernel code and options must be constants")
+    kernel = KERNELS[code.literal_value]
+    o = (k0.literal_value, k1.literal_value, k2.literal_value)
+
+    # the loop written here, with the kernel and its options constants of it (a dispatcher
+    # passed as an argument to a compiled function is a Python object: no caching)
+    def impl(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+        sc = np.empty(_ROWS * VBLOCK)
+        for blo in range(lo, hi, VBLOCK):
+            m = min(VBLOCK, hi - blo)
+            gather(sc, ti, tr, pr, prm, blo, m)
+            _loop(kernel, sc, m, o)
+            for r in range(out.shape[0]):
+                for k in range(m):
+                    out[r, start + blo + k] = sc[(_OUT + r) * VBLOCK + k]
+
+    return impl
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
-def run_parallel(code, ti, tr, pr, prm, iopt, out, start):
-    """:func:`run` with blocks of :data:`scatterbench.models.kernels.drive.BLOCK` geometries over the cores."""
-    n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-    for blk in prange((n + BLOCK - 1) // BLOCK):
-        lo = blk * BLOCK
-        run_range(code, ti, tr, pr, prm, iopt, out, start, lo, min(lo + BLOCK, n))
+def entries(code, opts) -> Entries:
+    """:func:`scatterbench.models.kernels.drive.entries` on SIMD lanes (``run``, ``run_parallel``,
+    ``run_checked``; float64) for kernel ``code`` with options ``opts`` (:func:`lane_options`):
+    closures over those ints, each compiling its one loop."""
+    k0, k1, k2 = opts
+    tag = "_".join(str(k) for k in opts)
+
+    @njit(cache=True, error_model="numpy")
+    @named(code, tag)
+    def run(ti, tr, pr, prm, iopt, out, start):
+        """The scalar ``run`` (same arguments, float64) on SIMD lanes."""
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
+        # np.int64(0), not 0: see drive.entries
+        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, np.int64(0), n)
+
+    @njit(cache=True, error_model="numpy")
+    @named(code, tag)
+    def run_checked(ti, tr, pr, prm, iopt, out):
+        """The scalar ``run_checked`` (same arguments, float64) on SIMD lanes."""
+        if not angles_ok(ti, tr, pr):
+            return False
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
+        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
+        return True
+
+    @njit(cache=True, error_model="numpy", parallel=True)
+    @named(code, tag)
+    def run_parallel(ti, tr, pr, prm, iopt, out, start):
+        """:func:`run` with blocks of :data:`scatterbench.models.kernels.drive.BLOCK` geometries over the cores."""
+        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
+        for blk in prange((n + BLOCK - 1) // BLOCK):
+            lo = blk * BLOCK
+            blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
+
+    return Entries(run, run_parallel, run_checked, None)
+
+
+#: numba's cache directory when this module was imported (:mod:`scatterbench.models.kernels`
+#: sets it then): the entries made later cache there too
+_CACHE_DIR = config.CACHE_DIR
+_ENTRIES = {}
+
+
+def lane_entries(code, iopt) -> Entries:
+    """The vector entries of kernel ``code`` with options ``iopt``: made on first use, once
+    per process (there are 20 variants; a run uses a few)."""
+    key = (code, lane_options(code, iopt))
+    got = _ENTRIES.get(key)
+    if got is None:
+        old, config.CACHE_DIR = config.CACHE_DIR, _CACHE_DIR  # numba reads it when decorating
+        try:
+            got = _ENTRIES[key] = entries(*key)
+        finally:
+            config.CACHE_DIR = old
+    return got
