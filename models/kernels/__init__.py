@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import logging
 import math
 import os
 import tempfile
@@ -125,6 +126,25 @@ with _caching_in(cache_dir()):
     from . import aperture, disc, drive, montecarlo, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
+#: says when a kernel compiles (the command line shows it: ``scatterbench.validation.cli``)
+log = logging.getLogger(__name__)
+_READY = set()  # the entries this process has called (loaded from the cache or compiled)
+
+
+def _announced(fn):
+    """``fn``, after saying, on its first call in this process, when it is not in the cache
+    yet: the command line shows that the kernels compile once per machine."""
+    if fn not in _READY:
+        _READY.add(fn)
+        if not os.path.exists(fn._cache._cache_file._index_path):
+            log.info(
+                "compiling the %s kernel loop (once per machine: cached in %s)",
+                fn.__name__,
+                fn._cache._cache_path,
+            )
+    return fn
+
+
 def _mutable(x):
     """``x``, or a copy of it when it is read-only (a cached array, a user's frozen one)."""
     return x if x.flags.writeable else x.copy()
@@ -187,7 +207,7 @@ class Compiled:
         """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
         loops = self.lanes if precision == "float64" and self.vectorized else self.scalar
-        fn = loops.run_parallel if n >= PARALLEL_MIN else loops.run
+        fn = _announced(loops.run_parallel if n >= PARALLEL_MIN else loops.run)
         # contiguous, writable inputs: one compiled specialization per entry and precision
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
@@ -239,7 +259,7 @@ class Compiled:
             return None
         if dtype is _FLOAT64 and n < PARALLEL_MIN:
             loops = self.lanes if self.vectorized and n >= VECTOR_MIN else self.scalar
-            if not loops.run_checked(ti, tr, pr, self.prm["float64"], self.iopt, out):
+            if not _announced(loops.run_checked)(ti, tr, pr, self.prm["float64"], self.iopt, out):
                 return None
         else:
             if not drive.angles_ok(ti, tr, pr):
@@ -262,5 +282,5 @@ class Compiled:
         if not (0.0 <= a <= _HALF_PI and 0.0 <= b <= _HALF_PI and math.isfinite(c)):
             return None
         out = np.empty((rows, 1))
-        self.scalar.run_one(a, b, c, self.prm["float64"], self.iopt, out)
+        _announced(self.scalar.run_one)(a, b, c, self.prm["float64"], self.iopt, out)
         return out.reshape(4, 4) if rows == 16 else out.reshape(())

@@ -19,6 +19,7 @@ Exit codes, the same for every command (:func:`main`):
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 
@@ -67,12 +68,24 @@ def _parser():
     return ap
 
 
+def _show_compiling():
+    """The kernels' compile notices (:mod:`scatterbench.models.kernels`) as progress lines on
+    stderr: a first run spends a while compiling, once per machine."""
+    log = logging.getLogger("scatterbench.models.kernels")
+    if not log.handlers:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("  %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+
+
 def main(argv=None) -> int:
     """Run one command; returns its exit code (see the module docstring), never raises."""
     try:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # argparse has printed usage and ``error: ...`` (2) or --help (0)
         return exc.code if isinstance(exc.code, int) else EXIT_USAGE
+    _show_compiling()
     try:
         return args.func(args)
     except KeyboardInterrupt:
