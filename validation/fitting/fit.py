@@ -264,15 +264,21 @@ def corner_figure(fit: FitResult):
     x = np.column_stack([p.from_u(u[:, i]) for i, p in enumerate(spec.free)])
     truth = fit.lik.data_all.meta.get("truth") or {}
     truths = [truth.get(p.key) for p in spec.free]
-    return corner.corner(
+    if not any(t is not None for t in truths):
+        truths = None
+    one = x.shape[1] == 1  # corner draws one Axes, not a grid: its truth lines index a grid
+    fig = corner.corner(
         x,
         labels=spec.names,
-        truths=truths if any(t is not None for t in truths) else None,
+        truths=None if one else truths,
         quantiles=[0.025, 0.16, 0.5, 0.84, 0.975],
         title_quantiles=[0.16, 0.5, 0.84],
         show_titles=True,
         title_fmt=".4g",
     )
+    if one and truths is not None:
+        fig.axes[0].axvline(truths[0], color="#4682b4")  # corner's truth colour
+    return fig
 
 
 def predictive_figure(fit: FitResult, pp):
