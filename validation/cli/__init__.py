@@ -22,6 +22,7 @@ Exit codes, the same for every command (:func:`main`):
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 
@@ -46,6 +47,7 @@ INPUT_ERRORS = {
     "scatterbench.validation.fitting.executors": "SchedulerError",
     "scatterbench.validation.report.nightly": "HistoryError",
     "scatterbench.validation.atomic": "FolderError",
+    "scatterbench.validation.fitting.fit": "FitError",
 }
 
 
@@ -82,8 +84,20 @@ def _parser():
     return ap
 
 
+def _tolerant_streams():
+    """Let stdout and stderr show any character: one their encoding cannot hold (an em dash
+    in a scene's description under ``PYTHONIOENCODING=latin-1``) is written as ``\\u2014``
+    instead of ending the command.  Files are written as UTF-8 whatever the locale."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is not None:
+            with contextlib.suppress(ValueError, OSError, TypeError):  # a stream that cannot
+                reconfigure(errors="backslashreplace")
+
+
 def main(argv=None) -> int:
     """Run one command; returns its exit code (see the module docstring), never raises."""
+    _tolerant_streams()
     try:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # argparse has printed usage and ``error: ...`` (2) or --help (0)

@@ -13,6 +13,7 @@ during a fit says how to resume (exit 130).
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import shutil
 import sys
@@ -252,6 +253,22 @@ def _run_fit(args, lik, settings):
             )
     except KeyboardInterrupt:
         return _interrupted(ck, final)
+    except BaseException:
+        if not os.path.exists(ck):  # failed before its first checkpoint: nothing to resume
+            shutil.rmtree(build, ignore_errors=True)
+        raise
+
+
+def _chain_problem(post):
+    """Why the chain cannot be read as a posterior (``None``: it can): it never moved, or its
+    autocorrelation time could not be estimated (a flat or stuck chain)."""
+    s = post["sampling"]
+    if not s["acceptance_mean"] > 0:
+        return "the chain never moved (acceptance 0): the percentiles are its starting ball"
+    tau = [float("nan") if t is None else t for t in s["tau_steps"]]
+    if not all(math.isfinite(t) for t in tau):
+        return "the autocorrelation time is not finite (a stuck or flat chain): the percentiles are not a posterior"
+    return None
 
 
 def _print_sampling(post, total_seconds):
@@ -305,6 +322,10 @@ def _cmd_fit(args) -> int:
         f"wrote {args.out}/posterior.json, chain.npz"
         + ("" if args.no_plots else ", corner.png, predictive.png, residuals.png")
     )
+    problem = _chain_problem(post)
+    if problem:
+        print(f"FAILED: {problem}")
+        return 1
     return 0
 
 
