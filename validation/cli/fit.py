@@ -251,12 +251,27 @@ def _run_fit(args, lik, settings):
                 executor_desc=executor,
                 plots=not args.no_plots,
             )
-    except KeyboardInterrupt:
-        return _interrupted(ck, final)
-    except BaseException:
-        if not os.path.exists(ck):  # failed before its first checkpoint: nothing to resume
-            shutil.rmtree(build, ignore_errors=True)
+    except BaseException as exc:
+        _keep_checkpoint_only(build, ck)
+        if isinstance(exc, KeyboardInterrupt):
+            return _interrupted(ck, final)
         raise
+
+
+def _keep_checkpoint_only(build, ck):
+    """After a failed or interrupted run: the build keeps its chain as ``ck`` (for --resume)
+    and nothing else (half-written results must not be swapped in by a later run); a build
+    without a chain is removed."""
+    done = os.path.join(build, "chain.npz")
+    if os.path.exists(done) and not os.path.exists(ck):
+        os.replace(done, ck)  # the run failed after its chain was complete
+    if not os.path.exists(ck):
+        shutil.rmtree(build, ignore_errors=True)
+        return
+    for name in os.listdir(build):
+        if name != os.path.basename(ck):
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(os.path.join(build, name))
 
 
 def _chain_problem(post):
