@@ -13,7 +13,6 @@ during a fit says how to resume (exit 130).
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import shutil
 import sys
@@ -275,14 +274,11 @@ def _keep_checkpoint_only(build, ck):
 
 
 def _chain_problem(post):
-    """Why the chain cannot be read as a posterior (``None``: it can): it never moved, or its
-    autocorrelation time could not be estimated (a flat or stuck chain)."""
-    s = post["sampling"]
-    if not s["acceptance_mean"] > 0:
-        return "the chain never moved (acceptance 0): the percentiles are its starting ball"
-    tau = [float("nan") if t is None else t for t in s["tau_steps"]]
-    if not all(math.isfinite(t) for t in tau):
-        return "the autocorrelation time is not finite (a stuck or flat chain): the percentiles are not a posterior"
+    """Why the chain cannot be read as a posterior (``None``: it can): no walker ever moved,
+    so its percentiles are the starting ball (its tau is NaN too).  A NaN tau alone is a
+    chain too short to estimate it: "NOT converged", said already, not a failure."""
+    if not post["sampling"]["acceptance_mean"] > 0:
+        return "the chain never moved (acceptance 0): the percentiles are its starting ball, not a posterior"
     return None
 
 
