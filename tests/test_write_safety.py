@@ -12,6 +12,7 @@ from __future__ import annotations
 import errno
 import importlib
 import importlib.metadata
+import json
 import os
 import subprocess
 import sys
@@ -87,6 +88,34 @@ def test_a_fit_that_fails_writing_leaves_the_previous_fit_byte_identical(complet
     left = sorted(os.listdir(complete_fit.parent))
     assert left == [".fit.lock", ".fit.partial", "fit"], left
     assert os.listdir(complete_fit.parent / ".fit.partial") == ["chain.partial.npz"]
+    # and --resume finishes that run from its chain (no new sampling: the budget is spent)
+    monkeypatch.undo()
+    assert main(_fit_args(complete_fit, "--resume", "--seed", "7")) == 0
+    post = json.loads((complete_fit / "posterior.json").read_text())
+    assert post["settings"]["seed"] == 7 and post["sampling"]["steps"] == 20
+    assert sorted(os.listdir(complete_fit.parent)) == [".fit.lock", "fit"]
+    assert set(os.listdir(complete_fit)) == set(before)
+
+
+def test_the_swap_puts_the_old_folder_back_when_the_new_one_cannot_be_renamed_in(tmp_path, monkeypatch):
+    out, new = tmp_path / "out", tmp_path / "new"
+    out.mkdir()
+    (out / "a").write_text("old")
+    new.mkdir()
+    (new / "a").write_text("new")
+    real, calls = os.rename, []
+
+    def rename(src, dst):
+        calls.append((src, dst))
+        if len(calls) == 2:  # new -> out: the moment the old folder is aside
+            raise OSError(errno.EIO, "simulated", str(dst))
+        real(src, dst)
+
+    monkeypatch.setattr(atomic.os, "rename", rename)
+    with pytest.raises(OSError, match="simulated"):
+        atomic.swap_folder(str(new), str(out))
+    assert (out / "a").read_text() == "old" and (new / "a").read_text() == "new"
+    assert sorted(os.listdir(tmp_path)) == ["new", "out"]  # the old folder is back, nothing aside
 
 
 def test_a_second_fit_into_a_folder_being_written_is_refused(tmp_path, capsys):
