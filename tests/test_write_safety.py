@@ -317,3 +317,16 @@ def test_a_latin_1_stdout_does_not_stop_a_command(tmp_path):
     assert r.returncode == 0, r.stderr
     assert b"SubsurfaceFacetBRDF \\u2014 facets" in r.stdout  # the em dash, escaped
     assert len((tmp_path / "s" / "small.csv").read_bytes().decode("utf-8").splitlines()) > 100
+
+
+def test_a_report_folder_given_as_a_symlink_keeps_the_link(tmp_path, monkeypatch):
+    """The folder the link names is replaced (built beside it), not the link."""
+    target = tmp_path / "real"
+    target.mkdir()
+    link = tmp_path / "link"
+    link.symlink_to(target)
+    monkeypatch.setattr(build, "build_report", _stub_report("new"))
+    build.write_report(str(link))
+    assert link.is_symlink() and os.path.realpath(link) == str(target)
+    assert (target / "report.html").read_text() == "<html>new</html>"
+    assert sorted(os.listdir(tmp_path)) == [".real.lock", "link", "real"]

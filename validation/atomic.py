@@ -208,9 +208,15 @@ class FolderBusy(FolderError):
         )
 
 
+def _resolved(out):
+    """``out`` as an absolute path; a symlink to a folder is followed, so that the folder it
+    names is replaced (and built beside, on its file system), not the link."""
+    return os.path.realpath(out) if os.path.islink(out) else os.path.abspath(out)
+
+
 def beside(out, tag):
     """The path ``.NAME.TAG`` in the folder that holds ``out`` (its lock, its build)."""
-    out = os.path.abspath(out)
+    out = _resolved(out)
     return os.path.join(os.path.dirname(out), f".{os.path.basename(out)}.{tag}")
 
 
@@ -220,7 +226,14 @@ def folder_lock(out, wait=0.0):
     folder itself is swapped, so its lock cannot live inside).  Raises :class:`FolderBusy`
     when another run holds it for longer than ``wait`` seconds (default: refuse at once,
     since two runs writing one folder is a mistake, not a queue)."""
-    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    parent = os.path.dirname(_resolved(out))
+    os.makedirs(parent, exist_ok=True)
+    problem = write_problem(parent)
+    if problem:
+        raise FolderError(
+            f"{out}: cannot write in {parent} ({problem}); the folder is built beside the old one "
+            "and swapped in, under a lock there"
+        )
     try:
         with file_lock(beside(out, "lock"), wait=wait):
             yield
@@ -232,12 +245,11 @@ def swap_folder(new, out):
     """Put the complete folder ``new`` at ``out``: the old ``out`` is renamed aside, ``new``
     renamed in, the old one removed.  If the second rename fails the old folder is put back,
     so ``out`` is always the old folder or the new one, never a mixture."""
+    out = _resolved(out)
     if not os.path.lexists(out):
         os.rename(new, out)
         return
-    old = tempfile.mkdtemp(
-        prefix=f".{os.path.basename(os.path.abspath(out))}.old-", dir=os.path.dirname(os.path.abspath(out))
-    )
+    old = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.old-", dir=os.path.dirname(out))
     os.rmdir(old)  # a unique name for the old folder; rename needs it absent
     os.rename(out, old)
     try:
@@ -292,10 +304,8 @@ def replacing_folder(out, owned=None, build=None, keep_build=(), wait=0.0, lock=
                 f"{', ...' if len(foreign) > 5 else ''}); it replaces the folder as a whole: give a folder of its own"
             )
         if build is None:
-            build = tempfile.mkdtemp(
-                prefix=f".{os.path.basename(os.path.abspath(out))}.build-",
-                dir=os.path.dirname(os.path.abspath(out)),
-            )
+            where = beside(out, "build-")
+            build = tempfile.mkdtemp(prefix=os.path.basename(where), dir=os.path.dirname(where))
         os.makedirs(build, exist_ok=True)
         try:
             yield build
