@@ -73,6 +73,10 @@ def contributed_models() -> list[Contributed]:
         except Exception as exc:  # noqa: BLE001 - a broken plug-in is reported, not fatal
             out.append(Contributed(ep.name, ep.value, dist, None, f"{type(exc).__name__}: {exc}"))
             continue
+        except SystemExit as exc:  # its module called sys.exit: broken too, not the end of the listing
+            why = f"its module called sys.exit({exc.code!r}) while loading"
+            out.append(Contributed(ep.name, ep.value, dist, None, why))
+            continue
         out.append(Contributed(ep.name, ep.value, dist, model))
     return out
 

@@ -43,7 +43,7 @@ def data_path(name: str) -> str:
 def provenance(name: str) -> str:
     """The leading ``#`` comment lines of a data file, without the ``#``."""
     lines = []
-    with open(data_path(name)) as fh:
+    with open(data_path(name), encoding="utf-8") as fh:
         for line in fh:
             if not line.startswith("#"):
                 break
@@ -53,7 +53,7 @@ def provenance(name: str) -> str:
 
 def read_csv(name: str) -> list[dict]:
     """Rows of a committed CSV file (comment lines skipped) as dicts of strings."""
-    with open(data_path(name)) as fh:
+    with open(data_path(name), encoding="utf-8") as fh:
         rows = [line for line in fh if not line.startswith("#")]
     return list(csv.DictReader(rows))
 

@@ -80,7 +80,8 @@ def test_ctrl_c_during_a_fit_says_how_to_resume_in_one_line(tmp_path, workers):
     )
     try:
         deadline = time.monotonic() + 300
-        while not (out / "chain.partial.npz").exists():
+        # the running checkpoint lives in the build beside the folder (swapped in when done)
+        while not (tmp_path / ".fit.partial" / "chain.partial.npz").exists():
             assert p.poll() is None and time.monotonic() < deadline, p.communicate()
             time.sleep(0.2)
         time.sleep(0.5)
@@ -92,7 +93,8 @@ def test_ctrl_c_during_a_fit_says_how_to_resume_in_one_line(tmp_path, workers):
     assert p.returncode == 130, err
     lines = [ln for ln in err.splitlines() if ln.strip()]
     assert len(lines) == 1 and "Traceback" not in err, err
-    assert lines[0].startswith("interrupted: the chain (") and "chain.partial.npz" in lines[0]
+    assert lines[0].startswith("interrupted: the chain (") and ".fit.partial/chain.partial.npz" in lines[0]
+    assert not out.exists()  # nothing half-written where the results go
     assert "--resume" in lines[0]
     # and the line's advice works: the same command with --resume continues the chain
     r = _run(_fit_args(out, "--max-steps", "60", "--workers", workers, "--resume"))

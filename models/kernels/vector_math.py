@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 from llvmlite import ir
-from numba import njit, types
+from numba import config, njit, types
 from numba.extending import intrinsic
 
 #: ``pi/2`` in three parts: 30 + 30 significant bits, and the rest
@@ -119,6 +119,21 @@ def sqrt(typingctx, x):
         return builder.call(fn, args)
 
     return x(x), codegen
+
+
+if config.DISABLE_JIT:
+    # NUMBA_DISABLE_JIT=1 (a debugging switch) runs the kernels as Python, where an
+    # @intrinsic cannot be called: the same operations in numpy, bit for bit.
+
+    def _from_bits(bits):  # noqa: F811 - the interpreted twin of the intrinsic above
+        return np.int64(bits).view(np.float64)
+
+    def _to_bits(x):  # noqa: F811
+        return np.float64(x).view(np.int64)
+
+    def sqrt(x):  # noqa: F811 - IEEE sqrt, NaN below zero (as llvm.sqrt), without numpy's warning
+        with np.errstate(invalid="ignore"):
+            return np.sqrt(x)
 
 
 @njit(error_model="numpy", inline="always")

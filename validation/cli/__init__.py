@@ -12,13 +12,17 @@ Exit codes, the same for every command (:func:`main`):
   one ``error: ...`` line naming the file (``file:line:column`` where known), key
   or flag, no traceback;
 * 3: an internal error (a bug or a failing machine): ``error: internal: ...``;
-  ``SCATTERBENCH_TRACEBACK=1`` shows the traceback;
-* 130: interrupted (Ctrl-C).
+  ``SCATTERBENCH_TRACEBACK=1`` shows the traceback.  Also code that is not the
+  command's calling ``sys.exit`` (a plug-in's module, a model's ``mueller``, a module
+  given to ``check``): whatever its code, the command did not finish, so it is
+  never success: ``error: user code called sys.exit(CODE) in FILE:LINE (FUNCTION)``;
+* 130: interrupted (Ctrl-C, or a ``KeyboardInterrupt`` raised by user code).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import sys
@@ -43,6 +47,8 @@ INPUT_ERRORS = {
     "scatterbench.validation.fitting.checkpoint": "CheckpointError",
     "scatterbench.validation.fitting.executors": "SchedulerError",
     "scatterbench.validation.report.nightly": "HistoryError",
+    "scatterbench.validation.atomic": "FolderError",
+    "scatterbench.validation.fitting.fit": "FitError",
 }
 
 
@@ -53,6 +59,17 @@ def _is_input_error(exc) -> bool:
         if mod is not None and isinstance(exc, getattr(mod, name)):
             return True
     return False
+
+
+def _where(exc) -> str:
+    """``FILE:LINE (FUNCTION)`` of the frame that raised ``exc`` (the innermost one)."""
+    tb = exc.__traceback__
+    if tb is None:
+        return "an unknown place"
+    while tb.tb_next is not None:
+        tb = tb.tb_next
+    code = tb.tb_frame.f_code
+    return f"{code.co_filename}:{tb.tb_lineno} ({code.co_name})"
 
 
 def _parser():
@@ -79,8 +96,20 @@ def _show_compiling():
         log.setLevel(logging.INFO)
 
 
+def _tolerant_streams():
+    """Let stdout and stderr show any character: one their encoding cannot hold (an em dash
+    in a scene's description under ``PYTHONIOENCODING=latin-1``) is written as ``\\u2014``
+    instead of ending the command.  Files are written as UTF-8 whatever the locale."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is not None:
+            with contextlib.suppress(ValueError, OSError, TypeError):  # a stream that cannot
+                reconfigure(errors="backslashreplace")
+
+
 def main(argv=None) -> int:
     """Run one command; returns its exit code (see the module docstring), never raises."""
+    _tolerant_streams()
     try:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # argparse has printed usage and ``error: ...`` (2) or --help (0)
@@ -91,6 +120,10 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except SystemExit as exc:  # no command exits this way: user code it ran did
+        print(f"error: user code called sys.exit({exc.code!r}) in {_where(exc)}", file=sys.stderr)
+        print("(the command did not finish: that is never success)", file=sys.stderr)
+        return EXIT_INTERNAL
     except Exception as exc:
         if _is_input_error(exc):
             print(f"error: {exc}", file=sys.stderr)

@@ -23,8 +23,12 @@ def run(spec, json_path=None, quick=False, checks=None) -> int:
     if os.getcwd() not in sys.path:
         sys.path.insert(0, os.getcwd())
     try:
+        names = None if checks is None else [c.strip() for c in checks.split(",") if c.strip()]
+        if names == []:  # "" or ",": a list of no checks would run nothing and pass
+            raise ValueError(
+                f"--checks {checks!r}: no check name given (comma-separated names; omit it for all)"
+            )
         model = load_model(spec)
-        names = [c.strip() for c in checks.split(",") if c.strip()] if checks else None
         t0 = time.perf_counter()
         report = check_model(model, checks=names, quick=quick, label=spec)
     except ValueError as exc:  # a model spec that names no model, an unknown check name

@@ -1,19 +1,25 @@
 """``scatterbench fit`` (the study commands are in :mod:`scatterbench.validation.cli.study`).
 
 Output folders are refused when they exist and are not empty, unless
-``--force`` (replace the results; files are replaced atomically, so a failed
-run leaves the previous ones intact) or, for ``fit``, ``--resume`` (continue
-the chain saved in ``DIR/chain.npz``); every flag and input is checked before
-the optimizer starts.  Ctrl-C during a fit says how to resume (exit 130).
+``--force`` (replace the results) or, for ``fit``, ``--resume`` (continue the
+chain saved in ``DIR/chain.npz``, or the one an interrupted or failed run left in
+``.DIR.partial/``); every flag and input is checked before the optimizer starts.
+The folder is built beside the old one and swapped in whole, under the folder's
+lock (``.DIR.lock``): a failed run leaves the previous results intact, and a
+second run on the same folder is refused (exit 2) while the first runs.  Ctrl-C
+during a fit says how to resume (exit 130).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import shutil
 import sys
 import time
 
 from scatterbench.models import scene as scene_mod
+from scatterbench.validation.atomic import beside, folder_lock, replacing_folder
 from scatterbench.validation.fitting.checkpoint import saved_steps
 from scatterbench.validation.fitting.datafile import load_data
 from scatterbench.validation.fitting.executors import make_executor
@@ -35,11 +41,22 @@ def _check_out(out, force, resume=None):
             "--force and --resume: give one (--force replaces the results, --resume continues them)"
         )
     writable_folder(out, "--out")
+    # the folder is replaced whole (renamed): its parent must take the new one and the lock
+    writable_folder(os.path.dirname(os.path.abspath(out)), "--out")
     if os.path.isdir(out) and os.listdir(out) and not (force or resume):
         raise UsageError(
             f"{out} exists and is not empty; use --force to overwrite it"
             + (" or --resume" if resume is not None else "")
         )
+
+
+@contextlib.contextmanager
+def locked_out(args, resume=None):
+    """Hold ``args.out``'s lock for the block (another run writing it: ``FolderBusy``, exit 2),
+    with :func:`_check_out` repeated under it (another run may have filled the folder)."""
+    with folder_lock(args.out):
+        _check_out(args.out, args.force, resume)
+        yield
 
 
 def _check_executor(args):
@@ -188,39 +205,81 @@ def _interrupted(ck, final):
     return 130
 
 
-def _run_fit(args, lik, settings):
-    """Run (or resume) the chain in ``args.out`` and write the results; returns the
-    posterior summary, or the exit code 130 after Ctrl-C.  The running checkpoint is
-    chain.partial.npz; it becomes chain.npz when the run ends, so a failed --force
-    run never replaces a previous complete chain."""
+#: the files ``fit`` writes into its folder; an old folder holding anything else is refused
+#: rather than deleted by the swap
+FIT_FILES = frozenset(
+    {"posterior.json", "chain.npz", "chain.partial.npz", "corner.png", "predictive.png", "residuals.png"}
+)
 
-    os.makedirs(args.out, exist_ok=True)
-    ck = os.path.join(args.out, "chain.partial.npz")
+
+def _run_fit(args, lik, settings):
+    """Run (or resume) the chain and write the results; returns the posterior summary, or
+    the exit code 130 after Ctrl-C.
+
+    The new folder is built beside ``args.out`` in ``.NAME.partial/`` (its running
+    checkpoint is chain.partial.npz there) and swapped in whole when every file is
+    written (:func:`~scatterbench.validation.atomic.replacing_folder`): a failed or
+    interrupted run leaves the previous results as they were.  The build is kept when
+    the run fails, so ``--resume`` continues its chain; the caller holds the folder's lock,
+    so no other run shares the checkpoint."""
+
+    build = beside(args.out, "partial")
+    if not args.resume:
+        shutil.rmtree(build, ignore_errors=True)  # a fresh run: an earlier run's build is not continued
+    ck = os.path.join(build, "chain.partial.npz")
     final = os.path.join(args.out, "chain.npz")
     try:
-        with _open_executor(args) as ex:
-            res = run_fit(
-                lik,
-                settings,
-                executor=ex,
-                checkpoint=ck,
-                resume=args.resume,
-                resume_from=ck if os.path.exists(ck) else final,
-                progress=not args.no_progress,
+        with replacing_folder(args.out, FIT_FILES.__contains__, build, (BaseException,), lock=False):
+            with _open_executor(args) as ex:
+                res = run_fit(
+                    lik,
+                    settings,
+                    executor=ex,
+                    checkpoint=ck,
+                    resume=args.resume,
+                    resume_from=ck if os.path.exists(ck) else final,
+                    progress=not args.no_progress,
+                )
+                executor = ex.describe()
+            os.replace(ck, os.path.join(build, "chain.npz"))
+            return write_fit(
+                res,
+                build,
+                data_path=args.data,
+                scene_path=args.scene,
+                executor_desc=executor,
+                plots=not args.no_plots,
             )
-            executor = ex.describe()
-    except KeyboardInterrupt:
-        return _interrupted(ck, final)
-    if os.path.exists(ck):
-        os.replace(ck, final)
-    return write_fit(
-        res,
-        args.out,
-        data_path=args.data,
-        scene_path=args.scene,
-        executor_desc=executor,
-        plots=not args.no_plots,
-    )
+    except BaseException as exc:
+        _keep_checkpoint_only(build, ck)
+        if isinstance(exc, KeyboardInterrupt):
+            return _interrupted(ck, final)
+        raise
+
+
+def _keep_checkpoint_only(build, ck):
+    """After a failed or interrupted run: the build keeps its chain as ``ck`` (for --resume)
+    and nothing else (half-written results must not be swapped in by a later run); a build
+    without a chain is removed."""
+    done = os.path.join(build, "chain.npz")
+    if os.path.exists(done) and not os.path.exists(ck):
+        os.replace(done, ck)  # the run failed after its chain was complete
+    if not os.path.exists(ck):
+        shutil.rmtree(build, ignore_errors=True)
+        return
+    for name in os.listdir(build):
+        if name != os.path.basename(ck):
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(os.path.join(build, name))
+
+
+def _chain_problem(post):
+    """Why the chain cannot be read as a posterior (``None``: it can): no walker ever moved,
+    so its percentiles are the starting ball (its tau is NaN too).  A NaN tau alone is a
+    chain too short to estimate it: "NOT converged", said already, not a failure."""
+    if not post["sampling"]["acceptance_mean"] > 0:
+        return "the chain never moved (acceptance 0): the percentiles are its starting ball, not a posterior"
+    return None
 
 
 def _print_sampling(post, total_seconds):
@@ -264,7 +323,8 @@ def _cmd_fit(args) -> int:
         f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
     )
     t0 = time.perf_counter()
-    post = _run_fit(args, lik, settings)
+    with locked_out(args, args.resume):  # held from the check of --out to the swap
+        post = _run_fit(args, lik, settings)
     if isinstance(post, int):  # interrupted
         return post
     _print_sampling(post, time.perf_counter() - t0)
@@ -273,6 +333,10 @@ def _cmd_fit(args) -> int:
         f"wrote {args.out}/posterior.json, chain.npz"
         + ("" if args.no_plots else ", corner.png, predictive.png, residuals.png")
     )
+    problem = _chain_problem(post)
+    if problem:
+        print(f"FAILED: {problem}")
+        return 1
     return 0
 
 

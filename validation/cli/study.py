@@ -6,7 +6,8 @@
 * ``compare``: several scenes fitted to the same data (:mod:`scatterbench.validation.fitting.compare`).
 
 Each writes JSON and PNG into ``--out`` (refused when it exists and is not
-empty, unless ``--force``).
+empty, unless ``--force``), built beside the old folder and swapped in whole,
+under the folder's lock (see :mod:`scatterbench.validation.cli.fit`).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 
 from scatterbench.models import DetectorAperture
 from scatterbench.models import scene as scene_mod
-from scatterbench.validation.atomic import atomic_savefig, atomic_write_json
+from scatterbench.validation.atomic import atomic_savefig, atomic_write_json, replacing_folder
 from scatterbench.validation.fitting.compare import check_comparable, compare_fits, format_comparison
 from scatterbench.validation.fitting.datafile import load_data
 from scatterbench.validation.fitting.fitspec import fitspec_from, masked_rows
@@ -38,6 +39,7 @@ from .fit import (
     _open_executor,
     _require_walkers,
     _spec_args,
+    locked_out,
 )
 
 __all__ = ["register"]
@@ -66,8 +68,12 @@ def _print_recovery(cells, injections):
 
 
 def _cmd_recovery(args) -> int:
-
     _check_out(args.out, args.force)
+    with locked_out(args):  # held from the check of --out to the swap of the new folder
+        return _recovery(args)
+
+
+def _recovery(args) -> int:
     _check_executor(args)
     settings, sc, data, spec, _ = _load_and_describe(args)
     extra = {k: v for k, v in spec.noise.items() if k != "brdf"}
@@ -90,23 +96,21 @@ def _cmd_recovery(args) -> int:
             progress=not args.no_progress,
         )
     seconds = time.perf_counter() - t0
-    os.makedirs(args.out, exist_ok=True)
-    atomic_write_json(
-        os.path.join(args.out, "recovery.json"),
-        {
-            "scene": args.scene,
-            "geometries_from": args.data,
-            "spec": spec.as_dict(),
-            "seed": settings.seed,
-            "injections_per_cell": args.injections,
-            "walkers": settings.walkers,
-            "max_steps": settings.max_steps,
-            "seconds": seconds,
-            "cells": cells,
-        },
-    )
+    record = {
+        "scene": args.scene,
+        "geometries_from": args.data,
+        "spec": spec.as_dict(),
+        "seed": settings.seed,
+        "injections_per_cell": args.injections,
+        "walkers": settings.walkers,
+        "max_steps": settings.max_steps,
+        "seconds": seconds,
+        "cells": cells,
+    }
+    with replacing_folder(args.out, {"recovery.json", "recovery.png"}.__contains__, lock=False) as out:
+        atomic_write_json(os.path.join(out, "recovery.json"), record)
+        _recovery_plot(cells, out)
     _print_recovery(cells, args.injections)
-    _recovery_plot(cells, args.out)
     print(
         f"{len(cells)} cells x {args.injections} injections in {seconds:.1f} s; wrote {args.out}/recovery.json, recovery.png"
     )
@@ -190,18 +194,23 @@ def _cmd_inversion(args) -> int:
     import matplotlib.pyplot as plt  # matplotlib (heavy): loaded only where a figure is drawn
 
     _check_out(args.out, args.force)
+    with locked_out(args):  # held from the check of --out to the swap of the new folder
+        return _inversion(args, plt)
+
+
+def _inversion(args, plt) -> int:
     data, model = _inversion_model(args)
     try:
         study = inversion_study(model, data, bins=args.bins, n_bootstrap=args.bootstrap, seed=args.seed)
     except ValueError as exc:  # too few distinct slopes for the curve, a model it cannot invert
         raise UsageError(f"{args.data}: {exc}") from exc
-    os.makedirs(args.out, exist_ok=True)
-    atomic_write_json(
-        os.path.join(args.out, "inversion.json"), {"data": args.data, "scene": args.scene, **study.as_dict()}
-    )
-    fig = inversion_figure(study, model)
-    atomic_savefig(fig, os.path.join(args.out, "inversion.png"), dpi=90)
-    plt.close(fig)
+    with replacing_folder(args.out, {"inversion.json", "inversion.png"}.__contains__, lock=False) as out:
+        atomic_write_json(
+            os.path.join(out, "inversion.json"), {"data": args.data, "scene": args.scene, **study.as_dict()}
+        )
+        fig = inversion_figure(study, model)
+        atomic_savefig(fig, os.path.join(out, "inversion.png"), dpi=90)
+        plt.close(fig)
     _print_inversion(study)
     print(f"wrote {args.out}/inversion.json, inversion.png")
     return 0
@@ -222,8 +231,12 @@ def _compare_likelihoods(args):
 
 
 def _cmd_compare(args) -> int:
-
     _check_out(args.out, args.force)
+    with locked_out(args):  # held from the check of --out to the swap of the new folder
+        return _compare(args)
+
+
+def _compare(args) -> int:
     _check_executor(args)
     settings = _chain_settings(args)
     liks, names = _compare_likelihoods(args)
@@ -239,10 +252,10 @@ def _cmd_compare(args) -> int:
         )
     with _open_executor(args) as ex:
         rows, _ = compare_fits(liks, names, settings, executor=ex)
-    os.makedirs(args.out, exist_ok=True)
-    atomic_write_json(
-        os.path.join(args.out, "compare.json"), {"data": args.data, "scenes": args.scene, "rows": rows}
-    )
+    with replacing_folder(args.out, {"compare.json"}.__contains__, lock=False) as out:
+        atomic_write_json(
+            os.path.join(out, "compare.json"), {"data": args.data, "scenes": args.scene, "rows": rows}
+        )
     print(format_comparison(rows))
     for r in rows:
         print(f"  {r['scene']}: {r['stop_reason']}; acceptance {r['acceptance']:.3f}")

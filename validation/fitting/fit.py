@@ -26,6 +26,7 @@ from .sampling import ChainResult, initial_ball, optimize, run_chain, summarize
 from .settings import ChainSettings
 
 __all__ = [
+    "FitError",
     "FitResult",
     "run_fit",
     "predictive",
@@ -35,6 +36,34 @@ __all__ = [
     "predictive_figure",
     "scan_x",
 ]
+
+
+class FitError(ValueError):
+    """Data a fit cannot start from: the log likelihood is not finite at the best start
+    (a row the model cannot reach, an error column that overflows its variance); the
+    message names the rows (the command line: ``error: ...``, exit 2)."""
+
+
+def _require_finite(lik, u, lp):
+    """Raise :class:`FitError` when ``lp`` (the best start's log posterior) is not finite:
+    every walker would start where ln L = -inf, never move, and its starting ball would be
+    reported as a posterior."""
+    if math.isfinite(lp):
+        return
+    with np.errstate(all="ignore"):
+        bad = np.flatnonzero(~np.isfinite(lik.pointwise(u)))
+    lines = getattr(lik.data, "lines", None)
+    where = (
+        ", ".join(f"line {int(lines[i])}" if lines is not None else f"row {int(i)}" for i in bad[:5])
+        + (", ..." if len(bad) > 5 else "")
+        if len(bad)
+        else "the prior"
+    )
+    raise FitError(
+        f"{getattr(lik.data_all, 'path', 'data')}: ln L is not finite ({lp}) at the best of the fit's "
+        f"starts: {len(bad)} row(s) give an impossible likelihood ({where}): an error column so large "
+        "its variance overflows, or a value the model cannot reach; the chain would never move"
+    )
 
 
 @dataclass
@@ -111,6 +140,7 @@ def run_fit(
     else:
         backend = CheckpointBackend(checkpoint, fp)
     u_opt, lp_opt, info = optimize(lik, settings.seed, n_starts=settings.starts)
+    _require_finite(lik, u_opt, lp_opt)  # before sampling: a chain from -inf never moves
     p0 = None
     if not resume:
         p0 = initial_ball(u_opt, settings.walkers, settings.seed, lik.spec.u_bounds(), sd=info["sd_u"])
@@ -264,15 +294,21 @@ def corner_figure(fit: FitResult):
     x = np.column_stack([p.from_u(u[:, i]) for i, p in enumerate(spec.free)])
     truth = fit.lik.data_all.meta.get("truth") or {}
     truths = [truth.get(p.key) for p in spec.free]
-    return corner.corner(
+    if not any(t is not None for t in truths):
+        truths = None
+    one = x.shape[1] == 1  # corner draws one Axes, not a grid: its truth lines index a grid
+    fig = corner.corner(
         x,
         labels=spec.names,
-        truths=truths if any(t is not None for t in truths) else None,
+        truths=None if one else truths,
         quantiles=[0.025, 0.16, 0.5, 0.84, 0.975],
         title_quantiles=[0.16, 0.5, 0.84],
         show_titles=True,
         title_fmt=".4g",
     )
+    if one and truths is not None:
+        fig.axes[0].axvline(truths[0], color="#4682b4")  # corner's truth colour
+    return fig
 
 
 def predictive_figure(fit: FitResult, pp):

@@ -49,16 +49,23 @@ def term_variances(noise: dict, data, terms) -> dict:
     ``data`` has one (``data=None``: the noise levels alone).  A level not given is 0."""
     err = (lambda name: None) if data is None else (lambda name: getattr(data, name))  # noqa: E731
     out = {}
-    for t in terms:
-        if t == "brdf":
-            f = noise.get("brdf", 0.0)
-            e = err("brdf_err")
-            out[t] = f * f + (0.0 if e is None else (e / data.brdf) ** 2)
-        else:
-            s = np.radians(noise.get("eta_deg", 0.0)) if t == "eta" else noise.get(t, 0.0)
-            e = err(f"{t}_err")
-            out[t] = s * s + (0.0 if e is None else e**2)
+    # an error column whose square exceeds float64 gives an infinite variance without a
+    # warning: ln L is then -inf on those rows, and the fit refuses them by line (fit.FitError)
+    with np.errstate(over="ignore"):
+        for t in terms:
+            out[t] = _variance(t, noise, err, data)
     return out
+
+
+def _variance(t, noise, err, data):
+    """One term's per-row variance (see :func:`term_variances`)."""
+    if t == "brdf":
+        f = noise.get("brdf", 0.0)
+        e = err("brdf_err")
+        return f * f + (0.0 if e is None else (e / data.brdf) ** 2)
+    s = np.radians(noise.get("eta_deg", 0.0)) if t == "eta" else noise.get(t, 0.0)
+    e = err(f"{t}_err")
+    return s * s + (0.0 if e is None else e**2)
 
 
 def replicate(pred: dict, variances: dict, rng) -> dict:

@@ -11,14 +11,14 @@ import traceback
 
 from tqdm import tqdm
 
-from scatterbench.validation.atomic import atomic_write_json, atomic_write_text
+from scatterbench.validation.atomic import atomic_write_json, atomic_write_text, replacing_folder
 from scatterbench.validation.checks.registry import SEED, check_record, judge, select, tally
 
 from .core import Context, Section, render_html
 from .provenance import git_commit
 from .sections import SECTIONS, report_checks
 
-__all__ = ["build_report", "write_report", "read_results_checked"]
+__all__ = ["build_report", "write_report", "write_files", "read_results_checked", "REPORT_FILES"]
 
 
 def _progress(total, label):
@@ -138,20 +138,34 @@ def read_results_checked(path):
     return res, None
 
 
-def write_report(out_dir, quick=False, previous=None, **kwargs):
-    """Write ``report.html`` and ``results.json`` into ``out_dir`` (each atomically).
+#: the files a report folder holds; an old folder holding anything else is refused
+#: rather than deleted by the swap
+REPORT_FILES = frozenset({"report.html", "results.json"})
+
+
+def write_files(folder, results, html):
+    """Write ``results.json`` and ``report.html`` into the (new, unpublished) ``folder``."""
+    atomic_write_json(os.path.join(folder, "results.json"), results)
+    atomic_write_text(os.path.join(folder, "report.html"), html)
+
+
+def write_report(out_dir, quick=False, previous=None, wait=0.0, **kwargs):
+    """Write ``report.html`` and ``results.json`` into ``out_dir``, together: the folder is
+    built beside the old one and swapped in whole, under its lock
+    (:func:`~scatterbench.validation.atomic.replacing_folder`), so a failed run leaves the
+    old pair as it was and a concurrent run on the same folder is refused
+    (:class:`~scatterbench.validation.atomic.FolderBusy`).
 
     The previous ``results.json`` of that folder (if any) is the comparison base
     for "change since previous" unless ``previous`` is given; one that cannot be
     used is said so in ``results["meta"]["previous_problem"]``.
     """
-    os.makedirs(out_dir, exist_ok=True)
-    problem = None
-    if previous is None:
-        previous, problem = read_results_checked(os.path.join(out_dir, "results.json"))
-    results, html = build_report(quick=quick, previous=previous, **kwargs)
-    if problem:
-        results["meta"]["previous_problem"] = problem
-    atomic_write_json(os.path.join(out_dir, "results.json"), results)
-    atomic_write_text(os.path.join(out_dir, "report.html"), html)
+    with replacing_folder(out_dir, REPORT_FILES.__contains__, wait=wait) as build:
+        problem = None
+        if previous is None:
+            previous, problem = read_results_checked(os.path.join(out_dir, "results.json"))
+        results, html = build_report(quick=quick, previous=previous, **kwargs)
+        if problem:
+            results["meta"]["previous_problem"] = problem
+        write_files(build, results, html)
     return results

@@ -35,9 +35,9 @@ import re
 import shutil
 from typing import NamedTuple
 
-from scatterbench.validation.atomic import LockHeld, atomic_write_json, file_lock, write_problem
+from scatterbench.validation.atomic import LockHeld, file_lock, write_problem
 
-from .build import read_results_checked, write_report
+from .build import build_report, read_results_checked, write_files
 
 __all__ = ["nightly", "compare_results", "HistoryError", "NightlyRun"]
 
@@ -222,6 +222,17 @@ def nightly(history, quick=False, stamp=None, wait=3600.0, _after_build=None, **
         ) from exc
 
 
+def _build(tmp, quick, previous, notes, after_build, kwargs):
+    """The run's report and results (with its regressions and notes) written into ``tmp``."""
+    results, html = build_report(quick=quick, previous=previous or {}, **kwargs)
+    results["regressions"] = compare_results(previous, results)
+    results["history_notes"] = notes
+    write_files(tmp, results, html)
+    if after_build is not None:
+        after_build(tmp)  # test hook: simulate a kill before the commit point
+    return results
+
+
 def _run(history, quick, stamp, after_build, kwargs):
     """The run itself, under the history's lock."""
     _check_layout(history)
@@ -230,17 +241,17 @@ def _run(history, quick, stamp, after_build, kwargs):
     previous, notes = _previous(history)
     tmp = os.path.join(history, f".tmp-{stamp}")
     os.makedirs(tmp)
-    results = write_report(tmp, quick=quick, previous=previous or {}, **kwargs)
-    regressions = compare_results(previous, results)
-    results["regressions"] = regressions
-    results["history_notes"] = notes
-    atomic_write_json(os.path.join(tmp, "results.json"), results)
-    if after_build is not None:
-        after_build(tmp)  # test hook: simulate a kill before the commit point
-    final = os.path.join(history, "runs", stamp)
-    os.replace(tmp, final)
+    try:
+        results = _build(tmp, quick, previous, notes, after_build, kwargs)
+        final = os.path.join(history, "runs", stamp)
+        os.replace(tmp, final)
+    except BaseException:
+        # whatever stopped the run (an error, Ctrl-C, user code calling sys.exit): no half run left
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
     link_tmp = os.path.join(history, f".tmp-latest-{stamp}")
     os.symlink(os.path.join("runs", stamp), link_tmp)
     os.replace(link_tmp, os.path.join(history, "latest"))
     failed = any(c["status"] == "fail" for c in results["checks"])
+    regressions = results["regressions"]
     return NightlyRun(1 if (regressions or failed or notes) else 0, regressions, final, notes)

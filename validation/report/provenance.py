@@ -34,7 +34,7 @@ def git_commit() -> str:
     if here:
         return here
     try:
-        with open(os.path.join(_PACKAGE, "_build_commit.txt")) as fh:
+        with open(os.path.join(_PACKAGE, "_build_commit.txt"), encoding="utf-8") as fh:
             recorded = fh.read().strip()
     except OSError:
         recorded = ""
