@@ -217,13 +217,21 @@ def check_recovery_coverage(ctx, cells=None):
 STRONG_DBIC = 10.0
 
 
+#: independent chains per fit of the model comparison (validation/fitting/compare.py)
+COMPARISON_CHAINS = 2
+
+
 def comparison_settings(quick):
-    """Seed 003's model comparison, ``dict(rows, settings)``: quick runs use the configuration of
+    """Seed 003's model comparison, ``dict(rows, settings, chains)``: quick runs use the configuration of
     tests/test_recovery.py (the same seed, so a test session fits it once)."""
 
+    # Two independent chains per fit (the second seeded from the first's seed and its index): the
+    # between-chain R-hat in the rows, and twice the tasks to keep the workers busy (16, not 8).
     if quick:
         return dict(
-            rows=40, settings=ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
+            rows=40,
+            settings=ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3),
+            chains=COMPARISON_CHAINS,
         )
     # Differential evolution: at 2000 steps the stretch move converged (N >= 50 tau) 0 of the
     # 8 chains (max tau 44-156), "de" 5 of 8 (by 800-1900 steps), measured 2026-11-24 by
@@ -231,6 +239,7 @@ def comparison_settings(quick):
     return dict(
         rows=None,
         settings=ChainSettings(walkers=24, seed=3, max_steps=12000, check_every=100, starts=4, moves="de"),
+        chains=COMPARISON_CHAINS,
     )
 
 
