@@ -169,3 +169,15 @@ def test_results_without_timings_differ_when_a_result_does(in_process):
     key = next(iter(moved["sections"]["seed003_presets"]["tracked"]))
     moved["sections"]["seed003_presets"]["tracked"][key]["value"] += 1e-12
     assert results_digest(moved) != results_digest(in_process)
+
+
+def test_the_monte_carlo_checks_runs_identical_on_workers():
+    """The slow Monte Carlo checks' runs (25 for the error scaling) are tasks of the run's executor."""
+    from scatterbench.validation.checks.seed003 import mc_error_scaling
+    from scatterbench.validation.fitting.executors import ProcessExecutor
+
+    spy = Spy()
+    serial = mc_error_scaling(seeds=2, executor=spy, reference_pairs=5000)
+    assert spy.tasks == [1 + 3 * 2]
+    with ProcessExecutor(2) as ex:
+        assert mc_error_scaling(seeds=2, executor=ex, reference_pairs=5000) == serial
