@@ -4,7 +4,7 @@ count, and the first ``report --quick`` cold and warm.
     python benchmarks/scaling.py [--geometries 1000000] [--threads 1 2 ...] [--workers 1 2 ...]
                                  [--studies sweep-quick presets ...] [--first-run] [--repeat 3]
 
-* **Kernels.** ``FacetBRDF`` (Gaussian slopes, aluminium, no shadowing) on ``--geometries``
+* **Kernels.** ``FacetBRDF.mueller16`` (Gaussian slopes, aluminium, no shadowing) on ``--geometries``
   random geometries, ``numba.set_num_threads(t)`` for every ``t`` in ``--threads`` (default
   1 .. the cores of this process's affinity mask): the best of ``--repeat`` calls, into a fresh
   result and into ``out=``, in ns per geometry, and the speedup over one thread.
@@ -62,7 +62,8 @@ def _best(fn, repeat):
 
 
 def kernels(n, threads, repeat):
-    """ns per geometry of FacetBRDF's Mueller matrix at each thread count, fresh and into out=."""
+    """ns per geometry of FacetBRDF's Mueller matrix (``mueller16``: the kernels' element-major
+    layout) at each thread count, into a fresh result and into ``out=``."""
     import numba
 
     from scatterbench import models
@@ -71,15 +72,15 @@ def kernels(n, threads, repeat):
     rng = np.random.default_rng(1)
     ti, tr = rng.uniform(0.0, 1.4, (2, n))
     pr = rng.uniform(-math.pi, math.pi, n)
-    out = np.empty((n, 4, 4))
-    m.mueller(ti, tr, pr, out=out)  # compiles or loads the kernels, touches out
+    out = np.empty((16, n))  # element-major, as the kernels write it
+    m.mueller16(ti, tr, pr, out=out)  # compiles or loads the kernels, touches out
     print(f"\nkernels: FacetBRDF (Gaussian 0.2, Al), {n} geometries, best of {repeat}; {_load()}")
     print(f"{'threads':>7}  {'fresh ns/geom':>13}  {'speedup':>7}  {'out= ns/geom':>12}  {'speedup':>7}")
     base = None
     for t in threads:
         numba.set_num_threads(min(t, numba.config.NUMBA_NUM_THREADS))
-        fresh = _best(lambda: m.mueller(ti, tr, pr), repeat) / n * 1e9
-        into = _best(lambda: m.mueller(ti, tr, pr, out=out), repeat) / n * 1e9
+        fresh = _best(lambda: m.mueller16(ti, tr, pr), repeat) / n * 1e9
+        into = _best(lambda: m.mueller16(ti, tr, pr, out=out), repeat) / n * 1e9
         base = base or (fresh, into)
         print(f"{t:>7}  {fresh:>13.1f}  {base[0] / fresh:>7.2f}  {into:>12.1f}  {base[1] / into:>7.2f}")
 
