@@ -194,5 +194,5 @@ def test_an_unreachable_scheduler_is_an_input_error(command, monkeypatch, tmp_pa
         argv = ["stability", "--no-energy", *flags]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert "error: scheduler: no dask.distributed scheduler answered at 'tcp://127.0.0.1:1'" in err
+    assert "error: --scheduler 'tcp://127.0.0.1:1': port 1 is a privileged port" in err
     assert "internal" not in err

@@ -103,7 +103,7 @@ def test_compare_prefers_the_generating_slope_family(setup):
 def pairing():
     """Seed 003's pairing on 40 rows of each SCATMECH data set, all likelihood terms and the BRDF alone."""
     return seed003_pairing(
-        ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3), rows=40
+        ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3), rows=40, chains=2
     )
 
 

@@ -29,7 +29,6 @@ from scatterbench.models import scene as scene_mod
 from scatterbench.models.geometry import signed_inplane
 from scatterbench.validation.fitting.compare import seed003_pairing
 from scatterbench.validation.fitting.datafile import Dataset, load_data
-from scatterbench.validation.fitting.executors import make_executor
 from scatterbench.validation.fitting.fitspec import fitspec_from
 from scatterbench.validation.fitting.inversion import fit_curve, invert
 from scatterbench.validation.fitting.likelihood import Likelihood
@@ -145,9 +144,6 @@ def check_resume_identity(ctx):
 #: the scene injected and refitted by the recovery study, and the file whose geometries it uses
 RECOVERY_SCENE = "aluminium_flakes_clearcoat.toml"
 RECOVERY_DATA = "scatmech_flake_measurement.csv"
-#: local worker processes of the full run's recovery study and model comparison (both cores of
-#: the 2-core machine the report's times are measured on; the results do not depend on it)
-STUDY_WORKERS = 2
 
 
 def recovery_settings(quick, seed=0):
@@ -163,7 +159,7 @@ def recovery_settings(quick, seed=0):
             injections=50,
             chain=ChainSettings(walkers=4, seed=seed, max_steps=150, check_every=150, starts=1),
         )
-    # Two correlated parameters, 16 walkers run to N > 50 tau, on both cores: the same study over 4
+    # Two correlated parameters, 16 walkers run to N > 50 tau, on the run's executor: the same study over 4
     # cells (8 and 32 geometries) took 1315 s on a loaded machine; the 8-geometry cells are the cheaper half.
     return dict(
         free=["sigma:0.01:1:log", "coating:1.2:2"],
@@ -172,35 +168,32 @@ def recovery_settings(quick, seed=0):
         n_geometries=(8,),
         injections=50,
         chain=ChainSettings(walkers=16, seed=seed, max_steps=4000, check_every=100, starts=1),
-        workers=STUDY_WORKERS,
     )
 
 
 def _recovery(quick, seed, executor=None):
-    """The recovery study of the run (on ``executor``, default: :func:`recovery_settings`' workers)."""
+    """The recovery study of the run, its members on ``executor`` (default: in-process)."""
 
     rs = recovery_settings(quick, seed)
     sc = scene_mod.load(os.path.join(os.path.dirname(references.__file__), "scenes", RECOVERY_SCENE))
     spec = fitspec_from(sc, rs["free"], rs["noise"])
     data = load_data(references.data_path(RECOVERY_DATA))
-    own = make_executor(rs.get("workers", 1), None) if executor is None else contextlib.nullcontext(executor)
-    with own as ex:  # identical results on any executor (tested)
-        return recovery_study(
-            sc,
-            spec,
-            data,
-            rs["chain"],
-            noise_levels=rs["noise_levels"],
-            n_geometries=rs["n_geometries"],
-            injections=rs["injections"],
-            executor=ex,
-        )
+    return recovery_study(  # identical results on any executor (tested)
+        sc,
+        spec,
+        data,
+        rs["chain"],
+        noise_levels=rs["noise_levels"],
+        n_geometries=rs["n_geometries"],
+        injections=rs["injections"],
+        executor=executor,
+    )
 
 
 def recovery_cells(ctx):
     """The recovery study's cells (:func:`scatterbench.validation.fitting.recovery.recovery_study`) for the
-    run's quick flag and seed, computed once per run."""
-    return ctx.compute(_recovery, ctx.quick, ctx.seed)
+    run's quick flag and seed, computed once per run on the run's executor."""
+    return ctx.study(_recovery, ctx.quick, ctx.seed)
 
 
 @check(paper="fitting machinery (interval coverage by injection-recovery)")
@@ -224,13 +217,21 @@ def check_recovery_coverage(ctx, cells=None):
 STRONG_DBIC = 10.0
 
 
+#: independent chains per fit of the model comparison (validation/fitting/compare.py)
+COMPARISON_CHAINS = 2
+
+
 def comparison_settings(quick):
-    """Seed 003's model comparison, ``dict(rows, settings)``: quick runs use the configuration of
+    """Seed 003's model comparison, ``dict(rows, settings, chains)``: quick runs use the configuration of
     tests/test_recovery.py (the same seed, so a test session fits it once)."""
 
+    # Two independent chains per fit (the second seeded from the first's seed and its index): the
+    # between-chain R-hat in the rows, and twice the tasks to keep the workers busy (16, not 8).
     if quick:
         return dict(
-            rows=40, settings=ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3)
+            rows=40,
+            settings=ChainSettings(walkers=16, seed=3, max_steps=200, check_every=100, starts=3),
+            chains=COMPARISON_CHAINS,
         )
     # Differential evolution: at 2000 steps the stretch move converged (N >= 50 tau) 0 of the
     # 8 chains (max tau 44-156), "de" 5 of 8 (by 800-1900 steps), measured 2026-11-24 by
@@ -238,21 +239,20 @@ def comparison_settings(quick):
     return dict(
         rows=None,
         settings=ChainSettings(walkers=24, seed=3, max_steps=12000, check_every=100, starts=4, moves="de"),
+        chains=COMPARISON_CHAINS,
     )
 
 
-def _comparison(quick):
-
-    # the full run's 8 fits on both cores: 63.1 s in-process, 34.3 s on 2 workers
-    # (benchmarks/study_workers.py); the quick run's take seconds, less than starting workers
-    # identical results on any executor (tested)
-    with make_executor(1 if quick else STUDY_WORKERS, None) as ex:
-        return seed003_pairing(**comparison_settings(quick), executor=ex)
+def _comparison(quick, executor=None):
+    """Seed 003's model comparison, its fits on ``executor`` (default: in-process); the full
+    run's 8 fits: 63.1 s in-process, 34.3 s on 2 workers (benchmarks/study_workers.py)."""
+    return seed003_pairing(**comparison_settings(quick), executor=executor)  # same on any executor
 
 
 def comparison_cases(ctx):
-    """:func:`scatterbench.validation.fitting.compare.seed003_pairing` with the run's settings, once per run."""
-    return ctx.compute(_comparison, ctx.quick)
+    """:func:`scatterbench.validation.fitting.compare.seed003_pairing` with the run's settings, once per
+    run on the run's executor."""
+    return ctx.study(_comparison, ctx.quick)
 
 
 def comparison_margins(cases):

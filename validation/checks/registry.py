@@ -32,6 +32,7 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from scatterbench.validation.fitting.executors import SerialExecutor
 from scatterbench.validation.studies.findings import Finding
 
 __all__ = [
@@ -178,15 +179,19 @@ def select(ids):
 
 @dataclass
 class CheckContext:
-    """What a run gives its checks: the quick flag, the seed, and a memo.
+    """What a run gives its checks: the quick flag, the seed, a memo and an executor.
 
     :meth:`compute` runs ``fn(*args, **kw)`` once per run and context; the
     report's context is one, so a section reuses what a check computed.
+    :meth:`study` does the same for a study that runs on the run's ``executor``
+    (:mod:`scatterbench.validation.fitting.executors`; ``None``: in-process), whose
+    results do not depend on it.
     """
 
     quick: bool = False
     seed: int = SEED
     memo: dict = field(default_factory=dict)
+    executor: object = None
 
     def compute(self, fn, *args, **kw):
         """``fn(*args, **kw)``, computed once per context (arguments must be hashable);
@@ -195,6 +200,19 @@ class CheckContext:
         if key not in self.memo:
             self.memo[key] = fn(*args, **kw)
         return self.memo[key]
+
+    def study(self, fn, *args, **kw):
+        """``fn(*args, executor=..., **kw)`` on the run's executor, computed once per context
+        like :meth:`compute` and keyed without the executor: a study gives the same results on
+        any executor (benchmarks/study_workers.py, tests/test_report_executors.py)."""
+        key = (fn.__module__, fn.__qualname__, args, tuple(sorted(kw.items())))
+        if key not in self.memo:
+            self.memo[key] = fn(*args, executor=self.runner(), **kw)
+        return self.memo[key]
+
+    def runner(self):
+        """The run's executor (in-process when none was given)."""
+        return self.executor if self.executor is not None else SerialExecutor()
 
 
 def _broken(spec, name, why):

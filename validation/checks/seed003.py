@@ -17,6 +17,7 @@ from scipy import integrate
 from scatterbench import models, references
 from scatterbench.models.polarization import reciprocal_mueller
 from scatterbench.models.smooth_interface import internal_hemispherical_reflectance
+from scatterbench.validation.fitting.executors import SerialExecutor
 from scatterbench.validation.numerics.grid import grid_reflectance
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 from scatterbench.validation.numerics.probes import random_geometries
@@ -339,9 +340,9 @@ def check_mc_convergence(ctx):
 MC_PAIRS = (200, 800, 3200)
 
 
-@lru_cache(maxsize=1)
-def mc_error_scaling(seeds=8):
-    """Measured RMS error of M00 (vs a 100000-pair reference) and mean reported SE, per pairs."""
+def _mc_m00(job):
+    """M00 and its SE at :data:`_GEOM` of the error-scaling model with ``(pairs, seed)`` (a task)."""
+    pairs, seed = job
     kw = dict(
         slopes=models.ExponentialSlopes(0.5),
         coating=1.5,
@@ -349,23 +350,28 @@ def mc_error_scaling(seeds=8):
         rho=0.3,
         surface=False,
     )
-    ref = models.RoughDiffuseBRDF(pairs=100_000, seed=12345, **kw).mueller(*_GEOM)[..., 0, 0]
+    M, E = models.RoughDiffuseBRDF(pairs=pairs, seed=seed, **kw).mueller_with_error(*_GEOM)
+    return M[..., 0, 0], E[..., 0, 0]
+
+
+def mc_error_scaling(seeds=8, executor=None, reference_pairs=100_000):
+    """Measured RMS error of M00 (vs a ``reference_pairs`` reference) and mean reported SE, per
+    pairs; the reference and every (pairs, seed) run one task each on ``executor`` (default
+    in-process)."""
+    jobs = [(reference_pairs, 12345)] + [(p, seed) for p in MC_PAIRS for seed in range(seeds)]
+    (ref, _), *runs = (executor or SerialExecutor()).map(_mc_m00, jobs, tasks=len(jobs))
     rms, se = [], []
-    for p in MC_PAIRS:
-        d2, s = [], []
-        for seed in range(seeds):
-            M, E = models.RoughDiffuseBRDF(pairs=p, seed=seed, **kw).mueller_with_error(*_GEOM)
-            d2.append(((M[..., 0, 0] - ref) / ref) ** 2)
-            s.append(E[..., 0, 0] / ref)
-        rms.append(float(np.sqrt(np.mean(d2))))
-        se.append(float(np.mean(s)))
+    for i, _ in enumerate(MC_PAIRS):
+        mine = runs[i * seeds : (i + 1) * seeds]
+        rms.append(float(np.sqrt(np.mean([((m - ref) / ref) ** 2 for m, _ in mine]))))
+        se.append(float(np.mean([e / ref for _, e in mine])))
     slope = float(np.polyfit(np.log(MC_PAIRS), np.log(rms), 1)[0])
     return tuple(rms), tuple(se), slope
 
 
 @check(paper="seed 003 Sec. 2.5 (Monte Carlo error)", slow=True)
 def check_mc_scaling(ctx):
-    rms, se, slope = mc_error_scaling()
+    rms, se, slope = ctx.study(mc_error_scaling)  # 25 Monte Carlo runs on the run's executor
     ratio = max(r / s for r, s in zip(rms, se, strict=True))
     return [
         judge(
@@ -516,20 +522,27 @@ def mc_energy(sigma, theta_i_deg, pairs=1000, **kw):
     return grid_reflectance(m, math.radians(theta_i_deg), n_t=24, n_phi=32)
 
 
-def mc_energy_samples():
+def _mc_energy_case(case):
+    sigma, theta_i_deg, kw = case
+    return mc_energy(sigma, theta_i_deg, **kw)
+
+
+def mc_energy_samples(executor=None):
     """``{(terms, rms slope, theta_i deg): (value, SE)}`` of the Monte Carlo model's
     reflectance: ``exact`` (rho = 1 diffuse + exact surface term), ``paper`` (the same with
     the Eq. 37 surface term), ``single`` (single scattering + exact surface term) and
-    ``single+diffuse`` (both volume terms at rho = 1)."""
+    ``single+diffuse`` (both volume terms at rho = 1); one task each on ``executor``
+    (default in-process)."""
     exact = dict(surface=True, convention="corrected")
-    out = {}
+    cases = {}
     for sigma in (0.5, 2.0):
         for t in (0.0, 60.0, 85.0):
-            out["exact", sigma, t] = mc_energy(sigma, t, rho=1.0, single=0.0, **exact)
-    out["paper", 2.0, 85.0] = mc_energy(2.0, 85.0, rho=1.0, single=0.0, surface=True)
-    out["single", 0.5, 0.0] = mc_energy(0.5, 0.0, rho=0.0, single=1.0, **exact)
-    out["single+diffuse", 0.5, 0.0] = mc_energy(0.5, 0.0, rho=1.0, single=1.0, **exact)
-    return out
+            cases["exact", sigma, t] = (sigma, t, dict(rho=1.0, single=0.0, **exact))
+    cases["paper", 2.0, 85.0] = (2.0, 85.0, dict(rho=1.0, single=0.0, surface=True))
+    cases["single", 0.5, 0.0] = (0.5, 0.0, dict(rho=0.0, single=1.0, **exact))
+    cases["single+diffuse", 0.5, 0.0] = (0.5, 0.0, dict(rho=1.0, single=1.0, **exact))
+    done = (executor or SerialExecutor()).map(_mc_energy_case, list(cases.values()), tasks=len(cases))
+    return dict(zip(cases, done, strict=True))
 
 
 MC_PAPER = "MC energy: rho=1, paper surface term, rms 2, 85 deg"
@@ -549,7 +562,7 @@ def _above(sample):
 )
 def check_mc_energy(ctx, samples=None):
     """``samples``: :func:`mc_energy_samples`; every value judged as value - 3 SE."""
-    s = mc_energy_samples() if samples is None else samples
+    s = ctx.study(mc_energy_samples) if samples is None else samples
     exact = {k: _above(x) for k, x in s.items() if k[0] == "exact"}
     (v, e), (w, f) = s["paper", 2.0, 85.0], s["single+diffuse", 0.5, 0.0]
     alone = max(exact["exact", 0.5, 0.0], _above(s["single", 0.5, 0.0]))

@@ -15,9 +15,10 @@ __all__ = ["sweep_findings"]
 
 
 def sweep_findings(ctx):
-    """The sweep's findings for the run (energy integrals only in full runs), once per run."""
+    """The sweep's findings for the run (energy integrals only in full runs), once per run on the
+    run's executor."""
 
-    return ctx.compute(sweep, energy=not ctx.quick)
+    return ctx.study(sweep, energy=not ctx.quick)
 
 
 @check(paper="every model at its extremes (stability sweep, accepted_findings.toml)")

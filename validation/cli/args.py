@@ -8,12 +8,19 @@ command before it starts, raising :class:`UsageError` (``error: ...``, exit 2).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import re
 
 from scatterbench.models.text import shown
 from scatterbench.validation.atomic import write_problem
+from scatterbench.validation.fitting.executors import (
+    SchedulerError,
+    check_scheduler_address,
+    default_workers,
+    make_executor,
+)
 
 __all__ = [
     "UsageError",
@@ -25,6 +32,9 @@ __all__ = [
     "positive_floats",
     "ints_at_least",
     "scheduler_address",
+    "executor_args",
+    "check_executor",
+    "open_executor",
     "writable_folder",
     "writable_file",
 ]
@@ -125,6 +135,56 @@ def scheduler_address(text):
             f"must be a scheduler address [PROTOCOL://]HOST:PORT, e.g. tcp://10.0.0.5:8786; got {shown(text, 40)}"
         )
     return text
+
+
+def executor_args(p, all_cores=False):
+    """``--workers N`` and ``--scheduler ADDRESS``, the one definition every command uses.
+    ``all_cores``: ``--workers`` defaults to the cores of this process's affinity mask (the
+    commands that run the whole suite), else to 1 (in-process)."""
+    default = "the cores this process may run on" if all_cores else "1: in-process"
+    p.add_argument(
+        "--workers",
+        type=int_in(1, MAX_WORKERS),
+        default=None,
+        help=f"local processes, 1-{MAX_WORKERS} (default {default}); the results do not depend on it",
+    )
+    p.add_argument(
+        "--scheduler",
+        type=scheduler_address,
+        default=None,
+        help="dask.distributed scheduler ADDRESS (tcp://host:8786; tls:// with dask's certificates)",
+    )
+    p.set_defaults(default_workers=default_workers if all_cores else (lambda: 1))
+
+
+def check_executor(args):
+    """Raise :class:`UsageError` for ``--workers`` with ``--scheduler``, or a scheduler address
+    no scheduler can be reached at (before any work; nothing is sent)."""
+    if args.scheduler and args.workers is not None:
+        raise UsageError("--workers and --scheduler: give one (local processes or a Dask cluster)")
+    if args.scheduler:
+        with _as_flag_error(args.scheduler):
+            args.scheduler = check_scheduler_address(args.scheduler)
+
+
+@contextlib.contextmanager
+def _as_flag_error(address):
+    """A :class:`SchedulerError` (``scheduler 'ADDRESS': reason``) as ``--scheduler 'ADDRESS': reason``."""
+    try:
+        yield
+    except SchedulerError as exc:
+        reason = str(exc).split("': ", 1)[-1]
+        raise UsageError(f"--scheduler {shown(address, 60)}: {reason}") from None
+
+
+def open_executor(args):
+    """The executor ``--workers``/``--scheduler`` ask for, its description printed.  A
+    scheduler that does not answer within its deadline is a :class:`UsageError` (exit 2)."""
+    workers = args.workers if args.workers is not None else args.default_workers()
+    with _as_flag_error(args.scheduler):
+        ex = make_executor(workers, args.scheduler)
+    print(f"executor: {ex.describe()}", flush=True)
+    return ex
 
 
 def writable_folder(path, flag):

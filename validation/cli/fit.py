@@ -22,13 +22,12 @@ from scatterbench.models import scene as scene_mod
 from scatterbench.validation.atomic import beside, folder_lock, replacing_folder
 from scatterbench.validation.fitting.checkpoint import saved_steps
 from scatterbench.validation.fitting.datafile import load_data
-from scatterbench.validation.fitting.executors import make_executor
 from scatterbench.validation.fitting.fit import run_fit, write_fit
 from scatterbench.validation.fitting.fitspec import fitspec_from
 from scatterbench.validation.fitting.likelihood import Likelihood
 from scatterbench.validation.fitting.settings import MOVES, ChainSettings
 
-from .args import MAX_WORKERS, UsageError, int_in, scheduler_address, writable_folder
+from .args import UsageError, check_executor, executor_args, open_executor, writable_folder
 
 __all__ = ["register"]
 
@@ -59,33 +58,8 @@ def locked_out(args, resume=None):
         yield
 
 
-def _check_executor(args):
-    if args.scheduler and args.workers != 1:
-        raise UsageError("--workers and --scheduler: give one (local processes or a Dask cluster)")
-
-
-def _open_executor(args):
-    """The executor ``--workers``/``--scheduler`` ask for, its description printed.  A
-    scheduler that does not answer raises ``SchedulerError``, an input error (exit 2)."""
-
-    ex = make_executor(args.workers, args.scheduler)
-    print(f"executor: {ex.describe()}")
-    return ex
-
-
-def _executor_args(p):
-    p.add_argument(
-        "--workers",
-        type=int_in(1, MAX_WORKERS),
-        default=1,
-        help=f"local processes, 1-{MAX_WORKERS} (default 1: in-process)",
-    )
-    p.add_argument(
-        "--scheduler",
-        type=scheduler_address,
-        default=None,
-        help="dask.distributed scheduler ADDRESS (tcp://host:8786)",
-    )
+# one definition of the executor flags (cli/args.py); the study commands import them from here
+_check_executor, _open_executor, _executor_args = check_executor, open_executor, executor_args
 
 
 def _spec_args(p):

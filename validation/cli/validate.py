@@ -18,12 +18,12 @@ from scatterbench.validation.checks.registry import (
     texts,
 )
 
-from .args import writable_file
+from .args import check_executor, executor_args, open_executor, writable_file
 
 __all__ = ["register", "run"]
 
 
-def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
+def run(quick=False, json_path=None, ctx=None, specs=None, executor=None) -> int:
     """Run the checks, print the table and the text blocks, write ``json_path`` (strict
     JSON, atomically) if given; 1 if a check fails, else 0.
 
@@ -55,7 +55,9 @@ def run(quick=False, json_path=None, ctx=None, specs=None) -> int:
 def _cmd_validate(args) -> int:
     if args.json:
         writable_file(args.json, "--json")
-    return run(quick=args.quick, json_path=args.json)
+    check_executor(args)
+    with open_executor(args) as ex:  # every study of the checks runs there; same results on any
+        return run(quick=args.quick, json_path=args.json, executor=ex)
 
 
 def register(sub):
@@ -69,4 +71,5 @@ def register(sub):
         help="skip the slow checks and use the quick study settings (the set `report --quick` judges)",
     )
     p.add_argument("--json", metavar="FILE", help="also write every check as strict JSON to FILE")
+    executor_args(p, all_cores=True)
     p.set_defaults(func=_cmd_validate)

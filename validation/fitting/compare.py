@@ -11,6 +11,7 @@ same rows (same masks) or the numbers are not comparable, so that is checked.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -20,12 +21,13 @@ from scatterbench import references
 from scatterbench.models import scene as scene_mod
 
 from .datafile import load_data
+from .diagnostics import chain_seed, rhat
 from .executors import SerialExecutor
-from .fit import information_criteria, predictive, predictive_checks, run_fit
+from .fit import FitResult, information_criteria, predictive, predictive_checks, run_fit
 from .fitspec import fitspec_from
 from .likelihood import Likelihood
 from .recovery import subsample
-from .settings import ChainSettings
+from .settings import ChainSettings, _integer
 
 __all__ = ["waic", "check_comparable", "compare_fits", "format_comparison", "seed003_pairing"]
 
@@ -58,28 +60,83 @@ def check_comparable(liks, names):
             )
 
 
-def _comparison_row(name, fit, seed):
-    """One scene's row: information criteria, WAIC, predictive coverage, chain diagnostics."""
-    return {
+def _pooled(fits):
+    """The chains of ``fits`` (one likelihood, independent chains) as one fit for the posterior
+    quantities (WAIC, predictive draws, medians): their burned and thinned samples together;
+    the optimum and the best chain otherwise those of the fit with the highest ln L."""
+    if len(fits) == 1:
+        return fits[0]
+    best = max(fits, key=lambda f: information_criteria(f)["max_log_likelihood"])
+    return FitResult(best.lik, best.optimum, _PooledChains(fits), best.summary, best.settings)
+
+
+class _PooledChains:
+    """Independent chains' samples, pooled in chain order (what :func:`waic` and
+    :func:`~scatterbench.validation.fitting.fit.predictive` read of a chain)."""
+
+    def __init__(self, fits):
+        self._samples = np.concatenate([f.chain.samples() for f in fits])
+
+    def samples(self):
+        return self._samples
+
+
+def _between_chains(fits):
+    """Per free parameter, the rank-normalized split R-hat between the chains of ``fits``
+    (each chain's burned and thinned samples in sampling coordinates, cut to the shortest)."""
+    each = [f.chain.samples() for f in fits]
+    n = min(len(s) for s in each)
+    names = fits[0].spec.names
+    return {k: rhat(np.stack([s[:n, i] for s in each])) for i, k in enumerate(names)}
+
+
+def _medians(fit):
+    u = fit.chain.samples()
+    return {p.key: float(np.median(p.from_u(u[:, i]))) for i, p in enumerate(fit.spec.free)}
+
+
+def _comparison_row(name, fits, seed):
+    """One scene's row from its independent chains ``fits`` (one or more): the maximum ln L
+    over them all, WAIC, predictive coverage and medians of their pooled samples, their worst
+    tau, mean acceptance and, with several chains, the between-chain R-hat."""
+    pooled = _pooled(fits)
+    best = max(fits, key=lambda f: information_criteria(f)["max_log_likelihood"])
+    row = {
         "scene": name,
-        **information_criteria(fit),
-        **waic(fit, seed=seed),
-        "predictive": predictive_checks(fit, predictive(fit, seed=seed)),
-        "tau_max": float(np.max(fit.chain.tau)),
-        "acceptance": float(fit.chain.acceptance.mean()),
-        "stop_reason": fit.chain.stop_reason,
-        "medians": {k: v["median"] for k, v in fit.summary["parameters"].items()},
+        **information_criteria(best),
+        **waic(pooled, seed=seed),
+        "predictive": predictive_checks(pooled, predictive(pooled, seed=seed)),
+        "tau_max": max(float(np.max(f.chain.tau)) for f in fits),
+        "acceptance": float(np.mean([f.chain.acceptance.mean() for f in fits])),
+        "stop_reason": fits[0].chain.stop_reason,
+        "medians": (
+            {k: v["median"] for k, v in fits[0].summary["parameters"].items()}
+            if len(fits) == 1
+            else _medians(pooled)
+        ),
     }
+    row["converged_chains"] = sum(bool(f.chain.converged) for f in fits)
+    if len(fits) > 1:
+        rh = _between_chains(fits)
+        row["stop_reason"] = (
+            f"{row['converged_chains']} of {len(fits)} chains converged (N >= tau_factor tau)"
+        )
+        row.update(chains=len(fits), rhat=rh, rhat_max=max(rh.values()))
+    return row
 
 
-def _fit_and_row(job):
-    """One scene's fit and its comparison row; ``job`` is ``(likelihood, name, settings)``.
+def _fit_one(job):
+    """One chain of one scene (a task): ``job`` is ``(likelihood, settings)``.
 
     Runs where the executor puts it, whole (a fit's chain is seeded by ``settings``
     alone, so it is the same chain wherever it runs)."""
-    lik, name, settings = job
-    fit = run_fit(lik, settings)
-    return _comparison_row(name, fit, settings.seed), fit
+    lik, settings = job
+    return run_fit(lik, settings)
+
+
+def _row(job):
+    """A scene's comparison row from its chains (a task): ``job`` is ``(name, fits, seed)``."""
+    return _comparison_row(*job)
 
 
 def _ranked(rows):
@@ -91,21 +148,29 @@ def _ranked(rows):
     return rows
 
 
-def _compare_groups(groups, settings, executor):
-    """:func:`compare_fits` of several ``(liks, names)`` groups with one map over all
-    their fits (so every worker has a fit to run), results regrouped in order."""
+def _compare_groups(groups, settings, executor, chains=1):
+    """:func:`compare_fits` of several ``(liks, names)`` groups with one map over all their
+    fits' chains (so every worker has a chain to run), then one over their rows, regrouped in
+    order.  Chain ``c`` of every fit is seeded :func:`chain_seed` ``(settings.seed, c)``."""
 
-    jobs = [(lik, nm, settings) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
-    done = (executor or SerialExecutor()).map(_fit_and_row, jobs, tasks=len(jobs))
+    ex = executor or SerialExecutor()
+    pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
+    seeds = [chain_seed(settings.seed, c) for c in range(chains)]
+    jobs = [(lik, dataclasses.replace(settings, seed=s)) for lik, _ in pairs for s in seeds]
+    done = ex.map(_fit_one, jobs, tasks=len(jobs))
+    per_fit = [done[i * chains : (i + 1) * chains] for i in range(len(pairs))]
+    rows = ex.map(
+        _row, [(nm, f, settings.seed) for (_, nm), f in zip(pairs, per_fit, strict=True)], tasks=len(pairs)
+    )
     out, start = [], 0
     for liks, _ in groups:
-        part = done[start : start + len(liks)]
+        part = slice(start, start + len(liks))
         start += len(liks)
-        out.append((_ranked([row for row, _ in part]), [fit for _, fit in part]))
+        out.append((_ranked(rows[part]), [f[0] for f in per_fit[part]]))
     return out
 
 
-def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor=None):
+def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor=None, chains=1):
     """Fit every likelihood (same data, same used rows) and rank them.
 
     Parameters
@@ -117,18 +182,24 @@ def compare_fits(liks, names, settings: ChainSettings | None = None, *, executor
         Every fit's chain (default ``ChainSettings()``); its seed also seeds the
         predictive draws and the WAIC.
     executor : optional
-        Runs the fits, one task per fit (:mod:`scatterbench.validation.fitting.executors`;
+        Runs the fits, one task per chain (:mod:`scatterbench.validation.fitting.executors`;
         default in-process); the rows are the same on any executor.
+    chains : int
+        Independent chains per fit (chain 0 seeded by ``settings.seed``, the others by
+        :func:`~scatterbench.validation.fitting.diagnostics.chain_seed`): with more than one,
+        each row's posterior quantities pool them and its ``rhat`` gives the between-chain
+        R-hat of every free parameter (``rhat_max`` the worst).
 
     Returns
     -------
     rows : list of dict
         The comparison, with ``dAIC``, ``dBIC``, ``dWAIC`` from the best.
     fits : list of FitResult
+        Each scene's first chain.
     """
     settings = ChainSettings() if settings is None else settings
     check_comparable(liks, names)
-    ((rows, fits),) = _compare_groups([(liks, names)], settings, executor)
+    ((rows, fits),) = _compare_groups([(liks, names)], settings, executor, _integer("chains", chains, 1))
     return rows, fits
 
 
@@ -153,11 +224,11 @@ SEED003_PAIRING = {
 _POLARIZATION_OFF = ("eta_deg=off", "P=off", "P_C=off")
 
 
-def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf"), executor=None):
+def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf"), executor=None, chains=1):
     """Fit both scenes of :data:`SEED003_PAIRING` to both data sets, with every likelihood
     term the scenes declare (``"all"``: BRDF, eta, P, P_C) and/or the BRDF alone
     (``"brdf"``), on ``rows`` evenly spread rows of each file (default all), every
-    chain with ``settings``.
+    chain with ``settings``, ``chains`` independent chains per fit (:func:`compare_fits`).
 
     Returns a list of ``{"data", "generator", "terms", "rows", "fits"}``, one per data
     set and term choice, ``rows`` being :func:`compare_fits`' table (scene names are
@@ -167,12 +238,13 @@ def seed003_pairing(settings: ChainSettings, *, rows=None, terms=("all", "brdf")
     argument (the fits are deterministic for a seed): the report and the tests that
     show the same pairing fit it once; treat it as read-only.
     """
-    key = (rows, tuple(terms), settings)
+    key = (rows, tuple(terms), settings, chains)
     if key in _PAIRING_CACHE:
         return _PAIRING_CACHE[key]
     cases, groups = _pairing_cases(rows, terms)
     out = []
-    for case, (table, fits) in zip(cases, _compare_groups(groups, settings, executor), strict=True):
+    done = _compare_groups(groups, settings, executor, _integer("chains", chains, 1))
+    for case, (table, fits) in zip(cases, done, strict=True):
         out.append({**case, "rows": table, "fits": fits})
     _PAIRING_CACHE[key] = out
     return out

@@ -33,20 +33,26 @@ import os
 import pickle
 import signal
 import threading
+import time
 
 from threadpoolctl import threadpool_limits
 
+from .scheduler import SchedulerError, check_scheduler_address, probe_scheduler
 from .settings import _integer
 
-__all__ = ["SerialExecutor", "ProcessExecutor", "DaskExecutor", "SchedulerError", "make_executor"]
+__all__ = [
+    "SerialExecutor",
+    "ProcessExecutor",
+    "DaskExecutor",
+    "SchedulerError",
+    "make_executor",
+    "check_scheduler_address",
+    "default_workers",
+]
 
-#: seconds :class:`DaskExecutor` waits for a scheduler given by address to answer
+#: seconds :class:`DaskExecutor` waits for a scheduler given by address to answer: one deadline
+#: for the connection, distributed's handshake and the scheduler's first reply
 SCHEDULER_TIMEOUT = 30
-
-
-class SchedulerError(ValueError):
-    """No dask.distributed scheduler answered at the address given (``--scheduler``): the
-    address is the user's input (the command line turns it into ``error: ...``, exit 2)."""
 
 
 def _chunks(items, n):
@@ -76,6 +82,12 @@ def _local_cores() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
         return os.cpu_count() or 1
+
+
+def default_workers() -> int:
+    """``--workers``' default for the commands that run the whole suite (``report``,
+    ``validate``, ``nightly``): the cores this process may run on."""
+    return _local_cores()
 
 
 def kernel_threads(workers: int) -> int:
@@ -219,19 +231,10 @@ class DaskExecutor(SerialExecutor):
     def __init__(self, address_or_client, timeout=None):
         from dask.distributed import Client  # dask.distributed (heavy): loaded only for a cluster
 
-        timeout = SCHEDULER_TIMEOUT if timeout is None else timeout
-
         if isinstance(address_or_client, Client):
             self.client, self._own = address_or_client, False
         else:
-            try:
-                self.client = Client(address_or_client, timeout=timeout)
-            except OSError as exc:  # refused, unreachable, timed out: the address is the user's input
-                raise SchedulerError(
-                    f"scheduler: no dask.distributed scheduler answered at {address_or_client!r} "
-                    f"within {timeout} s ({exc})"
-                ) from None
-            self._own = True
+            self.client, self._own = _connect(address_or_client, timeout), True
         info = self.client.scheduler_info().get("workers", {})
         self.workers = max(1, len(info))
         self._threads = _dask_kernel_threads(info, self.client.run(_local_cores) if info else {})
@@ -249,6 +252,27 @@ class DaskExecutor(SerialExecutor):
 
     def describe(self):
         return f"dask.distributed at {self.client.scheduler.address} ({self.workers} workers)"
+
+
+def _connect(address, timeout=None):
+    """A ``Client`` of the scheduler at ``address``, with one deadline (``timeout``, default
+    :data:`SCHEDULER_TIMEOUT`) for the connection, the handshake and the first reply
+    (:func:`~scatterbench.validation.fitting.scheduler.probe_scheduler`: ``Client``'s own timeout
+    covers only the connection); :class:`SchedulerError` when no scheduler can be used there."""
+    from dask.distributed import Client, Security  # dask.distributed (heavy): loaded only for a cluster
+
+    timeout = SCHEDULER_TIMEOUT if timeout is None else timeout
+    address = check_scheduler_address(address)
+    end = time.monotonic() + timeout
+    probe_scheduler(address, timeout, Security().get_connection_args("client"))
+    left = max(1.0, end - time.monotonic())
+    try:
+        return Client(address, timeout=left)
+    except Exception as exc:  # noqa: BLE001 - the scheduler went away or changed since the probe
+        raise SchedulerError(
+            f"scheduler {address!r}: answered, then the client could not connect within {left:.0f} s "
+            f"({type(exc).__name__}: {exc})"
+        ) from None
 
 
 def _dask_kernel_threads(info, cores):

@@ -39,14 +39,16 @@ def _section_failure(name):
     return {**check_record(r), "id": f"report.section_{name}", "paper": "report machinery"}
 
 
-def _context(context, quick, previous, seed):
+def _context(context, quick, previous, seed, executor):
     if context is None:
-        return Context(quick=quick, previous=previous, seed=seed)
+        return Context(quick=quick, previous=previous, seed=seed, executor=executor)
     if (context.quick, context.seed) != (quick, seed):
         raise ValueError(
             f"context: quick={context.quick}, seed={context.seed} must be the report's ({quick}, {seed})"
         )
     context.previous = previous
+    if executor is not None:
+        context.executor = executor
     return context
 
 
@@ -79,7 +81,14 @@ def _run_sections(ctx, specs):
 
 
 def build_report(
-    quick=False, previous=None, seed=SEED, only=None, extra_scenes=(), checks=None, context=None
+    quick=False,
+    previous=None,
+    seed=SEED,
+    only=None,
+    extra_scenes=(),
+    checks=None,
+    context=None,
+    executor=None,
 ):
     """Run every section; returns ``(results, html)``.  A section that raises is kept
     on the page with its error and counts as a failed check; the others still run.
@@ -89,9 +98,11 @@ def build_report(
     ``checks``: ids of the registered checks the summary judges (default: every one,
     less the slow ones in a quick run: the set ``validate`` judges);
     ``context``: a :class:`~scatterbench.validation.report.core.Context` to run in (its memo shared,
-    e.g. with ``validate``); default a new one.
+    e.g. with ``validate``); default a new one;
+    ``executor``: where the studies run (:mod:`scatterbench.validation.fitting.executors`; default
+    the context's, else in-process); the results are the same on any executor.
     """
-    ctx = _context(context, quick, previous, seed)
+    ctx = _context(context, quick, previous, seed, executor)
     ctx.cache["extra_scenes"] = list(extra_scenes)
     if checks is not None:
         ctx.cache["check_specs"] = select(checks)

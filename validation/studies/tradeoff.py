@@ -44,6 +44,7 @@ import numpy as np
 from scatterbench import models
 from scatterbench.models import evaluation
 from scatterbench.models.geometry import signed_inplane
+from scatterbench.validation.fitting.executors import SerialExecutor
 from scatterbench.validation.numerics.energy import exposed_reflectance
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 from scatterbench.validation.numerics.probes import (
@@ -398,17 +399,31 @@ def choose(result: KnobResult, tol: float):
     return min(ok, key=lambda p: p.seconds) if ok else None
 
 
-def study(names=None, quick=False, skipped=None):
+def _measure(job):
+    """One knob measured (a task of :func:`study`): ``(KnobResult, None)`` or ``(None, why)``."""
+    fn, quick = job
+    try:
+        return fn(quick=quick), None
+    except KnobUnavailable as exc:
+        return None, str(exc)
+
+
+def study(names=None, quick=False, skipped=None, executor=None):
     """Every knob's :class:`KnobResult` (``names``: these knobs only; ``quick``: fewer settings).
 
     A knob that cannot be measured here (:class:`KnobUnavailable`) is left out; its
-    reason goes into the dict ``skipped`` when one is given.
+    reason goes into the dict ``skipped`` when one is given.  ``executor``: where the knobs
+    run, one task each (:mod:`scatterbench.validation.fitting.executors`; default in-process).
+    The errors do not depend on it; each cost is timed where its knob runs, on that worker's
+    share of the cores, beside the other knobs' work.
     """
+    names = list(names or KNOBS)
+    jobs = [(KNOBS[n], quick) for n in names]
+    done = (executor or SerialExecutor()).map(_measure, jobs, tasks=len(jobs))
     out = []
-    for n in names or KNOBS:
-        try:
-            out.append(KNOBS[n](quick=quick))
-        except KnobUnavailable as exc:
-            if skipped is not None:
-                skipped[n] = str(exc)
+    for n, (result, why) in zip(names, done, strict=True):
+        if result is not None:
+            out.append(result)
+        elif skipped is not None:
+            skipped[n] = why
     return out

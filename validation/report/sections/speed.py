@@ -110,7 +110,7 @@ def _peers():
 
 def compute(ctx):
 
-    knobs = tuple(study(quick=ctx.quick))
+    knobs = tuple(study(quick=ctx.quick, executor=ctx.runner()))  # knobs one task each
     fronts = tuple(
         tuple(
             {"setting": p.setting, "error": p.error, "seconds": p.seconds, "evaluations": p.evaluations}

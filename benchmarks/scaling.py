@@ -1,0 +1,146 @@
+"""How the work scales with cores, in one run: the kernels by thread count, each study by worker
+count, and the first ``report --quick`` cold and warm.
+
+    python benchmarks/scaling.py [--geometries 1000000] [--threads 1 2 ...] [--workers 1 2 ...]
+                                 [--studies sweep-quick presets ...] [--first-run] [--repeat 3]
+
+* **Kernels.** ``FacetBRDF.mueller16`` (Gaussian slopes, aluminium, no shadowing) on ``--geometries``
+  random geometries, ``numba.set_num_threads(t)`` for every ``t`` in ``--threads`` (default
+  1 .. the cores of this process's affinity mask): the best of ``--repeat`` calls, into a fresh
+  result and into ``out=``, in ns per geometry, and the speedup over one thread.
+* **Studies.** Each study of ``--studies`` (the names of ``benchmarks/study_workers.py``; default
+  the ``report --quick`` studies: comparison, recovery, sweep, trade-off, presets) in a fresh
+  process per worker count of ``--workers`` (default 1, 2, 4, ... and the cores): seconds,
+  speedup over one worker, and the digest of its results, which must be equal for every
+  worker count (the command exits 1 when they are not).
+* **First run** (``--first-run``): ``scatterbench report --quick`` with an empty numba cache
+  (``NUMBA_CACHE_DIR`` a fresh folder: every kernel compiles) and then again with that cache
+  (warm), with the default ``--workers``.
+
+The machine's load average is printed before and after each part: figures from a shared
+machine are noisy.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+from benchmarks.study_workers import STUDY_NAMES, timed  # noqa: E402
+
+#: the studies a report --quick runs on its executor (study_workers' names)
+REPORT_STUDIES = ("comparison-quick", "recovery-quick", "sweep-quick", "tradeoff", "presets")
+
+
+def cores():
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+def _load():
+    return "load average " + " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def _best(fn, repeat):
+    best = math.inf
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def kernels(n, threads, repeat):
+    """ns per geometry of FacetBRDF's Mueller matrix (``mueller16``: the kernels' element-major
+    layout) at each thread count, into a fresh result and into ``out=``."""
+    import numba
+
+    from scatterbench import models
+
+    m = models.FacetBRDF(slopes=models.GaussianSlopes(0.2), substrate=1.37 + 7.62j)
+    rng = np.random.default_rng(1)
+    ti, tr = rng.uniform(0.0, 1.4, (2, n))
+    pr = rng.uniform(-math.pi, math.pi, n)
+    out = np.empty((16, n))  # element-major, as the kernels write it
+    m.mueller16(ti, tr, pr, out=out)  # compiles or loads the kernels, touches out
+    print(f"\nkernels: FacetBRDF (Gaussian 0.2, Al), {n} geometries, best of {repeat}; {_load()}")
+    print(f"{'threads':>7}  {'fresh ns/geom':>13}  {'speedup':>7}  {'out= ns/geom':>12}  {'speedup':>7}")
+    base = None
+    for t in threads:
+        numba.set_num_threads(min(t, numba.config.NUMBA_NUM_THREADS))
+        fresh = _best(lambda: m.mueller16(ti, tr, pr), repeat) / n * 1e9
+        into = _best(lambda: m.mueller16(ti, tr, pr, out=out), repeat) / n * 1e9
+        base = base or (fresh, into)
+        print(f"{t:>7}  {fresh:>13.1f}  {base[0] / fresh:>7.2f}  {into:>12.1f}  {base[1] / into:>7.2f}")
+
+
+def studies(names, workers):
+    """Each study on each worker count, in a fresh process; False when a study's digests differ."""
+    ok = True
+    for name in names:
+        print(f"\nstudy {name}: {_load()}")
+        digests, base = set(), None
+        for w in workers:
+            seconds, digest = timed(ROOT, str(w), name)
+            base = base or seconds
+            digests.add(digest)
+            print(f"  workers {w:>3}: {seconds:8.1f} s  speedup {base / seconds:5.2f}  digest {digest}")
+        if len(digests) != 1:
+            print(f"  RESULTS DIFFER between worker counts for {name}")
+            ok = False
+    return ok
+
+
+def first_run():
+    """``report --quick`` with an empty numba cache, then warm, each in a fresh process."""
+    print(f"\nfirst run: scatterbench report --quick; {_load()}")
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as out:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        for label in ("cold (empty numba cache)", "warm"):
+            t = time.perf_counter()
+            cmd = [sys.executable, "-m", "scatterbench.validation.cli", "report", "--quick", "--out", out]
+            r = subprocess.run(cmd, env=env, capture_output=True, text=True)
+            print(f"  {label:<25} {time.perf_counter() - t:7.1f} s  exit {r.returncode}")
+
+
+def _powers(top):
+    out, k = [], 1
+    while k < top:
+        out.append(k)
+        k *= 2
+    return out + [top]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--geometries", type=float, default=1e6)
+    ap.add_argument("--threads", type=int, nargs="+", default=None)
+    ap.add_argument("--workers", type=int, nargs="+", default=None)
+    ap.add_argument("--studies", nargs="*", choices=STUDY_NAMES, default=list(REPORT_STUDIES))
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--first-run", action="store_true", help="also time report --quick cold and warm")
+    args = ap.parse_args()
+    c = cores()
+    print(f"{c} cores in this process's affinity mask; {_load()}")
+    kernels(int(args.geometries), args.threads or list(range(1, c + 1)), args.repeat)
+    ok = studies(args.studies, args.workers or _powers(c))
+    if args.first_run:
+        first_run()
+    print(f"\nend; {_load()}")
+    if not ok:
+        sys.exit("RESULTS DIFFER between worker counts: the results must not depend on them")
+
+
+if __name__ == "__main__":
+    main()
