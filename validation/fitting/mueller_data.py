@@ -47,6 +47,7 @@ import csv
 import math
 import re
 from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -157,6 +158,9 @@ class MuellerData:
     lines: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
 
+    #: every per-row array, by name (what a fit's fingerprint hashes)
+    _ARRAYS: ClassVar[tuple] = ("theta_i", "phi_i", "theta_r", "phi_r", "wavelength_nm", "mueller", "err", "lines")
+
     def __len__(self):
         return len(self.theta_i)
 
@@ -179,9 +183,8 @@ class MuellerData:
 
     def subset(self, keep) -> MuellerData:
         """The rows ``keep`` selects (a boolean mask or an index array)."""
-        arrays = ("theta_i", "phi_i", "theta_r", "phi_r", "wavelength_nm", "mueller", "err", "lines")
         return replace(
-            self, **{a: None if getattr(self, a) is None else getattr(self, a)[keep] for a in arrays}
+            self, **{a: None if getattr(self, a) is None else getattr(self, a)[keep] for a in self._ARRAYS}
         )
 
 
