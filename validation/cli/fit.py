@@ -20,6 +20,8 @@ from scatterbench.validation.fitting.executors import make_executor
 from scatterbench.validation.fitting.fit import run_fit, write_fit
 from scatterbench.validation.fitting.fitspec import fitspec_from
 from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.mueller_data import load_mueller_data
+from scatterbench.validation.fitting.mueller_fit import is_mueller_file, mueller_likelihood, write_mueller_fit
 from scatterbench.validation.fitting.settings import MOVES, ChainSettings
 
 from .args import MAX_WORKERS, UsageError, int_in, scheduler_address, writable_folder
@@ -188,7 +190,7 @@ def _interrupted(ck, final):
     return 130
 
 
-def _run_fit(args, lik, settings):
+def _run_fit(args, lik, settings, write=write_fit):
     """Run (or resume) the chain in ``args.out`` and write the results; returns the
     posterior summary, or the exit code 130 after Ctrl-C.  The running checkpoint is
     chain.partial.npz; it becomes chain.npz when the run ends, so a failed --force
@@ -213,14 +215,8 @@ def _run_fit(args, lik, settings):
         return _interrupted(ck, final)
     if os.path.exists(ck):
         os.replace(ck, final)
-    return write_fit(
-        res,
-        args.out,
-        data_path=args.data,
-        scene_path=args.scene,
-        executor_desc=executor,
-        plots=not args.no_plots,
-    )
+    kw = {} if write is write_mueller_fit else {"plots": not args.no_plots}
+    return write(res, args.out, data_path=args.data, scene_path=args.scene, executor_desc=executor, **kw)
 
 
 def _print_sampling(post, total_seconds):
@@ -259,6 +255,8 @@ def _print_posterior(post):
 def _cmd_fit(args) -> int:
     _check_out(args.out, args.force, args.resume)
     _check_executor(args)
+    if is_mueller_file(args.data):
+        return _cmd_fit_mueller(args)
     settings, _, data, _, lik = _load_and_describe(args)
     print(
         f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
@@ -276,9 +274,42 @@ def _cmd_fit(args) -> int:
     return 0
 
 
+def _cmd_fit_mueller(args) -> int:
+    """``fit`` on Mueller-matrix data (NIST's file as published, or scatterbench-mueller/1): the
+    scene's ``[fit]`` and ``[fit.mueller]`` tables (fitting.mueller_spec); --free replaces the
+    free list, the BRDF-data flags --noise, --near-specular-deg and --exclude do not apply."""
+    for flag, given in (
+        ("--noise", args.noise),
+        ("--near-specular-deg", args.near_specular_deg),
+        ("--exclude", args.exclude),
+    ):
+        if given is not None:
+            raise UsageError(f"{flag}: not for Mueller-matrix data; use the scene's [fit.mueller] table")
+    settings = _chain_settings(args)
+    sc = scene_mod.load(args.scene)
+    data = load_mueller_data(args.data)
+    lik = mueller_likelihood(sc, data, args.free)
+    _require_walkers(settings, len(lik.spec.free))
+    print(lik.scene.describe())
+    print(lik.spec.describe())
+    print(f"data: {data.path}: {len(data)} rows, {len(lik.data)} used, basis {data.basis}")
+    t0 = time.perf_counter()
+    post = _run_fit(args, lik, settings, write=write_mueller_fit)
+    if isinstance(post, int):  # interrupted
+        return post
+    _print_sampling(post, time.perf_counter() - t0)
+    _print_posterior(post)
+    print(f"wrote {args.out}/posterior.json, posterior_samples.npz, chain.npz")
+    return 0
+
+
 def register(sub):
     p = sub.add_parser("fit", help="emcee posterior of a scene's free parameters given a data file")
-    p.add_argument("data", help="data CSV (see validation/datafile.py; JSON sidecar beside it)")
+    p.add_argument(
+        "data",
+        help="data CSV (see validation/datafile.py; JSON sidecar beside it), or Mueller-matrix data "
+        "(NIST's PTFE.data.csv as published, or scatterbench-mueller/1: see fitting/mueller_data.py)",
+    )
     _spec_args(p)
     p.add_argument(
         "--out", required=True, help="output folder (refused if it exists, unless --force/--resume)"

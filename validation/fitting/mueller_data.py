@@ -159,7 +159,16 @@ class MuellerData:
     meta: dict = field(default_factory=dict)
 
     #: every per-row array, by name (what a fit's fingerprint hashes)
-    _ARRAYS: ClassVar[tuple] = ("theta_i", "phi_i", "theta_r", "phi_r", "wavelength_nm", "mueller", "err", "lines")
+    _ARRAYS: ClassVar[tuple] = (
+        "theta_i",
+        "phi_i",
+        "theta_r",
+        "phi_r",
+        "wavelength_nm",
+        "mueller",
+        "err",
+        "lines",
+    )
 
     def __len__(self):
         return len(self.theta_i)

