@@ -350,7 +350,7 @@ def _check_ranges(path, rows, header, values, col_of, wl):
         azimuth & (np.abs(values) > 360),
         lambda n, v: f"column {n!r}: {v:g} is outside [-360, 360]",
     )
-    _check_wavelength(path, rows, values[:, col_of[wl] - 1], wl)
+    _check_wavelength(path, rows, values[:, col_of[wl] - 1], wl, col_of[wl])
     m11 = values[:, col_of["m11"] - 1]
     _first_bad(
         path,
@@ -389,9 +389,10 @@ def _check_ranges(path, rows, header, values, col_of, wl):
     )
 
 
-def _check_wavelength(path, rows, wl, column):
+def _check_wavelength(path, rows, wl, column, col, name=None):
     """The wavelength column's values in its unit's range; values in the other unit's range are
-    named as such (a column named for nm that holds micrometres, or the reverse)."""
+    named as such (a column named for nm that holds micrometres, or the reverse).  ``col``: its
+    1-based position; ``name``: the file's own name for it (NIST's ``lambda``, in um)."""
     lo, hi = _WAVELENGTH[column]
     bad = (wl < lo) | (wl > hi)
     if not np.any(bad):
@@ -401,13 +402,11 @@ def _check_wavelength(path, rows, wl, column):
     olo, ohi = _WAVELENGTH[other]
     unit, ounit = column[-2:], other[-2:]
     if olo <= wl[r] <= ohi:
-        why = (
-            f"{wl[r]:g} is outside [{lo:g}, {hi:g}] {unit} and looks like {ounit}: "
-            f"name the column {other}, or give the values in {unit}"
-        )
+        fix = f"name the column {other}, or " if name is None else ""
+        why = f"{wl[r]:g} is outside [{lo:g}, {hi:g}] {unit} and looks like {ounit}: {fix}give the values in {unit}"
     else:
         why = f"{wl[r]:g} is outside [{lo:g}, {hi:g}] {unit}"
-    raise DataFileError(path, rows[r][0], None, f"column {column!r}: {why}")
+    raise DataFileError(path, rows[r][0], col, f"column {name or column!r}: {why}")
 
 
 def _check_duplicates(path, rows, geometry, mueller):
@@ -452,6 +451,17 @@ def load_mueller_data(path) -> MuellerData:
     keys, header, header_line, rows = _split(path, text)
     if tuple(header) == NIST_COLUMNS:
         return _nist(path, header, header_line, rows)
+    if tuple(header[:6]) == NIST_COLUMNS[:6]:  # NIST's columns, but not all of them
+        missing = [c for c in NIST_COLUMNS if c not in header]
+        extra = [c for c in header if c not in NIST_COLUMNS]
+        raise DataFileError(
+            path,
+            header_line,
+            None,
+            "NIST's columns, incomplete or changed: "
+            + (f"missing {', '.join(missing)}" if missing else f"unknown {', '.join(extra)}")
+            + f" (NIST's PTFE.data.csv has the 21 columns {','.join(NIST_COLUMNS)}, in that order)",
+        )
     col_of, form, wl = _columns(path, header, header_line)
     if "basis" not in keys:
         raise DataFileError(
@@ -514,7 +524,7 @@ def _nist(path, header, header_line, rows):
         np.isin(names, ["phi", "phir"]) & (np.abs(values) > 360),
         lambda n, v: f"column {n!r}: {v:g} is outside [-360, 360]",
     )
-    _check_wavelength(path, rows, values[:, 0], "wavelength_um")
+    _check_wavelength(path, rows, values[:, 0], "wavelength_um", 1, name="lambda")
     _first_bad(
         path,
         rows,
