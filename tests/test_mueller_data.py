@@ -243,3 +243,34 @@ def test_nist_reader_errors_name_nist_columns(tmp_path):
     bad[9] = "2.5"
     msg = _error(_write(tmp_path, "\n".join([lines[0], ",".join(bad)]) + "\n", "n.csv"))
     assert ":2:10:" in msg and "'f_r21/f_r11'" in msg and "[-1.5, 1.5]" in msg
+
+
+# ------------------------------------------------------------------ the bad-input list
+def test_wavelength_unit_errors_give_line_and_column(tmp_path):
+    msg = _error(_normalized_file(tmp_path, [_row(np.zeros(15), wl="0.532")]))
+    assert ":3:5:" in msg  # wavelength_nm is the fifth column
+    lines = open(references.nist_ptfe_path(), encoding="utf-8").read().splitlines()[:3]
+    bad = lines[2].split(",")
+    bad[0] = "532"
+    msg = _error(_write(tmp_path, "\n".join([lines[0], lines[1], ",".join(bad)]) + "\n", "n.csv"))
+    assert ":3:1:" in msg and "column 'lambda'" in msg and "[0.1, 20] um" in msg
+
+
+def test_nist_m11_not_positive_and_conflicting_duplicate(tmp_path):
+    lines = open(references.nist_ptfe_path(), encoding="utf-8").read().splitlines()[:3]
+    bad = lines[2].split(",")
+    bad[5] = "0"
+    msg = _error(_write(tmp_path, "\n".join([lines[0], lines[1], ",".join(bad)]) + "\n"))
+    assert ":3:6:" in msg and "'f_r11'" in msg and "not > 0" in msg
+    dup = lines[1].split(",")
+    dup[6] = str(float(dup[6]) + 0.01)
+    msg = _error(_write(tmp_path, "\n".join([lines[0], lines[1], ",".join(dup)]) + "\n", "d.csv"))
+    assert ":3:" in msg and "line 2" in msg and "different elements" in msg
+
+
+def test_nist_header_with_a_column_missing_is_named(tmp_path):
+    lines = open(references.nist_ptfe_path(), encoding="utf-8").read().splitlines()[:2]
+    head, row = lines[0].split(","), lines[1].split(",")
+    text = ",".join(head[:-1]) + "\n" + ",".join(row[:-1]) + "\n"
+    msg = _error(_write(tmp_path, text))
+    assert ":1:" in msg and "missing f_r44/f_r11" in msg and "21 columns" in msg

@@ -27,12 +27,12 @@ import logging
 import os
 import sys
 
-from . import check, fit, models, report, scene, study, sweep, table1, tradeoff, validate
+from . import check, fit, models, predict, report, scene, study, sweep, table1, tradeoff, validate
 
 __all__ = ["main", "COMMANDS", "INPUT_ERRORS", "EXIT_OK", "EXIT_FAILED", "EXIT_USAGE", "EXIT_INTERNAL"]
 
 #: every command module, in the order ``scatterbench --help`` lists them
-COMMANDS = (validate, table1, sweep, tradeoff, scene, models, fit, study, report, check)
+COMMANDS = (validate, table1, sweep, tradeoff, scene, models, fit, predict, study, report, check)
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 

@@ -25,6 +25,8 @@ from scatterbench.validation.fitting.datafile import load_data
 from scatterbench.validation.fitting.fit import run_fit, write_fit
 from scatterbench.validation.fitting.fitspec import fitspec_from
 from scatterbench.validation.fitting.likelihood import Likelihood
+from scatterbench.validation.fitting.mueller_data import load_mueller_data
+from scatterbench.validation.fitting.mueller_fit import is_mueller_file, mueller_likelihood, write_mueller_fit
 from scatterbench.validation.fitting.settings import MOVES, ChainSettings
 
 from .args import UsageError, check_executor, executor_args, open_executor, writable_folder
@@ -183,12 +185,14 @@ def _interrupted(ck, final):
 #: rather than deleted by the swap
 FIT_FILES = frozenset(
     {"posterior.json", "chain.npz", "chain.partial.npz", "corner.png", "predictive.png", "residuals.png"}
+    | {"posterior_samples.npz"}  # a Mueller-data fit's samples (fitting.mueller_fit)
 )
 
 
-def _run_fit(args, lik, settings):
-    """Run (or resume) the chain and write the results; returns the posterior summary, or
-    the exit code 130 after Ctrl-C.
+def _run_fit(args, lik, settings, write=write_fit):
+    """Run (or resume) the chain and write the results with ``write`` (``write_fit``, or
+    ``write_mueller_fit`` for Mueller-matrix data); returns the posterior summary, or the
+    exit code 130 after Ctrl-C.
 
     The new folder is built beside ``args.out`` in ``.NAME.partial/`` (its running
     checkpoint is chain.partial.npz there) and swapped in whole when every file is
@@ -216,14 +220,8 @@ def _run_fit(args, lik, settings):
                 )
                 executor = ex.describe()
             os.replace(ck, os.path.join(build, "chain.npz"))
-            return write_fit(
-                res,
-                build,
-                data_path=args.data,
-                scene_path=args.scene,
-                executor_desc=executor,
-                plots=not args.no_plots,
-            )
+            kw = {} if write is write_mueller_fit else {"plots": not args.no_plots}
+            return write(res, build, data_path=args.data, scene_path=args.scene, executor_desc=executor, **kw)
     except BaseException as exc:
         _keep_checkpoint_only(build, ck)
         if isinstance(exc, KeyboardInterrupt):
@@ -292,6 +290,8 @@ def _print_posterior(post):
 def _cmd_fit(args) -> int:
     _check_out(args.out, args.force, args.resume)
     _check_executor(args)
+    if is_mueller_file(args.data):
+        return _cmd_fit_mueller(args)
     settings, _, data, _, lik = _load_and_describe(args)
     print(
         f"data: {data.path}: {len(data)} rows, {lik.n_points} used; likelihood terms: {', '.join(lik.terms)}"
@@ -314,9 +314,47 @@ def _cmd_fit(args) -> int:
     return 0
 
 
+def _cmd_fit_mueller(args) -> int:
+    """``fit`` on Mueller-matrix data (NIST's file as published, or scatterbench-mueller/1): the
+    scene's ``[fit]`` and ``[fit.mueller]`` tables (fitting.mueller_spec); --free replaces the
+    free list, the BRDF-data flags --noise, --near-specular-deg and --exclude do not apply."""
+    for flag, given in (
+        ("--noise", args.noise),
+        ("--near-specular-deg", args.near_specular_deg),
+        ("--exclude", args.exclude),
+    ):
+        if given is not None:
+            raise UsageError(f"{flag}: not for Mueller-matrix data; use the scene's [fit.mueller] table")
+    settings = _chain_settings(args)
+    sc = scene_mod.load(args.scene)
+    data = load_mueller_data(args.data)
+    lik = mueller_likelihood(sc, data, args.free)
+    _require_walkers(settings, len(lik.spec.free))
+    print(lik.scene.describe())
+    print(lik.spec.describe())
+    print(f"data: {data.path}: {len(data)} rows, {len(lik.data)} used, basis {data.basis}")
+    t0 = time.perf_counter()
+    with locked_out(args, args.resume):  # held from the check of --out to the swap
+        post = _run_fit(args, lik, settings, write=write_mueller_fit)
+    if isinstance(post, int):  # interrupted
+        return post
+    _print_sampling(post, time.perf_counter() - t0)
+    _print_posterior(post)
+    print(f"wrote {args.out}/posterior.json, posterior_samples.npz, chain.npz")
+    problem = _chain_problem(post)
+    if problem:
+        print(f"FAILED: {problem}")
+        return 1
+    return 0
+
+
 def register(sub):
     p = sub.add_parser("fit", help="emcee posterior of a scene's free parameters given a data file")
-    p.add_argument("data", help="data CSV (see validation/datafile.py; JSON sidecar beside it)")
+    p.add_argument(
+        "data",
+        help="data CSV (see validation/datafile.py; JSON sidecar beside it), or Mueller-matrix data "
+        "(NIST's PTFE.data.csv as published, or scatterbench-mueller/1: see fitting/mueller_data.py)",
+    )
     _spec_args(p)
     p.add_argument(
         "--out", required=True, help="output folder (refused if it exists, unless --force/--resume)"

@@ -446,9 +446,10 @@ def fitspec_from(scene, free=None, noise=None, near_specular_deg=None, exclude=N
     """
     table = dict(scene.fit or {})
     where = f"{scene.path}: [fit]"
-    unknown = set(table) - {"free", "noise", "mask"}
+    # [fit.mueller] is read by fits to Mueller-matrix data (fitting.mueller_spec)
+    unknown = set(table) - {"free", "noise", "mask", "mueller"}
     if unknown:
-        raise FitSpecError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: free, noise, mask")
+        raise FitSpecError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: free, noise, mask, mueller")
     params = _free_entries(where, table, free)
     noise_params, noise_fixed, off = _noise_entries(where, table, noise)
     params += noise_params

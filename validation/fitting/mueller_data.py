@@ -47,6 +47,7 @@ import csv
 import math
 import re
 from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -157,6 +158,18 @@ class MuellerData:
     lines: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
 
+    #: every per-row array, by name (what a fit's fingerprint hashes)
+    _ARRAYS: ClassVar[tuple] = (
+        "theta_i",
+        "phi_i",
+        "theta_r",
+        "phi_r",
+        "wavelength_nm",
+        "mueller",
+        "err",
+        "lines",
+    )
+
     def __len__(self):
         return len(self.theta_i)
 
@@ -179,9 +192,8 @@ class MuellerData:
 
     def subset(self, keep) -> MuellerData:
         """The rows ``keep`` selects (a boolean mask or an index array)."""
-        arrays = ("theta_i", "phi_i", "theta_r", "phi_r", "wavelength_nm", "mueller", "err", "lines")
         return replace(
-            self, **{a: None if getattr(self, a) is None else getattr(self, a)[keep] for a in arrays}
+            self, **{a: None if getattr(self, a) is None else getattr(self, a)[keep] for a in self._ARRAYS}
         )
 
 
@@ -338,7 +350,7 @@ def _check_ranges(path, rows, header, values, col_of, wl):
         azimuth & (np.abs(values) > 360),
         lambda n, v: f"column {n!r}: {v:g} is outside [-360, 360]",
     )
-    _check_wavelength(path, rows, values[:, col_of[wl] - 1], wl)
+    _check_wavelength(path, rows, values[:, col_of[wl] - 1], wl, col_of[wl])
     m11 = values[:, col_of["m11"] - 1]
     _first_bad(
         path,
@@ -377,9 +389,10 @@ def _check_ranges(path, rows, header, values, col_of, wl):
     )
 
 
-def _check_wavelength(path, rows, wl, column):
+def _check_wavelength(path, rows, wl, column, col, name=None):
     """The wavelength column's values in its unit's range; values in the other unit's range are
-    named as such (a column named for nm that holds micrometres, or the reverse)."""
+    named as such (a column named for nm that holds micrometres, or the reverse).  ``col``: its
+    1-based position; ``name``: the file's own name for it (NIST's ``lambda``, in um)."""
     lo, hi = _WAVELENGTH[column]
     bad = (wl < lo) | (wl > hi)
     if not np.any(bad):
@@ -389,13 +402,11 @@ def _check_wavelength(path, rows, wl, column):
     olo, ohi = _WAVELENGTH[other]
     unit, ounit = column[-2:], other[-2:]
     if olo <= wl[r] <= ohi:
-        why = (
-            f"{wl[r]:g} is outside [{lo:g}, {hi:g}] {unit} and looks like {ounit}: "
-            f"name the column {other}, or give the values in {unit}"
-        )
+        fix = f"name the column {other}, or " if name is None else ""
+        why = f"{wl[r]:g} is outside [{lo:g}, {hi:g}] {unit} and looks like {ounit}: {fix}give the values in {unit}"
     else:
         why = f"{wl[r]:g} is outside [{lo:g}, {hi:g}] {unit}"
-    raise DataFileError(path, rows[r][0], None, f"column {column!r}: {why}")
+    raise DataFileError(path, rows[r][0], col, f"column {name or column!r}: {why}")
 
 
 def _check_duplicates(path, rows, geometry, mueller):
@@ -440,6 +451,17 @@ def load_mueller_data(path) -> MuellerData:
     keys, header, header_line, rows = _split(path, text)
     if tuple(header) == NIST_COLUMNS:
         return _nist(path, header, header_line, rows)
+    if tuple(header[:6]) == NIST_COLUMNS[:6]:  # NIST's columns, but not all of them
+        missing = [c for c in NIST_COLUMNS if c not in header]
+        extra = [c for c in header if c not in NIST_COLUMNS]
+        raise DataFileError(
+            path,
+            header_line,
+            None,
+            "NIST's columns, incomplete or changed: "
+            + (f"missing {', '.join(missing)}" if missing else f"unknown {', '.join(extra)}")
+            + f" (NIST's PTFE.data.csv has the 21 columns {','.join(NIST_COLUMNS)}, in that order)",
+        )
     col_of, form, wl = _columns(path, header, header_line)
     if "basis" not in keys:
         raise DataFileError(
@@ -502,7 +524,7 @@ def _nist(path, header, header_line, rows):
         np.isin(names, ["phi", "phir"]) & (np.abs(values) > 360),
         lambda n, v: f"column {n!r}: {v:g} is outside [-360, 360]",
     )
-    _check_wavelength(path, rows, values[:, 0], "wavelength_um")
+    _check_wavelength(path, rows, values[:, 0], "wavelength_um", 1, name="lambda")
     _first_bad(
         path,
         rows,

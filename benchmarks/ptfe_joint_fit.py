@@ -1,0 +1,113 @@
+"""The joint fit of a physical PTFE model over all of NIST's data (7296 rows, 4 wavelengths, 16
+elements) toward N >= 50 tau: wall time, likelihood evaluations per second, and where a batch's
+time goes.
+
+    python benchmarks/ptfe_joint_fit.py [--scene FILE] [--walkers W] [--max-steps N]
+                                        [--threads T] [--seed S]
+
+Default scene: ``references/scenes/ptfe_smooth_diffuse_joint.toml`` (facets + totally diffuse
+subsurface under a smooth interface; 11 free parameters: roughness, albedo per wavelength, a
+Cauchy index, calibration, incidence offset, two noise levels), the fastest of seed 003's
+physical models that binds to a model set.  Which model is best is the model comparison's
+question (issue 29 part 4); this measures the speed of a joint fit.
+
+The run is ``run_fit`` (optimum, then emcee, every walker of a step in one call) with a step
+budget; the script prints the chain's own evaluations per second, the autocorrelation time it
+reached and, when the budget ends before N >= 50 tau, the time 50 tau would take at the measured
+rate.  It prints the load average before and after: on a shared machine the figures scale with
+the share of the cores this process got.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numba
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+from scatterbench.models import scene as scene_mod  # noqa: E402
+from scatterbench.references import nist_ptfe_path  # noqa: E402
+from scatterbench.validation.fitting.fit import run_fit  # noqa: E402
+from scatterbench.validation.fitting.mueller_data import load_mueller_data  # noqa: E402
+from scatterbench.validation.fitting.mueller_fit import mueller_likelihood  # noqa: E402
+from scatterbench.validation.fitting.mueller_kernel import loglike_rows  # noqa: E402
+from scatterbench.validation.fitting.sampling import _default_start  # noqa: E402
+from scatterbench.validation.fitting.settings import ChainSettings  # noqa: E402
+
+
+def _best(f, n=5):
+    times = []
+    for _ in range(n):
+        t = time.perf_counter()
+        f()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def _breakdown(lik, walkers):
+    """Seconds per batch of ``walkers``: the model's 16 elements, the fused likelihood, the whole."""
+    u0 = _default_start(lik, lik.spec.u_bounds())
+    U = u0 + 1e-3 * np.random.default_rng(0).standard_normal((walkers, len(u0)))
+    lik.batch(U)  # compile / warm
+    M = np.ascontiguousarray(lik.predict_psps(U, lik.rows))
+    c, _, _ = lik.nuisance(U)
+    s2 = np.full((len(lik.elements), walkers), 1e-2)
+    out = np.empty((walkers, len(lik.data)))
+    return {
+        "model": _best(lambda: lik.predict_psps(U, lik.rows)),
+        "likelihood kernel": _best(
+            lambda: loglike_rows(M, *lik._packed, c[:, 0].copy(), s2, lik._errvar, out)
+        ),
+        "batch (log posterior)": _best(lambda: lik.batch(U)),
+    }
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scene", default=os.path.join(ROOT, "references/scenes/ptfe_smooth_diffuse_joint.toml"))
+    ap.add_argument("--walkers", type=int, default=24)
+    ap.add_argument("--max-steps", type=int, default=20000)
+    ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS, help="numba threads")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args(argv)
+    numba.set_num_threads(args.threads)
+    print(f"load average before: {os.getloadavg()}; cores {os.cpu_count()}; numba threads {args.threads}")
+    t0 = time.perf_counter()
+    data = load_mueller_data(nist_ptfe_path())
+    lik = mueller_likelihood(scene_mod.load(args.scene), data)
+    print(
+        f"{args.scene}: {len(lik.data)} rows x {len(lik.elements)} elements, {len(lik.spec.free)} free parameters"
+    )
+    for k, v in _breakdown(lik, args.walkers).items():
+        print(f"  {k:<24} {v * 1e3:8.1f} ms per batch of {args.walkers} walkers")
+    settings = ChainSettings(
+        walkers=args.walkers,
+        seed=args.seed,
+        max_steps=args.max_steps,
+        check_every=100,
+        tau_factor=50,
+        starts=1,
+    )
+    fit = run_fit(lik, settings)
+    wall = time.perf_counter() - t0
+    ch = fit.chain
+    tau = float(np.nanmax(ch.tau))
+    rate = ch.evaluations / ch.seconds
+    print(ch.stop_reason)
+    print(f"steps {ch.steps}, tau (max) {tau:.1f} steps, N / tau {ch.steps / tau:.1f}")
+    print(f"evaluations per second (walker log posteriors): {rate:.0f}")
+    print(f"sampling {ch.seconds:.1f} s; wall time (load, optimum, chain) {wall:.1f} s")
+    if not ch.converged and np.isfinite(tau):
+        need = 50 * tau * args.walkers / rate
+        print(f"at this rate, N = 50 tau = {50 * tau:.0f} steps would take {need:.0f} s of sampling")
+    print(f"load average after: {os.getloadavg()}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
