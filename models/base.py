@@ -15,14 +15,13 @@ Models combine incoherently with arithmetic, as in ``astropy.modeling``:
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
 from . import evaluation, float32_domain, modelset
-from .constraints import Instance
+from .constraints import FACTOR_MAX, Instance, Interval
 from .evaluation import CHUNK
 from .facts import Correspondence, ModelFacts
 from .geometry import broadcast_angles
@@ -258,7 +257,8 @@ class Model(Declared, ModelFacts):
     def __mul__(self, w):
         if isinstance(w, Model):
             return NotImplemented
-        return Sum(terms=tuple((float(w) * k, m) for k, m in _terms(self)))
+        w = WEIGHT.check("weight", w)  # a bool or a string is no weight
+        return Sum(terms=tuple((w * k, m) for k, m in _terms(self)))
 
     __rmul__ = __mul__
 
@@ -273,6 +273,10 @@ class Model(Declared, ModelFacts):
             default = f"{'(required)':<22}" if p.required else f"default={p.default!r:<14}"
             lines.append(f"    {p.name:<{width}} {default} {p.doc} ({p.range_text()}{old})")
         return "\n".join(lines)
+
+
+#: a weight of an incoherent sum: a factor (constraints.FACTOR_MAX), not a bool or a string
+WEIGHT = Interval(0.0, FACTOR_MAX)
 
 
 def _terms(m):
@@ -304,10 +308,7 @@ class Sum(Model):
         for item in self.terms:
             if not (isinstance(item, tuple) and len(item) == 2 and isinstance(item[1], Model)):
                 raise ValueError("terms must be (weight, model) pairs with a Model instance")
-            w = float(item[0])
-            if not math.isfinite(w) or w < 0:
-                raise ValueError(f"weight must be a finite real >= 0; got {item[0]!r}")
-            clean.append((w, item[1]))
+            clean.append((WEIGHT.check("weight", item[0]), item[1]))
         object.__setattr__(self, "terms", tuple(clean))
         if any(m.transmission != self.terms[0][1].transmission for _, m in self.terms):
             raise ValueError("terms must all be BRDFs or all BTDFs")

@@ -34,6 +34,7 @@ __all__ = [
     "SLOPE_WIDTH_MIN",
     "SLOPE_WIDTH_MAX",
     "INDEX_EDGES",
+    "FACTOR_MAX",
     "ParameterError",
     "Constraint",
     "Interval",
@@ -72,6 +73,16 @@ SLOPE_WIDTH_MIN = 1e-8
 #: of vertical, the same resolution limit as :data:`SLOPE_WIDTH_MIN` from the other side
 #: (and above ~1e154 the w^2 of the lobe's normalisation overflows).
 SLOPE_WIDTH_MAX = 1e8
+
+#: Largest multiplicative factor a model takes: a weight of an incoherent sum, a BRDF amplitude
+#: in 1/sr (a Lambertian's, Maxwell-Beard's volumetric one), a Monte Carlo term's weight.  Such a
+#: factor scales every value of the model, so without an upper bound a finite, in-range value
+#: (1e306) overflows the result.  Two nested factors (a weight of a sum of an amplitude's model)
+#: give at most FACTOR_MAX^2 = 1e200, which leaves a factor 1e108 of float64's range
+#: (1.8e308) above them for the model itself: the largest value an in-range model reaches
+#: (a lobe of width SLOPE_WIDTH_MIN, ~1e15, seen at float64's grazing cosine, ~6e-17, on both
+#: sides) is below 1e50.  (float32's range is the float32 route's: see float32_domain.)
+FACTOR_MAX = 1e100
 
 #: The stability sweep's complex indices: index-matched to the ambient, a hair above it, a
 #: dielectric, silicon, aluminium, a near-perfect conductor and the perfect conductor.
@@ -115,6 +126,14 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     a = np.array(a, copy=True)
     a.flags.writeable = False
     return a
+
+
+def _scalar_of(value):
+    """A 0-d numpy array as the scalar it holds (0-d arrays are scalars, not model sets:
+    ``np.array(0.2)``); anything else unchanged."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        return value[()]
+    return value
 
 
 def _is_bool(value) -> bool:
@@ -223,6 +242,7 @@ class Interval(Constraint):
 
     def _scalar(self, name, value) -> float:
         """``value`` as a float (a complex number with no imaginary part counts), unchecked range."""
+        value = _scalar_of(value)
         if _is_array(value):
             self.fail(name, value, " (one value: this parameter is not an array parameter)")
         if _is_bool(value):
@@ -290,6 +310,7 @@ class Integer(Constraint):
         return f"an integer in {interval_notation(self.low, self.high)}"
 
     def check(self, name, value) -> int:
+        value = _scalar_of(value)
         if _is_bool(value):
             self.fail(name, value, " (a bool is not a number)")
         if not isinstance(value, numbers.Integral):
@@ -325,6 +346,7 @@ class ComplexIndex(Constraint):
         )
 
     def check(self, name, value):
+        value = _scalar_of(value)
         if _is_array(value) or _is_bool(value) or not isinstance(value, numbers.Complex):
             self.fail(name, value)
         z = complex(value)
@@ -455,6 +477,9 @@ class Samples(Constraint):
         return f"a sequence of at least {self.min_size} values{order} each {self.element.describe()}"
 
     def check(self, name, value) -> tuple:
+        if not isinstance(value, np.ndarray) and any(_is_bool(v) for v in _items(value)):
+            # numpy turns (True, 1.6) into floats: a bool is no sample
+            self.fail(name, value, " (a bool is not a number)")
         try:
             a = np.asarray(value)
         except (TypeError, ValueError):  # ragged nesting
@@ -468,6 +493,14 @@ class Samples(Constraint):
         if self.increasing and np.any(np.diff(a) <= 0):
             self.fail(name, value, " (not strictly increasing)")
         return tuple(a.tolist())
+
+
+def _items(value):
+    """The items of a sequence (none for anything that is not iterable)."""
+    try:
+        return list(value)
+    except TypeError:
+        return []
 
 
 class ScalarOrArray(Constraint):

@@ -46,7 +46,7 @@ from . import kernel_specs
 from .base import Model
 from .constraints import ComplexIndex, Instance, Options, ScalarOrArray
 from .facts import Correspondence
-from .fresnel import fresnel_reflectance
+from .fresnel import _reflectance
 from .params import SLOPE_WIDTH_MAX, SLOPE_WIDTH_MIN, Alias, check_real, choice_alias, convention_param, param
 from .shadowing import smith_g
 from .slopes import AnisotropicGaussianSlopes, GaussianSlopes
@@ -150,7 +150,7 @@ def fresnel_average(cos_i, index):
     """Natural-light reflectance ``F = (F_s + F_p) / 2`` (Eq. 17) of relative index ``index``:
     the shared complex Fresnel reflectances (:func:`scatterbench.models.fresnel.fresnel_reflectance`),
     which the corrected real form :func:`fresnel_real` equals (checked in validate)."""
-    rs, rp = fresnel_reflectance(cos_i, 1.0, index)
+    rs, rp = _reflectance(cos_i, 1.0, index)
     return 0.5 * (rs + rp)
 
 

@@ -155,7 +155,18 @@ def _refine(regions, split, integrand, block):
     return _join(regions.take(~split), kids)
 
 
-def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, block=4096):
+def _worst_splits(split, err, row, room):
+    """``split`` kept for at most ``room[r]`` regions of each row ``r``, its largest errors."""
+    idx = np.flatnonzero(split)
+    order = idx[np.lexsort((-err[idx], row[idx]))]
+    r = row[order]
+    rank = np.arange(r.size) - np.searchsorted(r, r, side="left")
+    out = np.zeros_like(split)
+    out[order[rank < room[r]]] = True
+    return out
+
+
+def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, block=4096, max_evaluated=None):
     """Integrate ``integrand`` over every cell and sum the cells per row, refining adaptively.
 
     Parameters
@@ -177,6 +188,11 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
         ``(k + 1, n_rows)``.
     max_regions : int
         Regions per row beyond which it is not refined (reported in ``capped``).
+    max_evaluated : int, optional
+        Regions a row may evaluate in all (its initial ones, and two per split): a pass splits
+        at most what is left of it, the worst regions first, and a row with no split left is
+        ``capped``.  So ``GM_POINTS * max_evaluated`` bounds the integrand's points per row
+        (given that the initial regions fit in it).
     start : int
         Each cell starts as ``start x start`` regions (an embedded estimate on one region
         can miss a feature that both rules straddle alike; a few regions expose it).
@@ -209,12 +225,17 @@ def adaptive(integrand, cell_row, n_rows, norm, budget, max_regions, start=2, bl
         todo = active & ~(row_err <= allowed)  # a NaN error is not converged
         # rows at the cap, or whose error is not finite (no split can repair it), are reported
         capped |= todo & ((count >= max_regions) | ~np.isfinite(row_err))
+        if max_evaluated is not None:
+            room = (max_evaluated - evaluated) // 2  # splits each row can still afford
+            capped |= todo & (room < 1)
         todo &= ~capped
         # the worst regions are split: those above both their fair share of the row's budget
         # and a fraction of the row's worst (the share alone would soon split nearly all)
         worst = np.zeros(n_rows)
         np.maximum.at(worst, row, np.where(np.isfinite(err), err, 0.0))  # NaN rows are capped
         split = todo[row] & (err > np.maximum(allowed[row] / count[row], WORST * worst[row]))
+        if max_evaluated is not None:
+            split = _worst_splits(split, err, row, room)
         if not split.any():
             return Cubature(total, row_err, count, capped, evaluated)
         evaluated += 2 * np.bincount(row[split], minlength=n_rows)

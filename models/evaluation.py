@@ -399,6 +399,7 @@ def small(model, theta_i, theta_r, phi_r, rows, precision, out=None):
     compiled model's call straight into its kernel, formatted (``(..., 4, 4)`` matrices, or
     ``M00`` of the angles' shape); ``None`` for the general route (which also raises the
     errors).  :func:`compiled`'s choice, written out: this route's overhead is the call's."""
+    check_out(out)
     if model._sets or _BACKEND.get() != "numba":
         return None
     kernel = model._kernel  # None where no kernel covers the model
@@ -416,11 +417,27 @@ def small(model, theta_i, theta_r, phi_r, rows, precision, out=None):
     return None if fast is None else fast.astype(np.float32)
 
 
+def check_out(out):
+    """``out`` as a user may give it: ``None`` or a writeable numpy array (a ``numpy.memmap``
+    is one), else the ``TypeError`` or ``ValueError`` naming ``out`` (a list raised an
+    AttributeError and a read-only array numba's TypingError from inside the kernels)."""
+    if out is None:
+        return None
+    if not isinstance(out, np.ndarray):
+        raise TypeError(
+            f"out must be a numpy array (or numpy.memmap) of shape (rows, N); got {type(out).__name__}"
+        )
+    if not out.flags.writeable:
+        raise ValueError("out must be a writeable array; got a read-only one")
+    return out
+
+
 def evaluate(model, theta_i, theta_r, phi_r, rows, precision="float64", out=None):
     """``(shape, M)``: ``model`` at a user's angles, validated and broadcast once, as
     element-major storage ``M`` ``(rows, N)`` (rows 16: row ``4 a + b`` is element ``ab``;
     rows 1: ``M00``), ``shape`` the broadcast shape (``N`` its size); into ``out`` when given
     (a ``(rows, N)`` array of the precision's dtype, e.g. a ``numpy.memmap``)."""
+    check_out(out)
     p = plan(model, theta_i, theta_r, phi_r)
     dtype = np.dtype(check_precision(precision))
     if out is None:

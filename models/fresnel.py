@@ -24,6 +24,8 @@ import math
 
 import numpy as np
 
+from .constraints import INDEX_MAX, INDEX_MIN, ComplexIndex, Interval
+
 __all__ = [
     "fresnel_coefficients",
     "fresnel_reflectance",
@@ -36,18 +38,53 @@ __all__ = [
 
 
 def _w(c, m):
-    arg = m * m - 1.0 + c * c
+    # m^2 - sin^2 in the form that keeps its digits: (m^2 - 1) + c^2 for |m| near 1 or above
+    # (exact at grazing under m = 1), m^2 - (1 - c)(1 + c) for a small index, where the first
+    # cancels at normal incidence (m = 1e-12: 1e-24 - 1 + 1 = 0, so w = 0 for w = m, and a
+    # film's interfaces then met as 1 + r r' = 0: 0/0)
+    c = np.asarray(c)
+    small = np.abs(m) < 0.5
+    arg = np.where(small, m * m - (1.0 - c) * (1.0 + c), m * m - 1.0 + c * c)
     arg = np.asarray(arg, dtype=complex)
     arg = np.where(arg.imag == 0, arg.real + 0j, arg)  # +0 imaginary part: TIR branch +i
     return np.sqrt(arg)
+
+
+def _checked(cos_i, n1, n2):
+    """The public functions' arguments validated: ``cos_i`` finite in [0, 1] (float64 array),
+    ``n1`` a real index (the incident medium is non-absorbing), ``n2`` an index ``n + ik``
+    or ``math.inf`` (:class:`~.constraints.ComplexIndex`); a ``ValueError`` naming the
+    parameter and its range otherwise (n2 = -1.5 and cos_i = 2 gave numbers, n1 = 0 a
+    ZeroDivisionError)."""
+    c = np.asarray(cos_i)
+    if c.dtype.kind not in "iuf":
+        raise ValueError(f"cos_i must be a real number or array in [0, 1]; got {c.dtype}")
+    c = c.astype(float, copy=False)
+    if c.size and not (np.all(np.isfinite(c)) and c.min() >= 0.0 and c.max() <= 1.0):
+        bad = c[~((c >= 0.0) & (c <= 1.0))].reshape(-1)[0]
+        raise ValueError(
+            f"cos_i must lie in [0, 1] (the cosine of an angle of incidence); got {float(bad)!r}"
+        )
+    return c, _N1.check("n1", n1), _N2.check("n2", n2)
+
+
+_N1 = Interval(INDEX_MIN, INDEX_MAX)
+_N2 = ComplexIndex()
 
 
 def fresnel_coefficients(cos_i, n1, n2):
     """``(r_s, r_p, t_s, t_p)`` for light in ``n1`` (real) hitting ``n2``.
 
     ``cos_i`` is the cosine of the angle of incidence (array, in [0, 1]).
-    ``n2`` may be complex (``k >= 0``) or ``math.inf``.
+    ``n2`` may be complex (``k >= 0``) or ``math.inf``.  Out-of-range arguments raise a
+    ``ValueError`` naming them.
     """
+    return _coefficients(*_checked(cos_i, n1, n2))
+
+
+def _coefficients(cos_i, n1, n2):
+    """:func:`fresnel_coefficients` of arguments the caller validated (the models' internal
+    calls, whose local cosines may carry a rounding beyond 1)."""
     c = np.asarray(cos_i, dtype=float)
     if n2 == math.inf:
         one = np.ones_like(c, dtype=complex)
@@ -66,8 +103,13 @@ def fresnel_coefficients(cos_i, n1, n2):
 
 
 def fresnel_reflectance(cos_i, n1, n2):
-    """Intensity reflectances ``(R_s, R_p)``."""
-    rs, rp, _, _ = fresnel_coefficients(cos_i, n1, n2)
+    """Intensity reflectances ``(R_s, R_p)`` (arguments as :func:`fresnel_coefficients`)."""
+    return _reflectance(*_checked(cos_i, n1, n2))
+
+
+def _reflectance(cos_i, n1, n2):
+    """:func:`fresnel_reflectance` of validated arguments (internal calls)."""
+    rs, rp, _, _ = _coefficients(cos_i, n1, n2)
     return np.abs(rs) ** 2, np.abs(rp) ** 2
 
 
@@ -77,14 +119,14 @@ def fresnel_transmittance(cos_i, n1, n2):
     ``T = Re(n2 cos t) / (n1 cos i) |t|^2 = Re(w) / c |t|^2``: the ratio of the
     normal components of the Poynting vectors, zero beyond the critical angle.
     """
+    c, n1, n2 = _checked(cos_i, n1, n2)
     if n2 == math.inf:
-        z = np.zeros_like(np.asarray(cos_i, float))
+        z = np.zeros_like(c)
         return z, z.copy()
-    c = np.asarray(cos_i, dtype=float)
     m = complex(n2) / complex(n1)
     if m.imag != 0:
         raise ValueError("fresnel_transmittance needs a non-absorbing n2 (k = 0)")
-    _, _, ts, tp = fresnel_coefficients(c, n1, n2)
+    _, _, ts, tp = _coefficients(c, n1, n2)
     w = _w(c, m)
     with np.errstate(divide="ignore", invalid="ignore"):
         f = np.where(c > 0, w.real / np.where(c > 0, c, 1.0), 0.0)

@@ -34,7 +34,7 @@ import numpy as np
 
 from . import kernel_specs
 from .base import Model
-from .constraints import ComplexIndex, Interval, Options, ScalarOrArray
+from .constraints import FACTOR_MAX, ComplexIndex, Interval, Options, ScalarOrArray
 from .facet import FacetBRDF
 from .facts import Correspondence, scatmech_index
 from .params import param
@@ -91,11 +91,15 @@ class MaxwellBeardBRDF(Model):
     slopes: SlopeDistribution = param(GaussianSlopes(0.1), "facet slope distribution", SLOPES)
     substrate: complex = param(1.5 + 0j, "material index n + ik", ScalarOrArray(ComplexIndex()))
     # the amplitudes are BRDFs (1/sr): swept at 0 and 1/pi, a white Lambertian
+    # bounded by FACTOR_MAX: an amplitude scales the model, and an unbounded one overflows it
     rho_d: float = param(
-        0.0, "Lambertian BRDF (1/sr)", ScalarOrArray(Interval(0.0)), edges=(0.0, 1.0 / math.pi)
+        0.0, "Lambertian BRDF (1/sr)", ScalarOrArray(Interval(0.0, FACTOR_MAX)), edges=(0.0, 1.0 / math.pi)
     )
     rho_v: float = param(
-        0.0, "volumetric BRDF coefficient (1/sr)", ScalarOrArray(Interval(0.0)), edges=(0.0, 1.0 / math.pi)
+        0.0,
+        "volumetric BRDF coefficient (1/sr)",
+        ScalarOrArray(Interval(0.0, FACTOR_MAX)),
+        edges=(0.0, 1.0 / math.pi),
     )
     tau: float = param(
         0.25, "shadowing parameter tau (rad)", ScalarOrArray(Interval(0.0, closed="right")), edges=(1e-4, 2.0)

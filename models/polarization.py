@@ -94,8 +94,13 @@ def mueller16_from_jones(ss, ps, sp, pp, out=None):
 
 
 def jones_to_mueller(J):
-    """Mueller matrix ``(..., 4, 4)`` of Jones matrices ``(..., 2, 2)``."""
+    """Mueller matrix ``(..., 4, 4)`` of Jones matrices ``(..., 2, 2)`` (a single ``(2, 2)``
+    matrix gives a ``(4, 4)`` one)."""
     J = np.asarray(J, dtype=complex)
+    if J.ndim < 2 or J.shape[-2:] != (2, 2):
+        raise ValueError(f"J must be Jones matrices of shape (..., 2, 2); got shape {J.shape}")
+    if J.ndim == 2:  # the element arrays are 0-d: the map's out= needs at least one axis
+        return jones_to_mueller(J[None])[0]
     parts = [(J[..., a, b].real, J[..., a, b].imag) for a, b in ((0, 0), (0, 1), (1, 0), (1, 1))]
     return np.moveaxis(mueller16_from_jones(*parts), 0, -1).reshape(J.shape[:-2] + (4, 4))
 

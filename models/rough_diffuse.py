@@ -65,7 +65,7 @@ import numpy as np
 
 from . import evaluation, modelset
 from .base import Model
-from .constraints import Instance, Integer, Interval, OneOf, Options, ScalarOrArray
+from .constraints import FACTOR_MAX, Instance, Integer, Interval, OneOf, Options, ScalarOrArray
 from .facet import FacetBRDF
 from .facet_btdf import _dot, angle_basis, facet_transmission_jones, projected_area, ray_basis
 from .facts import Correspondence
@@ -200,7 +200,10 @@ class RoughDiffuseBRDF(Model):
     )
     surface: bool = param(True, "add the exposed surface's facet reflection", Options(True, False))
     single: float = param(
-        1.0, "weight of the single-scattering term", ScalarOrArray(Interval(0.0)), edges=(0.0, 1.0)
+        1.0,
+        "weight of the single-scattering term",
+        ScalarOrArray(Interval(0.0, FACTOR_MAX)),
+        edges=(0.0, 1.0),
     )
     feedback: str = param(
         "rough", "R-bar of Eq. 23: of the rough interface (MC) or of the flat one", Options("rough", "flat")

@@ -105,9 +105,10 @@ def lambda_ggx(mu, alpha):
     mu = np.asarray(mu, dtype=float)
     with np.errstate(divide="ignore"):
         x = alpha / mu  # inf at grazing
-    # written as x^2 / (2 (1 + sqrt(1 + x^2))) so that small x loses no digits
+    # written as x (x / (1 + hypot(1, x))) / 2 so that small x loses no digits and large x
+    # (mu = 1e-300: x^2 overflowed to inf, and inf / inf was NaN) no range: the ratio is < 1
     with np.errstate(invalid="ignore"):
-        out = 0.5 * x * x / (1.0 + np.sqrt(1.0 + x * x))
+        out = 0.5 * x * (x / (1.0 + np.hypot(1.0, x)))
     return np.where(np.isinf(x), np.inf, out)
 
 

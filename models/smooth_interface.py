@@ -59,7 +59,7 @@ import numpy as np
 from scipy import integrate
 
 from .cubature import AccuracyWarning
-from .fresnel import coating_cos, fresnel_reflectance
+from .fresnel import _reflectance, coating_cos
 from .geometry import gauss_legendre
 from .thin_film import FilmStack
 
@@ -144,7 +144,7 @@ def _rbar(n: float) -> float:
         return 0.0
 
     def f(c):
-        rs, rp = fresnel_reflectance(np.array([c]), 1.0, n)
+        rs, rp = _reflectance(np.array([c]), 1.0, n)
         return float(rs[0] + rp[0]) * c  # 0.5 (Rs + Rp) * 2c
 
     # The integrand has a branch point at c = i sqrt(n^2 - 1): near n = 1 it is

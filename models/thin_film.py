@@ -74,7 +74,7 @@ from .constraints import (
     Samples,
     ScalarOrArray,
 )
-from .fresnel import _w, fresnel_coefficients, reflection_rs_k
+from .fresnel import _coefficients, _w, reflection_rs_k
 from .params import Declared, check_index, check_real, param
 
 __all__ = [
@@ -128,13 +128,23 @@ def _resolve(name, value, wavelength_nm):
     return check_index(name, value)
 
 
+#: Thickest film (nm, 1 m) and shortest wavelength (nm, 1 pm) a stack takes.  The phase
+#: 2 pi d kz / lambda of a film must be a finite float64 (d = 1e308 nm overflowed it to inf, and
+#: exp(i inf) is NaN): with d / lambda <= 1e12 and |kz| <= 2 INDEX_MAX (3.6e16) it stays below
+#: 2.3e29.  (Already above d |n| / lambda ~ 1 / eps = 4.5e15 the phase is not resolved to a
+#: cycle: such a film is a thick slab, whose interference float64 cannot represent.)
+THICKNESS_MAX_NM = 1e9
+WAVELENGTH_MIN_NM = 1e-3
+_WAVELENGTH = ScalarOrArray(Interval(WAVELENGTH_MIN_NM, None))
+
+
 class Layers(Constraint):
     """Films as ``((index, thickness_nm), ...)``: each thickness a finite real ``>= 0``, each
     index ``n + ik`` or a callable of the wavelength, validated (at the stack's wavelength) by
     the stack that holds them.  Returned as a tuple of pairs, thicknesses as floats."""
 
     kind = "sequence"
-    THICKNESS = Interval(0.0)
+    THICKNESS = Interval(0.0, THICKNESS_MAX_NM)
 
     def describe(self) -> str:
         return (
@@ -205,9 +215,7 @@ class FilmStack(Declared):
 
     layers: tuple = param((), "films ((index, thickness_nm), ...) from the incident side", _LAYERS)
     substrate: complex = param(1.5 + 0j, "index below the films (n + ik, inf, or callable)", Dispersive())
-    wavelength_nm: float = param(
-        550.0, "vacuum wavelength (nm)", ScalarOrArray(Interval(0.0, closed="right"))
-    )
+    wavelength_nm: float = param(550.0, "vacuum wavelength (nm)", _WAVELENGTH)
 
     def _validate(self):
         _ = self.indices  # validates every index at this wavelength
@@ -239,7 +247,7 @@ class FilmStack(Declared):
         (films, thickness), sub = self._thick, self.indices[1]
         c = np.asarray(cos_i, dtype=float)
         if not films:
-            return fresnel_coefficients(c, n0, sub)
+            return _coefficients(c, n0, sub)
         kz = [n0 * c + 0j] + [n0 * _w(c, n / n0) for n in films]  # n_j cos(theta_j), Im >= 0
         ns = [complex(n0)] + list(films)
         r, t = _bottom(kz[-1], ns[-1], c, n0, sub)
@@ -347,9 +355,7 @@ class Films(Declared):
     """
 
     layers: tuple = param((), "films ((index, thickness_nm), ...) from the ambient side down", _LAYERS)
-    wavelength_nm: float = param(
-        550.0, "vacuum wavelength (nm)", ScalarOrArray(Interval(0.0, closed="right"))
-    )
+    wavelength_nm: float = param(550.0, "vacuum wavelength (nm)", _WAVELENGTH)
 
     def _validate(self):
         _ = self.indices

@@ -57,7 +57,7 @@ from functools import cached_property
 import numpy as np
 
 from .base import Model
-from .constraints import Constraint, Interval, ParameterError, ScalarOrArray
+from .constraints import FACTOR_MAX, Constraint, Interval, ParameterError, ScalarOrArray
 from .facts import Correspondence
 from .params import param
 
@@ -282,7 +282,7 @@ class ZernikeExpansionBRDF(Model):
         ScalarOrArray(Interval(0.0, None, closed="right")),
     )
     scale: float = param(
-        1.0, "overall factor r(lambda) (SCATMECH's scale)", ScalarOrArray(Interval(0.0, None))
+        1.0, "overall factor r(lambda) (SCATMECH's scale)", ScalarOrArray(Interval(0.0, FACTOR_MAX))
     )
     rotation: float = param(
         0.0, "azimuth of the sample's x axis (rad; SCATMECH's rotation)", ScalarOrArray(Interval())

@@ -254,7 +254,8 @@ def lam_unit(kind, mu):
     if mu == T(0.0):
         return T(math.inf)
     x = T(1.0) / mu
-    return T(0.5) * x * x / (T(1.0) + sqrt(T(1.0) + x * x))
+    # as shadowing.lambda_ggx: x^2 would overflow at grazing (float32 already at x ~ 2e19)
+    return T(0.5) * x * (x / (T(1.0) + math.hypot(T(1.0), x)))
 
 
 @njit(error_model="numpy")

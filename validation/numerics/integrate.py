@@ -31,10 +31,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from scatterbench.models import cubature
+from scatterbench.models.constraints import Integer
+from scatterbench.models.contributed import as_model
 from scatterbench.models.params import check_real
 from scatterbench.models.polarization import stokes
 
-__all__ = ["IntegralResult", "integrated_reflectance"]
+__all__ = ["IntegralResult", "integrated_reflectance", "MIN_EVALUATIONS"]
 
 
 @dataclass(frozen=True)
@@ -101,9 +103,13 @@ def integrated_reflectance(
         Incident polarization (Stokes vector or name); the integrand is the
         scattered intensity ``(M @ S)[0] / S[0]``.
     max_evaluations : int
-        Model evaluations after which refinement stops (``converged`` False): the regions are
-        capped at ``max_evaluations / (2 * 17)``, each region costing its 17 points and its
-        parent's before it.
+        Most model evaluations (geometries) the integral may spend, an integer >= 68
+        (:data:`MIN_EVALUATIONS`).  Each region costs 17 (the Genz-Malik points); the initial
+        partition's regions are spent first, then splits (two regions each), the worst first,
+        while the budget lasts.  ``evaluations`` never exceeds it; where the error estimate
+        has not met ``tol`` by then, ``converged`` is False.  A budget below the cost of the
+        initial partition (which resolves a declared lobe) integrates on the coarsest one, the
+        whole domain as 2 x 2 regions, and reports ``converged`` False.
     symmetric : bool, optional
         Integrate ``phi`` over ``[0, pi]`` and double, valid for models with a
         mirror plane at ``phi = 0``.  By default, True when the incident state
@@ -127,37 +133,62 @@ def integrated_reflectance(
     >>> round(float(r.value + (rs + rp) / 2), 6), r.converged
     (1.0, True)
     """
+    model = _check_model(model)
     # check_real: a bool is no tolerance (True would integrate to tol = 1)
     tol = check_real("tol", tol, 0.0, low_open=True)
+    # an integer count: -5, True and 1.5 are no budget
+    max_regions = _BUDGET.check("max_evaluations", max_evaluations) // cubature.GM_POINTS
     theta_i = _check_incidence(theta_i)
     s_in = np.asarray(stokes(incident), dtype=float)
     if symmetric is None:
         symmetric = bool(getattr(model, "mirror_symmetric", False)) and s_in[2] == 0 and s_in[3] == 0
     rects = _initial_rectangles(model.lobe(theta_i) if hasattr(model, "lobe") else None, symmetric, theta_i)
+    affordable = len(rects) * START**2 <= max_regions
+    if not affordable:  # the coarsest partition: the whole domain
+        rects = np.array([[rects[:, 0].min(), rects[:, 1].max(), rects[:, 2].min(), rects[:, 3].max()]])
     factor = 2.0 if symmetric else 1.0
     # the half-range integral is doubled, and so is its error
-    got = _one_row(_integrand(model, theta_i, s_in, rects), len(rects), tol / factor, max_evaluations)
+    got = _one_row(_integrand(model, theta_i, s_in, rects), len(rects), tol / factor, max_regions)
     return IntegralResult(
         value=factor * float(got.value[0, 0]),
         error=factor * float(got.error[0]),
         evaluations=int(cubature.GM_POINTS * got.evaluated[0]),
-        converged=not bool(got.capped[0]),
+        converged=affordable and not bool(got.capped[0]),
     )
 
 
-def _one_row(f, n_cells, goal, max_evaluations):
+#: each initial cell starts as START x START regions (cubature.adaptive's ``start``)
+START = 2
+#: the smallest budget: the coarsest partition, one cell of START x START regions
+MIN_EVALUATIONS = START**2 * cubature.GM_POINTS
+_BUDGET = Integer(MIN_EVALUATIONS, None)
+
+
+def _check_model(model):
+    """``model`` as the integrator calls it: a :class:`scatterbench.models.Model`, or any object
+    with ``mueller`` seen as one; otherwise the ``ValueError`` naming ``model``."""
+    if not callable(getattr(model, "mueller", None)):
+        raise ValueError(
+            f"model must be a scattering model (an object with mueller(theta_i, theta_r, phi_r)); "
+            f"got {type(model).__name__}"
+        )
+    return as_model(model)
+
+
+def _one_row(f, n_cells, goal, max_regions):
     """:func:`scatterbench.models.cubature.adaptive` (the one adaptive rectangle integrator, which
     :class:`scatterbench.models.PointSourceBRDF` also refines with) on one row of ``n_cells``
     cells: absolute error ``goal`` on the integral (the weight's own integral, the last, has no
-    budget), regions capped so that the evaluations (each region's, and its parent's before it)
-    stay within about ``max_evaluations``."""
+    budget), at most ``max_regions`` regions evaluated in all (each 17 points)."""
     return cubature.adaptive(
         f,
         np.zeros(n_cells, dtype=int),
         1,
         norm=lambda diff, total: diff[0],
         budget=lambda total: np.full(1, goal),
-        max_regions=max(1, int(max_evaluations) // (2 * cubature.GM_POINTS)),
+        max_regions=max_regions,
+        start=START,
+        max_evaluated=max_regions,
     )
 
 
