@@ -136,7 +136,8 @@ def _announced(fn):
     yet: the command line shows that the kernels compile once per machine."""
     if fn not in _READY:
         _READY.add(fn)
-        if not os.path.exists(fn._cache._cache_file._index_path):
+        cache = getattr(fn, "_cache", None)  # None: a Python function (NUMBA_DISABLE_JIT=1)
+        if cache is not None and not os.path.exists(cache._cache_file._index_path):
             log.info(
                 "compiling the %s kernel loop (once per machine: cached in %s)",
                 fn.__name__,

@@ -92,8 +92,9 @@ assert [KERNELS[c] for c in CODES.values()] == [facet, btdf, single, diffuse, co
 
 
 def serial(code, ti, tr, pr, prm, o, out, start, lo, hi):
-    """:func:`_serial` for kernel ``code``, in compiled code only (see :func:`_serial_of`)."""
-    raise NotImplementedError("compiled code only")
+    """:func:`_serial` for kernel ``code``; compiled code picks the kernel while typing
+    (:func:`_serial_of`), Python (``NUMBA_DISABLE_JIT=1``) here."""
+    _serial(KERNELS[code], ti, tr, pr, prm, o, out, start, lo, hi)
 
 
 @overload(serial, prefer_literal=True)

@@ -150,9 +150,12 @@ def lane_options(code, iopt) -> tuple:
 
 def blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
     """Geometries ``lo .. hi - 1`` into ``out[:, start + i]``, a block at a time, through
-    kernel ``code`` with options ``(k0, k1, k2)`` (:func:`lane_options`), all constants; in
-    compiled code only (see :func:`scatterbench.models.kernels.drive.serial`)."""
-    raise NotImplementedError("compiled code only")
+    kernel ``code`` with options ``(k0, k1, k2)`` (:func:`lane_options`), all constants;
+    compiled code builds the loop while typing (:func:`_blocks_of`), Python
+    (``NUMBA_DISABLE_JIT=1``) runs the same here."""
+    _blocks_of(types.literal(code), types.literal(k0), types.literal(k1), types.literal(k2), *[None] * 8)(
+        code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi
+    )
 
 
 @overload(blocks, prefer_literal=True)
