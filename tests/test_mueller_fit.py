@@ -419,3 +419,18 @@ def test_fused_kernel_equals_the_numpy_reference(nist, one_thread):
         a, r = lik.pointwise_batch(U), lik.pointwise_reference(U)
         assert np.all(np.isfinite(a))
         np.testing.assert_allclose(a, r, rtol=1e-11)
+
+
+def test_a_scene_with_films_fits_its_own_wavelength_only(nist):
+    """Films are built at the scene's wavelength: fitting such a scene to other wavelengths
+    would use the wrong film phases, so it is refused, naming the table and the remedy."""
+    text = SCENE.replace("{extra}", "").replace(
+        "[volume]", "[coating.film]\nlayers = [{index = 1.25, thickness_nm = 100.0}]\n\n[volume]"
+    )
+    sc = scene_mod.loads(text, "<films>")
+    d = _subset(nist, (532.0, 633.0), step=50)
+    with pytest.raises(FitSpecError, match=r"\[coating.film\].*wavelengths_nm = \[532.0\]"):
+        MuellerLikelihood(sc, mueller_spec_from(sc, d.wavelength_nm), d)
+    only = scene_mod.loads(text.replace("[fit.mueller]", "[fit.mueller]\nwavelengths_nm = [532]"), "<films>")
+    lik = MuellerLikelihood(only, mueller_spec_from(only, d.wavelength_nm), d)
+    assert set(lik.data.wavelength_nm) == {532.0}

@@ -84,6 +84,7 @@ class MuellerLikelihood:
         self.data_all = data
         self.mask = np.isin(data.wavelength_nm, spec.wavelengths)
         self.data = data.subset(self.mask)
+        _check_films(scene, spec)
         self.base_scene = _fixed_materials(scene, spec)
         self.scene = _SceneView(self.base_scene, spec)
         self.elements = spec.elements
@@ -335,6 +336,20 @@ def _material_rows(spec, rows):
             else:
                 out[key] = vals.real[None, :]
     return out
+
+
+def _check_films(scene, spec):
+    """Thin films are built at the scene's wavelength: a scene with films fits its own only."""
+    raw = scene.raw
+    films = [
+        f"[{t}.film]" for t in ("coating", "substrate") if isinstance(raw.get(t), dict) and "film" in raw[t]
+    ]
+    wl = scene.wavelength_nm
+    if films and (len(spec.wavelengths) > 1 or wl is None or abs(spec.wavelengths[0] - wl) > 1e-9 * wl):
+        raise FitSpecError(
+            f"{scene.path}: {films[0]} is built at [illumination] wavelength_nm = {wl}; the fit's data are at "
+            f"{', '.join(f'{w:g}' for w in spec.wavelengths)} nm: give [fit.mueller] wavelengths_nm = [{wl}]"
+        )
 
 
 def _fixed_materials(scene, spec):
