@@ -171,25 +171,29 @@ class Model(Declared, ModelFacts):
         (:mod:`scatterbench.models.float32_domain`); otherwise, as for a model without a kernel, the
         float64 evaluation rounded to float32 (:attr:`float32_fallback` says why).
         """
+        angles = (theta_i, theta_r, phi_r)
         fast = evaluation.small(self, theta_i, theta_r, phi_r, 16, precision, out)
-        if fast is not None:
-            return fast
-        shape, out = evaluation.evaluate(self, theta_i, theta_r, phi_r, 16, precision, out)
-        return evaluation.as_matrices(out, shape)
+        if fast is None:
+            shape, out = evaluation.evaluate(self, theta_i, theta_r, phi_r, 16, precision, out)
+            fast = evaluation.as_matrices(out, shape)
+        return evaluation.finite32(self, fast, angles, 16, precision)
 
     def mueller16(self, theta_i, theta_r, phi_r=0.0, out=None, precision="float64"):
         """``(shape, M)``: the Mueller BRDF as its element-major storage ``M`` ``(16, N)``
         (row ``4 a + b`` is element ``ab``) and the broadcast ``shape`` of the geometries
         (``N`` their number); :meth:`mueller` returns a ``shape + (4, 4)`` view of it."""
-        return evaluation.evaluate(self, theta_i, theta_r, phi_r, 16, precision, out)
+        shape, m = evaluation.evaluate(self, theta_i, theta_r, phi_r, 16, precision, out)
+        # the storage (16, N): rows of elements, refused or made finite as a whole
+        evaluation.finite32(self, evaluation.as_matrices(m, shape), (theta_i, theta_r, phi_r), 16, precision)
+        return shape, m
 
     def brdf(self, theta_i, theta_r, phi_r=0.0, precision="float64"):
         """Unpolarized-in, total-out BRDF ``M00`` (1/sr); ``precision`` as for :meth:`mueller`."""
         fast = evaluation.small(self, theta_i, theta_r, phi_r, 1, precision)
-        if fast is not None:
-            return fast
-        shape, out = evaluation.evaluate(self, theta_i, theta_r, phi_r, 1, precision)
-        return out.reshape(shape)
+        if fast is None:
+            shape, out = evaluation.evaluate(self, theta_i, theta_r, phi_r, 1, precision)
+            fast = out.reshape(shape)
+        return evaluation.finite32(self, fast, (theta_i, theta_r, phi_r), 1, precision)
 
     @property
     def float32_fallback(self) -> str | None:

@@ -119,11 +119,11 @@ class Conformant(Model, registry=False):
         return bool(getattr(self.model, "mirror_symmetric", False))
 
     def _mueller16(self, ti, tr, pr):
-        M = np.asarray(self.model.mueller(ti, tr, pr), dtype=float)
+        M = np.asarray(self.model.mueller(*_readonly(ti, tr, pr)), dtype=float)
         return M.reshape(len(ti), 16).T
 
     def _jones_flat(self, ti, tr, pr):
-        return np.asarray(self.model.jones(ti, tr, pr), dtype=complex).reshape(len(ti), 2, 2)
+        return np.asarray(self.model.jones(*_readonly(ti, tr, pr)), dtype=complex).reshape(len(ti), 2, 2)
 
     def rotated(self, angle):
         rot = getattr(self.model, "rotated", None)
@@ -135,6 +135,17 @@ class Conformant(Model, registry=False):
 
     def __repr__(self):
         return repr(self.model)
+
+
+def _readonly(*arrays):
+    """Read-only copies of the angles handed to a wrapped model: one that writes into its
+    inputs raises there, and cannot change the caller's arrays (the kit's grids, a chunk)."""
+    out = []
+    for a in arrays:
+        a = np.array(a, copy=True)
+        a.flags.writeable = False
+        out.append(a)
+    return out
 
 
 def as_model(obj):

@@ -55,6 +55,8 @@ __all__ = [
     "small_angles",
     "as_matrices",
     "float32_guarded",
+    "finite32",
+    "check_out",
     "raw_float32",
     "kernel_precision",
 ]
@@ -414,7 +416,32 @@ def small(model, theta_i, theta_r, phi_r, rows, precision, out=None):
     if out is not None:
         return None
     fast = kernel.fast(theta_i, theta_r, phi_r, rows, "float64")  # the float32 fallback
-    return None if fast is None else fast.astype(np.float32)
+    with np.errstate(over="ignore"):  # beyond float32: finite32 refuses it, naming precision
+        return None if fast is None else fast.astype(np.float32)
+
+
+#: the largest float32
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def finite32(model, values, angles, rows, precision):
+    """A float32 result made finite or refused, the one rule for every float32 route: where
+    ``values`` (the result, a view of its storage) holds inf or NaN, the call is evaluated
+    again in float64; if that fits float32's range (3.4e38) it is rounded into ``values``
+    (the float32 kernel overflowed where float64 did not), else a ``ValueError`` naming
+    ``precision`` says the result is beyond float32 (a lobe of width 1e-8 at grazing reaches
+    1e47) rather than returning inf."""
+    if precision != "float32" or np.isfinite(values).all():
+        return values
+    shape, m64 = evaluate(model, *angles, rows, "float64")
+    peak = float(np.max(np.abs(m64))) if m64.size else 0.0
+    if not np.isfinite(m64).all() or peak > FLOAT32_MAX:
+        raise ValueError(
+            f"precision must be 'float64' for this call: the result reaches {peak:.3g}, beyond "
+            f"float32's range (<= {FLOAT32_MAX:.3g}); precision='float32' would give inf"
+        )
+    values[...] = (as_matrices(m64, shape) if rows == 16 else m64.reshape(shape)).reshape(values.shape)
+    return values
 
 
 def check_out(out):
@@ -461,7 +488,8 @@ def fill(p, out, rows, precision):
         if kernel:
             m._kernel.write(out, sl, ti, tr, pr, runs)
         else:
-            out[:, sl] = flat(m, ti, tr, pr, rows)
+            with np.errstate(over="ignore"):  # rounding to float32: finite32 judges the result
+                out[:, sl] = flat(m, ti, tr, pr, rows)
 
 
 def blocks(model, theta_i, theta_r, phi_r):

@@ -111,8 +111,14 @@ _AUTO_MIN, _AUTO_MAX = 16, 4096
 #: ``resolution="auto"``: the regions per geometry at which refinement stops (each region a
 #: 17-point rule: at most ~70,000 inner-model evaluations per geometry)
 MAX_REGIONS = 4096
+#: a fixed resolution's node arrays per chunk of geometries (bytes; PointSourceBRDF._superpose)
+NODE_BYTES = 256 * 2**20
+#: float64 arrays of one geometry's nodes alive at once (source_nodes: X, rho, psi, Phi, cos, w;
+#: the shift's angles and masks)
+NODE_ARRAYS = 8
 #: ``tol``: below ~1e-13 the rounding of the sums dominates; above 0.1 it is no statement
 _TOL_MIN, _TOL_MAX = 1e-13, 0.1
+_TOL_DEFAULT = 1e-4
 
 
 @dataclass(frozen=True)
@@ -166,7 +172,7 @@ class PointSourceBRDF(_Wrapper):
     # Not swept (edges=()): at 1e-13 every geometry refines to MAX_REGIONS (~70,000 inner
     # evaluations); tests/test_point_source_accuracy.py holds the estimates to tol instead.
     tol: float = param(
-        1e-4,
+        _TOL_DEFAULT,
         "accuracy of resolution='auto', relative to max(M00, M00 at the lobe centre)",
         Interval(_TOL_MIN, _TOL_MAX),
         edges=(),
@@ -177,6 +183,16 @@ class PointSourceBRDF(_Wrapper):
     #: ``tol``, hundreds to thousands of evaluations; the kit checks the wrapper's shapes and
     #: physics, not its quadrature)
     kit_variant = MappingProxyType({"resolution": 4})
+
+    def _validate(self):
+        super()._validate()
+        if self.resolution != "auto" and self.tol != _TOL_DEFAULT:
+            # a fixed resolution is unrefined: a tol beside it would be silently ignored
+            raise ValueError(
+                f"tol applies to resolution='auto' only (refined until every element is within tol); "
+                f"resolution={self.resolution} is a fixed, unestimated rule: give tol with "
+                f"resolution='auto', or a fixed resolution without tol; got tol={self.tol:g}"
+            )
 
     @classmethod
     def sweep_base(cls):
@@ -370,7 +386,25 @@ class PointSourceBRDF(_Wrapper):
         return out.reshape(16, m, P)
 
     def _superpose(self, ti, tr, pr, resolution):
-        """Eq. 28 (or the shift approximation) at ``resolution`` radial nodes: ``(16, n)``."""
+        """Eq. 28 (or the shift approximation) at ``resolution`` radial nodes: ``(16, n)``,
+        in chunks of geometries whose node arrays (``psi``, ``Phi``, ``w`` and the temporaries
+        of :meth:`source_nodes` and the shift, :data:`NODE_ARRAYS` arrays of ``2 resolution^2``
+        float64 per geometry) stay within :data:`NODE_BYTES`: unchunked they grew as geometries
+        x 2 resolution^2 (8 geometries at resolution 2048 needed more than 3 GB).  A geometry's
+        value does not depend on the others in its chunk, so the chunks give the same numbers.
+        One geometry's arrays are the floor: 200 MB at resolution 2048, 800 MB at 4096."""
+        per = NODE_ARRAYS * 8 * 2 * resolution * resolution
+        step = max(1, NODE_BYTES // per)
+        if ti.size <= step:
+            return self._superpose_chunk(ti, tr, pr, resolution)
+        out = np.empty((16, ti.size))
+        for a in range(0, ti.size, step):
+            sl = slice(a, a + step)
+            out[:, sl] = self._superpose_chunk(ti[sl], tr[sl], pr[sl], resolution)
+        return out
+
+    def _superpose_chunk(self, ti, tr, pr, resolution):
+        """:meth:`_superpose` of one chunk of geometries."""
         out = np.zeros((16, ti.size))
         psi, Phi, w = self.source_nodes(ti, resolution)
         if self.method == "shift":

@@ -151,6 +151,19 @@ def _mutable(x):
     return x if x.flags.writeable else x.copy()
 
 
+def azimuth_as(pr, dtype):
+    """Azimuths as ``dtype``: for float32, any beyond [-pi, pi] reduced there in float64 first
+    (``atan2(sin, cos)``, whose argument reduction is exact), since a finite float64 azimuth
+    such as 1e300 rounds to inf in float32 and its cosine is NaN, and a large one keeps none of
+    its phase."""
+    if dtype == np.float64:
+        return pr.astype(dtype, copy=False)
+    far = np.abs(pr) > math.pi
+    if far.any():
+        pr = np.where(far, np.arctan2(np.sin(pr), np.cos(pr)), pr)
+    return pr.astype(dtype)
+
+
 class Compiled:
     """A model's kernel: its code, parameter rows and options, and the calls into it.
 
@@ -227,13 +240,14 @@ class Compiled:
         C-contiguous ndarray of that dtype, otherwise (a memmap; a float32 ``out`` filled by
         the float64 fallback) through a chunk-sized buffer."""
         dtype = np.dtype(precision)
-        a, b, c = (x.astype(dtype, copy=False) for x in (ti, tr, pr))
+        a, b, c = ti.astype(dtype, copy=False), tr.astype(dtype, copy=False), azimuth_as(pr, dtype)
         if type(out) is np.ndarray and out.flags.c_contiguous and out.dtype == dtype:
             self.call(a, b, c, out, sl.start, precision)
         else:
             buf = np.empty((out.shape[0], sl.stop - sl.start), dtype=dtype)
             self.call(a, b, c, buf, 0, precision)
-            out[:, sl] = buf
+            with np.errstate(over="ignore"):  # rounding to float32: finite32 judges the result
+                out[:, sl] = buf
 
     def fast(self, theta_i, theta_r, phi_r, rows, precision="float64", out=None):
         """The small-call path: up to :data:`scatterbench.models.evaluation.KERNEL_CHUNK` geometries given
@@ -265,7 +279,7 @@ class Compiled:
         else:
             if not drive.angles_ok(ti, tr, pr):
                 return None
-            self.call(ti.astype(dtype), tr.astype(dtype), pr.astype(dtype), out, 0, precision)
+            self.call(ti.astype(dtype), tr.astype(dtype), azimuth_as(pr, dtype), out, 0, precision)
         return out.reshape(shape) if rows == 1 else evaluation.as_matrices(out, shape)
 
     def _one(self, theta_i, theta_r, phi_r, rows):

@@ -52,6 +52,9 @@ __all__ = [
     "Conformant",
     "as_model",
     "evaluate",
+    "readonly",
+    "mueller_of",
+    "jones_of",
     "where",
     "claims",
     "accepted_reason",
@@ -78,7 +81,8 @@ ATTRIBUTES = {
     "rotated": "rotated(angle) -> the model of the sample rotated about z, for anisotropic "
     "samples (without it the model is taken to be azimuthally isotropic)",
     "lobe": "lobe(theta_i) -> (theta, phi, width) of a narrow lobe, a hint for the integrator",
-    "mirror_symmetric": "True when M00 is even in phi_r (the integrator then halves its domain)",
+    "mirror_symmetric": "True when M00 is even in phi_r: verified on the grid (check mirror symmetry); "
+    "the energy integral halves its domain only where the claim holds there",
 }
 
 
@@ -212,7 +216,10 @@ def _run_one(spec, model, ctx):
     except Exception as exc:  # noqa: BLE001 - a model that raises fails the check that called it
         tb = traceback.format_exc(limit=-1).strip().splitlines()
         where_ = tb[-3].strip() if len(tb) >= 3 else ""
-        return [verdict(spec.name, math.nan, 0.0, f"raised {type(exc).__name__}: {exc} [{where_}]")]
+        what = f"raised {type(exc).__name__}: {exc} [{where_}]"
+        if isinstance(exc, ValueError) and "read-only" in str(exc):
+            what = "the model writes into its input arrays (the kit hands it read-only copies); " + what
+        return [verdict(spec.name, math.nan, 0.0, what)]
     out = out if isinstance(out, list) else [out]
     if not out or not all(isinstance(r, ModelCheck) for r in out):
         return [verdict(spec.name, math.nan, 0.0, "the check returned no ModelCheck")]
@@ -225,12 +232,35 @@ def claims(model, attribute, default):
     return getattr(model, attribute, default)
 
 
+def readonly(*arrays):
+    """Fresh read-only copies of the geometry inputs handed to a model: a model that writes
+    into its inputs cannot corrupt the kit's grids for the checks after it (it fails the check
+    that called it instead, naming what it did: :func:`run_model_checks`)."""
+    out = []
+    for a in arrays:
+        if isinstance(a, np.ndarray):  # numbers are immutable: passed as they are
+            a = np.array(a, copy=True)
+            a.flags.writeable = False
+        out.append(a)
+    return out
+
+
+def mueller_of(model, *angles, **kw):
+    """``model.mueller(*angles, **kw)`` with read-only copies of the angles (:func:`readonly`)."""
+    return model.mueller(*readonly(*angles), **kw)
+
+
+def jones_of(model, *angles):
+    """``model.jones(*angles)`` with read-only copies of the angles (:func:`readonly`)."""
+    return model.jones(*readonly(*angles))
+
+
 def evaluate(model, ti, tr, pr, **kw):
-    """``(M, warned)``: ``model.mueller(ti, tr, pr, **kw)`` as an array and the number of
-    floating-point warnings it raised (gradual underflow, the correct IEEE result for far
-    tails, not counted)."""
+    """``(M, warned)``: ``model.mueller(ti, tr, pr, **kw)`` (read-only copies of the angles) as
+    an array and the number of floating-point warnings it raised (gradual underflow, the
+    correct IEEE result for far tails, not counted)."""
     with fp_warnings() as caught:
-        M = np.asarray(model.mueller(ti, tr, pr, **kw))
+        M = np.asarray(mueller_of(model, ti, tr, pr, **kw))
     return M, len(caught)
 
 

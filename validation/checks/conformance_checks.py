@@ -40,7 +40,9 @@ from .conformance import (
     claims,
     evaluate,
     finding_of,
+    jones_of,
     model_check,
+    mueller_of,
     skipped,
     verdict,
     where,
@@ -57,6 +59,7 @@ __all__ = [
     "ENERGY_BUDGET",
     "ENERGY_LADDER_DEG",
     "QUICK_LADDER_DEG",
+    "mirror_verified",
 ]
 
 #: relative to M00: the same geometry evaluated in another batch, shape or dtype (vectorized
@@ -130,7 +133,7 @@ def _repeatable(model, ctx):
 
     def compute():
         ti, tr, pr = random_geometries(16, seed=12)
-        a, b = (np.asarray(model.mueller(ti, tr, pr)) for _ in range(2))
+        a, b = (np.asarray(mueller_of(model, ti, tr, pr)) for _ in range(2))
         return bool(np.array_equal(a, b, equal_nan=True))
 
     return _memo(ctx, "repeatable", model, compute)
@@ -147,7 +150,7 @@ def _judge_forms(check, model, ctx, forms, tol, what):
     worst, at, label = 0.0, "", ""
     for name, args, ref, geometry in forms:
         try:
-            M = np.asarray(model.mueller(*args))
+            M = np.asarray(mueller_of(model, *args))
         except Exception as exc:  # noqa: BLE001 - a call form the model cannot take fails this check
             return verdict(check, math.inf, tol, f"{name} {_shapes(args)} raised {type(exc).__name__}: {exc}")
         if M.shape != ref.shape:
@@ -170,7 +173,7 @@ def _reference(model):
     failure of the first scalar call that does not give a (4, 4) result."""
     R = np.empty((3, 4, 2, 4, 4))
     for i, j, k in np.ndindex(3, 4, 2):
-        M = np.asarray(model.mueller(_TI[i], _TR[j], _PR[k]))
+        M = np.asarray(mueller_of(model, _TI[i], _TR[j], _PR[k]))
         if M.shape != (4, 4):
             at = where(_TI[i], _TR[j], _PR[k])
             return verdict(
@@ -224,7 +227,7 @@ def check_dtypes(model, ctx):
     forms = []
     for name, args in (("float32 arrays", f32), ("Python ints", (0, 1, 2)), ("int64 arrays", ints)):
         as64 = tuple(np.asarray(a, dtype=float) for a in args)
-        forms.append((name, args, np.asarray(model.mueller(*as64)), as64))
+        forms.append((name, args, np.asarray(mueller_of(model, *as64)), as64))
     return _judge_forms("dtypes", model, ctx, forms, DTYPE_TOL, "max |M(x) - M(float64(x))| / M00")
 
 
@@ -244,18 +247,18 @@ def check_out_argument(model, ctx):
         return skipped("out argument", "mueller() takes no out= argument")
     ti, tr, pr = random_geometries(37, seed=8)
     try:
-        model.mueller(ti, tr, pr, out=np.empty((16, ti.size + 1)))
+        mueller_of(model, ti, tr, pr, out=np.empty((16, ti.size + 1)))
     except ValueError:
         pass
     else:
         why = "an out of shape (16, N + 1) was accepted (ValueError expected)"
         return verdict("out argument", math.inf, BROADCAST_TOL, why)
     buf = np.full((16, ti.size), np.nan)
-    M = np.asarray(model.mueller(ti, tr, pr, out=buf))
+    M = np.asarray(mueller_of(model, ti, tr, pr, out=buf))
     if not _repeatable(model, ctx):
         why = "values not compared: the model does not repeat its own numbers (see determinism)"
         return skipped("out argument", why)
-    ref = np.asarray(model.mueller(ti, tr, pr))
+    ref = np.asarray(mueller_of(model, ti, tr, pr))
     written = np.moveaxis(buf.reshape(4, 4, -1), -1, 0)
     e, k = _worst(np.maximum(_relative(M, ref), _relative(written, ref)))
     detail = "max |M(out=) - M| / M00 over the result and the buffer"
@@ -274,7 +277,7 @@ def _grid(model, ctx):
             raise ValueError(f"mueller gave shape {M.shape} for {ti.size} geometries, not ({ti.size}, 4, 4)")
         J = None
         if callable(getattr(model, "jones", None)) and not claims(model, "depolarizing", False):
-            J = np.asarray(model.jones(ti, tr, pr))
+            J = np.asarray(jones_of(model, ti, tr, pr))
         return ti, tr, pr, M.reshape(-1, 4, 4), J, warned
 
     return _memo(ctx, "grid", model, compute)
@@ -324,6 +327,48 @@ def check_realizable(model, ctx):
         where=where(*(a[live] for a in (ti, tr, pr)), k),
         op=">=",
     )
+
+
+def _mirror_errors(model, ctx):
+    """``(errors, ti, tr, pr)``: per grid geometry ``|M00(phi) - M00(-phi)| / max`` of the two
+    (0 where both vanish), once per context."""
+
+    def compute():
+        ti, tr, pr, M, _, _ = _grid(model, ctx)
+        R, _ = evaluate(model, ti, tr, -pr)
+        a, b = M[:, 0, 0], np.asarray(R).reshape(-1, 4, 4)[:, 0, 0]
+        scale = np.maximum(np.abs(a), np.abs(b))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            e = np.where(a == b, 0.0, np.abs(a - b) / np.where(scale > 0, scale, 1.0))
+        return e, ti, tr, pr
+
+    return _memo(ctx, "mirror", model, compute)
+
+
+def mirror_verified(model, ctx) -> bool:
+    """True when the model claims ``mirror_symmetric`` and the claim holds on the grid (to
+    :data:`RECIPROCITY_TOL`): only then may an integral halve its azimuth range.  A claim is
+    not trusted: a model that claims it and is brighter at negative azimuths would otherwise
+    have half its light (and any energy it creates) integrated away."""
+    if not claims(model, "mirror_symmetric", False) or _stochastic(model):
+        return False
+    e = _mirror_errors(model, ctx)[0]
+    return bool(np.all(np.isfinite(e)) and e.max() <= RECIPROCITY_TOL)
+
+
+@model_check(
+    tests="a claim of mirror symmetry (mirror_symmetric = True: M00 even in phi_r, which lets the "
+    "integrator halve its domain) holds on the grid: |M00(phi) - M00(-phi)| / M00 <= 1e-9"
+)
+def check_mirror_symmetry(model, ctx):
+    if not claims(model, "mirror_symmetric", False):
+        return skipped("mirror symmetry", "the model does not claim mirror symmetry (mirror_symmetric)")
+    if _stochastic(model):
+        return skipped("mirror symmetry", "stochastic: its noise differs between phi and -phi")
+    e, ti, tr, pr = _mirror_errors(model, ctx)
+    v, k = _worst(e)
+    detail = "max |M00(phi) - M00(-phi)| / M00 on the grid (the model claims mirror_symmetric)"
+    return verdict("mirror symmetry", v, RECIPROCITY_TOL, detail, where=where(ti, tr, pr, k))
 
 
 def _reciprocity_errors(model, ctx):
@@ -408,12 +453,23 @@ def _energy_reason(model, ti, r, bound):
 
 
 def _energy_ladder(model, ctx):
-
     view = as_model(model)
+    half = mirror_verified(model, ctx)  # a claim of mirror symmetry only where it holds
     out = []
     for ti in energy_incidences(ctx):
-        out.append((ti, integrated_reflectance(view, ti, tol=ENERGY_TOL, max_evaluations=ENERGY_BUDGET)))
+        r = integrated_reflectance(view, ti, tol=ENERGY_TOL, max_evaluations=ENERGY_BUDGET, symmetric=half)
+        out.append((ti, r))
     return out
+
+
+def _declared_excess(bound):
+    """The finding of a reflectance above 1 within a declared ``energy_bound`` above 1: the
+    model says it is not energy-conserving, so it does not pass (it creates light), and fails
+    only above what it declared."""
+    return Finding(
+        fails=False,
+        fails_if=f"the integrated reflectance exceeds the declared energy_bound {bound:g}",
+    )
 
 
 @model_check(
@@ -441,6 +497,10 @@ def check_energy(model, ctx):
     lower = [r.value - r.error for _, r in ladder]
     k = int(np.argmax(lower))
     at = f"theta_i={math.degrees(ladder[k][0]):.6g} deg"
+    if bound > 1.0 and 1.0 < lower[k] <= bound:
+        # a declared bound above 1 is not trusted as a pass: above 1 the model creates light
+        detail += "; above 1 (energy conservation) within the declared bound: a finding, not a pass"
+        return verdict("energy", lower[k], 1.0, detail, where=at, finding=_declared_excess(bound))
     reasons = {ti: _energy_reason(model, ti, r, bound) for ti, r in ladder if r.value - r.error > bound}
     if reasons and all(reasons.values()):
         reason, condition = reasons[ladder[k][0]]  # the worst incidence's
@@ -452,10 +512,10 @@ def check_energy(model, ctx):
 # --------------------------------------------------------------------------- determinism, pickle
 def _same(model, others, ti, tr, pr):
     """``(worst, k)``: the largest relative difference of ``others``' numbers from the model's."""
-    ref = np.asarray(model.mueller(ti, tr, pr))
+    ref = np.asarray(mueller_of(model, ti, tr, pr))
     e = np.zeros(ti.size)
     for m in others:
-        e = np.maximum(e, _relative(np.asarray(m.mueller(ti, tr, pr)), ref))
+        e = np.maximum(e, _relative(np.asarray(mueller_of(m, ti, tr, pr)), ref))
     return _worst(e)
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from scatterbench import references
 from scatterbench.validation.numerics.probes import random_geometries
 
-from .conformance import claims, model_check, skipped, verdict, where
+from .conformance import claims, model_check, mueller_of, skipped, verdict, where
 
 __all__ = [
     "SCATMECH_TOL",
@@ -227,7 +227,7 @@ def check_scatmech(model, ctx):
         why = f"pySCATMECH is not installed and no committed reference values were made with {decl[0]} {decl[1]}"
         return skipped("scatmech", why)
     ti, tr, pr, R = data
-    M = np.asarray(model.mueller(ti, tr, pr)).reshape(-1, 4, 4)
+    M = np.asarray(mueller_of(model, ti, tr, pr)).reshape(-1, 4, 4)
     e = np.max(np.abs(M - R), axis=(-1, -2)) / np.maximum(R[:, 0, 0], SCATMECH_FLOOR)
     e = np.where(np.isfinite(e), e, math.inf)
     k = int(np.argmax(e))
