@@ -41,6 +41,7 @@ from .fit import (
     _spec_args,
     locked_out,
 )
+from .study_ptfe import register_ptfe
 
 __all__ = ["register"]
 
@@ -318,3 +319,5 @@ def register(sub):
     _mcmc_args(c)
     _executor_args(c)
     c.set_defaults(func=_cmd_compare)
+
+    register_ptfe(ss)
