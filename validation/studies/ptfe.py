@@ -11,6 +11,7 @@ geometry.  ArviZ is imported inside the functions that need it (its import takes
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
@@ -84,7 +85,7 @@ class StudySettings:
         return ChainSettings(
             walkers=self.walkers,  # raised to 2 x free parameters per model by fit_model
             max_steps=self.steps,
-            check_every=max(10, self.steps // 4),
+            check_every=self.steps,  # short chains: one autocorrelation estimate, at the end
             starts=1,
             seed=self.seed + seed_offset,
         )
@@ -107,7 +108,11 @@ def fit_model(name, data, chain: ChainSettings, scene=None):
     need = 2 * len(lik.spec.free)  # emcee's ensemble needs >= 2 walkers per dimension
     if chain.walkers < need:
         chain = replace(chain, walkers=need)
-    return run_fit(lik, chain)
+    with warnings.catch_warnings():
+        # a walker that never moved in a short chain makes emcee's autocorrelation divide 0 by 0;
+        # its tau is then NaN, which the burn-in rule handles (half the chain kept)
+        warnings.filterwarnings("ignore", "invalid value encountered in divide", RuntimeWarning)
+        return run_fit(lik, chain)
 
 
 def _kept(fit):
@@ -137,8 +142,6 @@ def inference_data(fit, loglik):
 def compare_models(idatas: dict) -> dict:
     """PSIS-LOO (with Pareto-k counts) and WAIC per model and ArviZ's LOO comparison
     (``elpd_diff`` and its standard error ``dse`` against the best)."""
-    import warnings
-
     import arviz as az
 
     out = {}
