@@ -140,3 +140,24 @@ def test_study_cli_refuses_bad_input(tmp_path, capsys):
     assert "nosuch" in capsys.readouterr().err
     assert main(["study", "ptfe", "--out", out, "--walkers", "7"]) == 2
     assert "walkers" in capsys.readouterr().err
+
+
+def test_report_section_renders_its_computed_numbers(monkeypatch):
+    """The report's section in --quick (here on two models and one held-out incidence, to stay
+    fast): its tables hold the study's numbers and its verdict names the computed winner."""
+    from scatterbench.validation.report.core import Context, Section
+    from scatterbench.validation.report.sections import ptfe as section
+
+    quick = dict(
+        ptfe.QUICK, models=("lambertian", "maxwell_beard"), cv_incidences=(0.0,), steps=20, row_step=96
+    )
+    monkeypatch.setattr(ptfe, "QUICK", quick)
+    d = section.compute(Context(quick=True))
+    s = Section("ptfe", "t")
+    section.render(s, d)
+    rows = s.numbers["ptfe_comparison"]
+    assert [r["model"] for r in rows] == d.verdict["ranking"]
+    assert rows[0]["elpd_diff"] == 0.0 and rows[1]["elpd_diff"] > 0
+    assert rows[0]["elpd_loo"] > rows[1]["elpd_loo"]
+    assert s.numbers["ptfe_verdict"]["winner"] == rows[0]["model"]
+    assert {b["type"] for b in s.blocks} == {"text", "table", "figure"}

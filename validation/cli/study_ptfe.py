@@ -17,20 +17,11 @@ from scatterbench.validation.studies.ptfe_figures import incidence_figure, incid
 from .args import UsageError, int_at_least
 from .fit import _check_out, locked_out
 
-__all__ = ["register_ptfe", "QUICK"]
-
-#: --quick: three models (the fast ones), every 48th row, short chains, two held-out incidences
-QUICK = {
-    "row_step": 48,
-    "steps": 30,
-    "models": ("lambertian", "maxwell_beard", "smooth_diffuse"),
-    "cv_incidences": (0.0, 45.0),
-    "draws": 60,
-}
+__all__ = ["register_ptfe", "format_results"]
 
 
 def settings_from(args) -> ptfe.StudySettings:
-    kw = dict(QUICK) if args.quick else {}
+    kw = dict(ptfe.QUICK) if args.quick else {}
     for key, val in (("row_step", args.row_step), ("steps", args.steps), ("walkers", args.walkers)):
         if val is not None:
             kw[key] = val

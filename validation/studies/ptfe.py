@@ -31,6 +31,8 @@ from scatterbench.validation.fitting.settings import ChainSettings
 __all__ = [
     "MODELS",
     "PHYSICAL",
+    "QUICK",
+    "REPORT",
     "StudySettings",
     "select_rows",
     "fit_model",
@@ -53,6 +55,24 @@ MODELS = {
 }
 #: seed 003's physical models (its claim: they improve over Maxwell-Beard)
 PHYSICAL = ("smooth_diffuse", "rough_diffuse", "single_hg")
+
+#: ``--quick`` and the report's quick run: three models (the fast ones), every 48th row,
+#: short chains, two held-out incidences
+QUICK = {
+    "row_step": 48,
+    "steps": 30,
+    "models": ("lambertian", "maxwell_beard", "smooth_diffuse"),
+    "cv_incidences": (0.0, 45.0),
+    "draws": 60,
+}
+#: the report's full run: the four models whose likelihood is closed-form (rough_diffuse's
+#: Monte Carlo interface costs ~7 s per 16-walker step on this machine: run it with the CLI)
+REPORT = {
+    "row_step": 24,
+    "steps": 100,
+    "models": ("lambertian", "maxwell_beard", "smooth_diffuse", "single_hg"),
+    "cv_incidences": (0.0, 45.0, 75.0),
+}
 
 
 @dataclass(frozen=True)

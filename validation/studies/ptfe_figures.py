@@ -67,6 +67,7 @@ def incidence_figure(maps_at, incidence_deg, model_name, plt):
         fig.colorbar(rs, ax=axes[2, j], shrink=0.6)
         for i in range(3):
             axes[i, j].set_ylim(0, 90)
+            axes[i, j].set_yticklabels([])  # the radius (theta_r) labels crowd the small maps
             axes[i, j].tick_params(labelsize=5)
     fig.suptitle(f"PTFE, {model_name}: incidence {incidence_deg:g} deg (radius: theta_r deg; angle: phi_r)")
     return fig
