@@ -68,6 +68,10 @@ def test_true_model_wins_by_elpd_loo(fits):
     assert cmp[TRUE]["elpd_waic"] > cmp["lambertian"]["elpd_waic"]
     v = ptfe.verdict(cmp)
     assert v["winner"] == TRUE and v["loser"] == "lambertian"
+    assert (
+        v["pareto_k_above_0.7"][TRUE]
+        == cmp[TRUE]["pareto_k"]["bad (0.7-1]"] + cmp[TRUE]["pareto_k"]["very bad (>1)"]
+    )
     assert v["seed003_claim"] is not None if "maxwell_beard" in cmp else "seed003_claim" not in v
     # one observation per row: the log-likelihood has the rows as its last axis
     assert idatas[TRUE].log_likelihood["rows"].shape[-1] == len(fits[TRUE].lik.data)

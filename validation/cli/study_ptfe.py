@@ -105,6 +105,11 @@ def format_results(res) -> str:
         lines.append(
             f"margin over {v['runner_up']}: elpd_diff {v['margin']['elpd_diff']:.1f} +- {v['margin']['dse']:.1f} (dse)"
         )
+    bad = {m: n for m, n in v["pareto_k_above_0.7"].items() if n}
+    if bad:
+        lines.append(
+            "Pareto k > 0.7 (PSIS-LOO unreliable) at rows: " + ", ".join(f"{m} {n}" for m, n in bad.items())
+        )
     if "seed003_claim" in v:
         per = ", ".join(
             f"{m} {c['elpd_loo_minus_maxwell_beard']:+.1f}"

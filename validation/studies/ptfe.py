@@ -256,6 +256,11 @@ def verdict(comparison: dict) -> dict:
         "loser": order[-1],
         "runner_up": order[1] if len(order) > 1 else None,
     }
+    # rows whose PSIS estimate is unreliable (Pareto k > 0.7): their elpd_loo is suspect
+    out["pareto_k_above_0.7"] = {
+        m: comparison[m]["pareto_k"]["bad (0.7-1]"] + comparison[m]["pareto_k"]["very bad (>1)"]
+        for m in order
+    }
     if len(order) > 1:
         r = comparison[order[1]]
         out["margin"] = {"elpd_diff": r["elpd_diff"], "dse": r["dse"]}
