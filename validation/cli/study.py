@@ -1,4 +1,5 @@
-"""``scatterbench study recovery | inversion | compare``: uncertainty studies.
+"""``scatterbench study recovery | inversion | compare | ptfe``: uncertainty studies and the
+PTFE real-data study (:mod:`.study_ptfe`).
 
 * ``recovery``: injection-recovery coverage, bias and width versus noise level
   and number of geometries (:mod:`scatterbench.validation.fitting.recovery`).
@@ -41,6 +42,7 @@ from .fit import (
     _spec_args,
     locked_out,
 )
+from .study_ptfe import register_ptfe
 
 __all__ = ["register"]
 
@@ -264,7 +266,7 @@ def _compare(args) -> int:
 
 
 def register(sub):
-    p = sub.add_parser("study", help="uncertainty studies: recovery, inversion, compare")
+    p = sub.add_parser("study", help="studies: recovery, inversion, compare, ptfe (real data)")
     ss = p.add_subparsers(dest="study", required=True)
 
     r = ss.add_parser("recovery", help="injection-recovery coverage, bias and width")
@@ -318,3 +320,5 @@ def register(sub):
     _mcmc_args(c)
     _executor_args(c)
     c.set_defaults(func=_cmd_compare)
+
+    register_ptfe(ss)

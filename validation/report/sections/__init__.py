@@ -15,6 +15,7 @@ from . import (
     edge_findings,
     model_comparison,
     provenance,
+    ptfe,
     scatmech,
     scenes,
     seed000,
@@ -52,6 +53,7 @@ SECTIONS = (
     _spec(
         "model_comparison", "Model comparison: seed 003's combination against Maxwell-Beard", model_comparison
     ),
+    _spec("ptfe", "Real data: NIST's sintered PTFE, five models compared and cross-validated", ptfe),
     _spec("speed", "Speed and accuracy", speed),
     _spec("stability", "Stability sweep at the extremes", edge_findings),
     _spec("scenes", "Scenes and the mechanisms they build", scenes),

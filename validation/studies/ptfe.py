@@ -1,0 +1,329 @@
+"""The real-data study (issue 29 part 4): NIST's sintered PTFE, five models fitted, compared by
+PSIS-LOO and WAIC (ArviZ), checked by posterior predictive coverage and by leaving one incidence
+angle out.  Compute only: the figures are in :mod:`.ptfe_figures`, the CLI in
+:mod:`scatterbench.validation.cli.study`.
+
+One observation is one row (a geometry and wavelength): its log-likelihood is the sum over the
+fitted elements, because the elements of one measured matrix share their calibration and
+geometry.  ArviZ is imported inside the functions that need it (its import takes seconds).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from dataclasses import asdict, dataclass, replace
+
+import numpy as np
+
+from scatterbench.models import scene as scene_mod
+from scatterbench.references import scene_path
+from scatterbench.validation.fitting.fit import run_fit
+from scatterbench.validation.fitting.mueller_data import ELEMENTS
+from scatterbench.validation.fitting.mueller_fit import (
+    mueller_likelihood,
+    predictive_draws,
+    write_mueller_fit,
+)
+from scatterbench.validation.fitting.mueller_likelihood import Rows
+from scatterbench.validation.fitting.settings import ChainSettings
+
+__all__ = [
+    "MODELS",
+    "PHYSICAL",
+    "QUICK",
+    "REPORT",
+    "StudySettings",
+    "select_rows",
+    "fit_model",
+    "pointwise_loglik",
+    "inference_data",
+    "compare_models",
+    "heldout_coverage",
+    "leave_one_incidence_out",
+    "verdict",
+    "run_study",
+]
+
+#: the study's models: name -> shipped per-wavelength scene
+MODELS = {
+    "smooth_diffuse": "ptfe_smooth_diffuse_per_wavelength.toml",
+    "rough_diffuse": "ptfe_rough_diffuse_per_wavelength.toml",
+    "single_hg": "ptfe_single_hg_per_wavelength.toml",
+    "maxwell_beard": "ptfe_maxwell_beard_per_wavelength.toml",
+    "lambertian": "ptfe_lambertian_per_wavelength.toml",
+}
+#: seed 003's physical models (its claim: they improve over Maxwell-Beard)
+PHYSICAL = ("smooth_diffuse", "rough_diffuse", "single_hg")
+
+#: ``--quick`` and the report's quick run: three models (the fast ones), every 48th row,
+#: short chains, two held-out incidences
+QUICK = {
+    "row_step": 48,
+    "steps": 30,
+    "models": ("lambertian", "maxwell_beard", "smooth_diffuse"),
+    "cv_incidences": (0.0, 45.0),
+    "draws": 60,
+}
+#: the report's full run: the four models whose likelihood is closed-form (rough_diffuse's
+#: Monte Carlo interface costs ~7 s per 16-walker step on this machine: run it with the CLI)
+REPORT = {
+    "row_step": 24,
+    "steps": 100,
+    "models": ("lambertian", "maxwell_beard", "smooth_diffuse", "single_hg"),
+    "cv_incidences": (0.0, 45.0, 75.0),
+}
+
+
+@dataclass(frozen=True)
+class StudySettings:
+    """What the study fits: one wavelength, every ``row_step``-th of its rows (file order,
+    deterministic), ``walkers`` x ``steps`` emcee chains, seeded."""
+
+    wavelength_nm: float = 532.0
+    row_step: int = 24
+    walkers: int = 16
+    steps: int = 200
+    seed: int = 0
+    models: tuple = tuple(MODELS)
+    cv: bool = True
+    cv_incidences: tuple | None = None  # None: every incidence of the subset
+    draws: int = 200
+
+    def __post_init__(self):
+        if not (isinstance(self.row_step, int) and self.row_step >= 1):
+            raise ValueError(f"row_step: {self.row_step!r} is not an integer >= 1")
+        if not (isinstance(self.steps, int) and self.steps >= 10):
+            raise ValueError(f"steps: {self.steps!r} is not an integer >= 10")
+        if not (isinstance(self.walkers, int) and self.walkers >= 2 and self.walkers % 2 == 0):
+            raise ValueError(f"walkers: {self.walkers!r} is not an even integer >= 2")
+        unknown = [m for m in self.models if m not in MODELS]
+        if unknown or not self.models:
+            raise ValueError(f"models: {unknown or 'none'} not in {list(MODELS)}")
+
+    def chain(self, seed_offset=0) -> ChainSettings:
+        return ChainSettings(
+            walkers=self.walkers,  # raised to 2 x free parameters per model by fit_model
+            max_steps=self.steps,
+            check_every=self.steps,  # short chains: one autocorrelation estimate, at the end
+            starts=1,
+            seed=self.seed + seed_offset,
+        )
+
+
+def select_rows(data, wavelength_nm, row_step):
+    """Indices of ``data``'s rows at ``wavelength_nm``, every ``row_step``-th in file order;
+    ``ValueError`` when the wavelength is absent."""
+    at = np.flatnonzero(np.abs(data.wavelength_nm - wavelength_nm) <= 1e-6 * wavelength_nm)
+    if not len(at):
+        have = ", ".join(f"{w:g}" for w in np.unique(data.wavelength_nm))
+        raise ValueError(f"wavelength_nm: {wavelength_nm:g} is not in the data (it has {have} nm)")
+    return at[::row_step]
+
+
+def fit_model(name, data, chain: ChainSettings, scene=None):
+    """:func:`run_fit` of model ``name``'s shipped scene (or ``scene``) on ``data``."""
+    sc = scene if scene is not None else scene_mod.load(scene_path(MODELS[name]))
+    lik = mueller_likelihood(sc, data)
+    need = 2 * len(lik.spec.free)  # emcee's ensemble needs >= 2 walkers per dimension
+    if chain.walkers < need:
+        chain = replace(chain, walkers=need)
+    with warnings.catch_warnings():
+        # a walker that never moved in a short chain makes emcee's autocorrelation divide 0 by 0;
+        # its tau is then NaN, which the burn-in rule handles (half the chain kept)
+        warnings.filterwarnings("ignore", "invalid value encountered in divide", RuntimeWarning)
+        return run_fit(lik, chain)
+
+
+def _kept(fit):
+    """The kept chain ``(walkers, draws, k)``: burned and thinned as the fit's summary."""
+    burn, thin = fit.chain.burn_thin()
+    return np.swapaxes(fit.chain.chain[burn::thin], 0, 1)
+
+
+def pointwise_loglik(fit) -> np.ndarray:
+    """Per-row log-likelihood ``(walkers, draws, rows)`` at the kept samples (the prior
+    excluded: PSIS-LOO and WAIC need the likelihood alone)."""
+    U = _kept(fit)
+    W, D, k = U.shape
+    return fit.lik.pointwise_batch(U.reshape(-1, k)).reshape(W, D, -1)
+
+
+def inference_data(fit, loglik):
+    """An ArviZ InferenceData: the posterior in physical units (one chain per walker) and
+    the per-row log-likelihood as ``log_likelihood['rows']``."""
+    import arviz as az
+
+    U = _kept(fit)
+    post = {p.key: np.vectorize(p.from_u)(U[..., i]) for i, p in enumerate(fit.lik.spec.free)}
+    return az.from_dict(posterior=post, log_likelihood={"rows": loglik}, dims={"rows": ["row"]})
+
+
+def compare_models(idatas: dict) -> dict:
+    """PSIS-LOO (with Pareto-k counts) and WAIC per model and ArviZ's LOO comparison
+    (``elpd_diff`` and its standard error ``dse`` against the best)."""
+    import arviz as az
+
+    out = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the Pareto-k and WAIC warnings are reported as counts
+        for name, idata in idatas.items():
+            loo = az.loo(idata, pointwise=True)
+            waic = az.waic(idata)
+            k = np.asarray(loo.pareto_k)
+            out[name] = {
+                "elpd_loo": float(loo.elpd_loo),
+                "se_loo": float(loo.se),
+                "p_loo": float(loo.p_loo),
+                "elpd_waic": float(waic.elpd_waic),
+                "se_waic": float(waic.se),
+                "p_waic": float(waic.p_waic),
+                "pareto_k": {
+                    "good (<=0.7)": int(np.sum(k <= 0.7)),
+                    "bad (0.7-1]": int(np.sum((k > 0.7) & (k <= 1))),
+                    "very bad (>1)": int(np.sum(k > 1)),
+                    "max": float(np.max(k)),
+                },
+            }
+        table = az.compare(idatas, ic="loo")
+    for name, row in table.iterrows():
+        out[name].update(rank=int(row["rank"]), elpd_diff=float(row["elpd_diff"]), dse=float(row["dse"]))
+    return out
+
+
+def heldout_coverage(fit, held, draws=200, seed=0) -> dict:
+    """Fraction of the rows of ``held`` (a MuellerData: held-out rows for cross-validation, the
+    fitted rows for the posterior predictive check) inside the 68% and 95% posterior-predictive
+    intervals, per fitted element and all elements pooled."""
+    lik = fit.lik
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 11]))
+    samples = fit.chain.samples()
+    pick = rng.choice(len(samples), size=min(draws, len(samples)), replace=False)
+    rep = predictive_draws(lik, samples[pick], Rows(held, lik.spec.wavelengths, range(16)), rng)
+    N = held.normalized()
+    out, pooled = {}, {"68": [], "95": []}
+    for name in lik.elements:
+        e = ELEMENTS.index(name)
+        obs = held.mueller[:, 0, 0] if e == 0 else N[:, e // 4, e % 4]
+        lo68, hi68, lo95, hi95 = np.percentile(rep[e], [16, 84, 2.5, 97.5], axis=0)
+        in68, in95 = (obs >= lo68) & (obs <= hi68), (obs >= lo95) & (obs <= hi95)
+        pooled["68"].append(in68)
+        pooled["95"].append(in95)
+        out[name] = {"inside_68": float(in68.mean()), "inside_95": float(in95.mean()), "rows": len(obs)}
+    out["all"] = {
+        "inside_68": float(np.concatenate(pooled["68"]).mean()),
+        "inside_95": float(np.concatenate(pooled["95"]).mean()),
+        "rows": len(held),
+    }
+    return out
+
+
+def leave_one_incidence_out(name, data, settings: StudySettings, scene=None) -> dict:
+    """For each incidence angle of ``data`` (or ``settings.cv_incidences``): fit on the other
+    incidences, then the 68%/95% coverage of the held-out rows only."""
+    inc = np.round(np.degrees(data.theta_i), 1)  # NIST's normal incidence is 0.001 deg
+    angles = sorted(set(inc.tolist())) if settings.cv_incidences is None else list(settings.cv_incidences)
+    folds = {}
+    for j, a in enumerate(angles):
+        held = np.abs(inc - a) < 0.05
+        if not held.any() or held.all():
+            have = ", ".join(f"{x:g}" for x in sorted(set(inc.tolist())))
+            raise ValueError(
+                f"cv_incidences: {a:g} deg leaves no held-out or no training rows (incidences: {have})"
+            )
+        fit = fit_model(name, data.subset(~held), settings.chain(seed_offset=1 + j), scene)
+        cov = heldout_coverage(fit, data.subset(held), settings.draws, settings.seed + j)
+        folds[f"{a:g}"] = {"heldout_rows": int(held.sum()), "coverage": cov}
+    pooled = {
+        q: float(
+            sum(f["coverage"]["all"][q] * f["heldout_rows"] for f in folds.values())
+            / sum(f["heldout_rows"] for f in folds.values())
+        )
+        for q in ("inside_68", "inside_95")
+    }
+    return {"folds": folds, "pooled": pooled}
+
+
+def verdict(comparison: dict) -> dict:
+    """The winner by elpd_loo, its margin over the runner-up (difference and SE from
+    ``az.compare``), the losing model, and whether each of seed 003's physical models fitted
+    improves over Maxwell-Beard (elpd_loo higher by more than 2 SE of the difference)."""
+    order = sorted(comparison, key=lambda m: comparison[m]["rank"])
+    best = order[0]
+    out = {
+        "winner": best,
+        "ranking": order,
+        "loser": order[-1],
+        "runner_up": order[1] if len(order) > 1 else None,
+    }
+    # rows whose PSIS estimate is unreliable (Pareto k > 0.7): their elpd_loo is suspect
+    out["pareto_k_above_0.7"] = {
+        m: comparison[m]["pareto_k"]["bad (0.7-1]"] + comparison[m]["pareto_k"]["very bad (>1)"]
+        for m in order
+    }
+    if len(order) > 1:
+        r = comparison[order[1]]
+        out["margin"] = {"elpd_diff": r["elpd_diff"], "dse": r["dse"]}
+    if "maxwell_beard" in comparison:
+        mb = comparison["maxwell_beard"]["elpd_loo"]
+        claim = {}
+        for m in PHYSICAL:
+            if m in comparison:
+                d = comparison[m]["elpd_loo"] - mb
+                claim[m] = {"elpd_loo_minus_maxwell_beard": d, "improves": bool(d > 0)}
+        out["seed003_claim"] = {
+            "per_model": claim,
+            # None: no physical model was fitted, so the claim is not tested
+            "holds": all(c["improves"] for c in claim.values()) if claim else None,
+            "rule": "a physical model improves when its elpd_loo exceeds Maxwell-Beard's",
+        }
+    return out
+
+
+def run_study(data, settings: StudySettings, out_dir=None, progress=print) -> tuple[dict, dict]:
+    """Fit every model on the subset, compare, check and cross-validate.  Returns ``(results,
+    fits)``; with ``out_dir``, each model's ``posterior.json``, samples and ``posterior.nc``
+    are written under ``out_dir/<model>/`` (atomically; the caller swaps the folder in)."""
+    rows = select_rows(data, settings.wavelength_nm, settings.row_step)
+    sub = data.subset(rows)
+    fits, idatas, models = {}, {}, {}
+    for name in settings.models:
+        progress(f"ptfe: fitting {name} on {len(sub)} rows at {settings.wavelength_nm:g} nm")
+        fit = fit_model(name, sub, settings.chain())
+        ll = pointwise_loglik(fit)
+        idata = inference_data(fit, ll)
+        fits[name], idatas[name] = fit, idata
+        entry = {"scene": MODELS[name], "parameters": fit.summary["parameters"]}
+        if out_dir is not None:
+            folder = os.path.join(out_dir, name)
+            post = write_mueller_fit(fit, folder, data_path=data.path, scene_path=MODELS[name])
+            _write_netcdf(idata, os.path.join(folder, "posterior.nc"))
+            entry["posterior_json"] = os.path.join(name, "posterior.json") if post else None
+        # in-sample posterior predictive check: the fitted rows inside the 68/95% intervals
+        entry["posterior_predictive"] = heldout_coverage(fit, fit.lik.data, settings.draws, settings.seed)
+        models[name] = entry
+    comparison = compare_models(idatas)
+    res = {
+        "settings": asdict(settings),
+        "data": {"path": data.path, "rows": len(sub), "row_indices": rows.tolist()},
+        "models": models,
+        "comparison": comparison,
+        "verdict": verdict(comparison),
+    }
+    if settings.cv:
+        res["cross_validation"] = {}
+        for name in settings.models:
+            progress(f"ptfe: leave-one-incidence-out for {name}")
+            res["cross_validation"][name] = leave_one_incidence_out(name, sub, settings)
+    return res, fits
+
+
+def _write_netcdf(idata, path):
+    """The InferenceData as netCDF (h5netcdf), written beside and renamed into place."""
+    tmp = f"{path}.tmp{os.getpid()}"
+    try:
+        idata.to_netcdf(tmp, engine="h5netcdf")
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
