@@ -1,6 +1,6 @@
 """Independent chains per fit of a model comparison (issue 30, part 2): seeded from the run's
 seed and the chain's index, so the rows do not depend on the executor, and compared by the
-rank-normalized split R-hat (validation/fitting/diagnostics.py), held to ArviZ's."""
+rank-normalized split R-hat (ArviZ's, through validation/fitting/diagnostics.py)."""
 
 import json
 import math
@@ -18,18 +18,6 @@ from scatterbench.validation.fitting.fitspec import fitspec_from
 from scatterbench.validation.fitting.likelihood import Likelihood
 from scatterbench.validation.fitting.recovery import subsample
 from scatterbench.validation.fitting.settings import ChainSettings
-
-
-@pytest.mark.parametrize("shift", [0.0, 0.3, 2.0])
-@pytest.mark.parametrize("shape", [(4, 301), (2, 50), (8, 1000)])
-def test_rhat_equals_arviz_s_rank_normalized_split_rhat(shift, shape):
-    az = pytest.importorskip("arviz")
-    rng = np.random.default_rng(int(shift * 10) + shape[0])
-    x = rng.standard_t(3, shape)  # heavy tails: what the rank normalization is for
-    x[0] += shift
-    ours = rhat(x)
-    theirs = float(az.rhat(az.convert_to_dataset(x), method="rank")["x"])
-    assert ours == pytest.approx(theirs, rel=1e-12, abs=0)
 
 
 def test_rhat_sees_chains_that_disagree_and_not_chains_that_agree():
