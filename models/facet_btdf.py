@@ -47,7 +47,7 @@ import numpy as np
 
 from . import kernel_specs
 from .base import Model
-from .constraints import Instance, Options, RealIndex, ScalarOrArray
+from .constraints import INDEX_MAX, Instance, Interval, Options, ScalarOrArray
 from .facts import Correspondence, scatmech_index
 from .geometry import sp_basis
 from .params import choice_alias, convention_param, param
@@ -194,7 +194,10 @@ class FacetBTDF(Model):
         "facet slope distribution",
         Instance(SlopeDistribution, text="a slope distribution (e.g. models.GaussianSlopes)"),
     )
-    substrate: float = param(1.5, "substrate index (real, > 1)", ScalarOrArray(RealIndex(1.0)))
+    # declared (1, INDEX_MAX]: the rule below (n = 1 is a delta) stated where the range is
+    substrate: float = param(
+        1.5, "substrate index (real, > 1)", ScalarOrArray(Interval(1.0, INDEX_MAX, closed="right"))
+    )
     convention: str = convention_param(
         "normalization of the slopes seen by the ray: Eq. 37 (paper, SCATMECH) or exact Eq. 36 (corrected)"
     )
