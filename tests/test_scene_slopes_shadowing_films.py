@@ -171,12 +171,12 @@ NO_WL = 'name = "x"\n[illumination]\ntheta_i_deg = 30\n'
         (
             ILL + GGX + "[substrate.film]\nlayers = [{index = 2.6, thickness_nm = -1}]\n",
             "[substrate.film] layers[0].thickness_nm",
-            "in [0, inf); got -1",
+            "in [0, 1e+09]; got -1",
         ),
         (
             ILL + GGX + '[substrate.film]\nlayers = [{index = 2.6, thickness_nm = "1"}]\n',
             "[substrate.film] layers[0].thickness_nm",
-            "finite real number in [0, inf); got '1'",
+            "finite real number in [0, 1e+09]; got '1'",
         ),
         (
             ILL + GGX + "[substrate.film]\nlayers = [{index = 2.6, thickness_nm = true}]\n",
