@@ -96,7 +96,27 @@ def scene_for_data(scene, data):
     return scene.with_aperture(float(ap))
 
 
-class Likelihood:
+class BatchPosterior:
+    """The log posterior of a likelihood with ``spec.log_prior`` and ``loglike_batch`` (this
+    module's :class:`Likelihood`, the Mueller-data one): the samplers call :meth:`batch`."""
+
+    def batch(self, U) -> np.ndarray:
+        """Log posterior of positions ``U`` ``(W, k)`` in one evaluation, ``(W,)``: the prior
+        (:meth:`FitSpec.log_prior`, vectorized) plus the likelihood where the prior is finite;
+        ``-inf`` outside the bounds or where the likelihood is not finite."""
+        U = np.atleast_2d(np.asarray(U, dtype=float))
+        out = np.array(self.spec.log_prior(U), dtype=float)  # a copy: written below
+        inside = np.flatnonzero(np.isfinite(out))
+        if inside.size:
+            ll = out[inside] + self.loglike_batch(U[inside])
+            out[inside] = np.where(np.isfinite(ll), ll, -math.inf)
+        return out
+
+    def __call__(self, u) -> float:
+        return float(self.batch(np.asarray(u, dtype=float)[None])[0])
+
+
+class Likelihood(BatchPosterior):
     """``L(u)``: the log posterior in the spec's sampling coordinates is ``self(u)``.
 
     :meth:`batch` evaluates many positions at once, ``(walkers, k)`` in, ``(walkers,)`` out:
@@ -280,21 +300,6 @@ class Likelihood:
         """``ln L`` with the scene rebuilt and validated at ``u`` (tests hold :meth:`loglike`
         to it)."""
         return float(np.sum(self.pointwise_rebuilt(u)))
-
-    def batch(self, U) -> np.ndarray:
-        """Log posterior of positions ``U`` ``(W, k)`` in one evaluation, ``(W,)``: the prior is
-        flat inside the bounds (:meth:`FitSpec.log_prior`, vectorized), ``-inf`` outside or
-        where the model predicts no light at a used row."""
-        U = np.atleast_2d(np.asarray(U, dtype=float))
-        out = self.spec.log_prior(U)
-        inside = np.flatnonzero(np.isfinite(out))
-        if inside.size:
-            ll = out[inside] + self.loglike_batch(U[inside])
-            out[inside] = np.where(np.isfinite(ll), ll, -math.inf)
-        return out
-
-    def __call__(self, u) -> float:
-        return float(self.batch(np.asarray(u, dtype=float)[None])[0])
 
 
 #: likelihood term -> (its noise term, data attribute, its error attribute)

@@ -33,6 +33,7 @@ from scatterbench.models.base import Sum
 from scatterbench.models.scene import binding
 
 from .fitspec import FitSpecError
+from .likelihood import BatchPosterior
 from .mueller_data import ELEMENTS, to_basis
 from .mueller_kernel import loglike_rows, pack_map
 from .mueller_spec import dispersion_index
@@ -75,7 +76,7 @@ def _basis_map(data, needed):
     return out
 
 
-class MuellerLikelihood:
+class MuellerLikelihood(BatchPosterior):
     """``self(u)``: the log posterior in the spec's sampling coordinates; :meth:`batch`
     evaluates ``(walkers, k)`` positions at once (the sampler's vectorized path)."""
 
@@ -259,19 +260,6 @@ class MuellerLikelihood:
                 w = (r / np.sqrt(np.broadcast_to(v, r.shape)))[0]
             parts.append(np.where(np.isfinite(w), w, 1e3))
         return np.concatenate(parts)
-
-    def batch(self, U) -> np.ndarray:
-        """Log posterior of positions ``U`` ``(W, k)`` in one evaluation."""
-        U = np.atleast_2d(np.asarray(U, dtype=float))
-        out = np.asarray(self.spec.log_prior(U), dtype=float).copy()
-        inside = np.flatnonzero(np.isfinite(out))
-        if inside.size:
-            ll = out[inside] + self.loglike_batch(U[inside])
-            out[inside] = np.where(np.isfinite(ll), ll, -math.inf)
-        return out
-
-    def __call__(self, u) -> float:
-        return float(self.batch(np.asarray(u, dtype=float)[None])[0])
 
 
 def _mueller16(model, evaluate):

@@ -1,4 +1,4 @@
-"""Figures of the PTFE study (:mod:`.ptfe`): per incidence angle, the measured and the model
+"""Figures of the PTFE study (:mod:`scatterbench.validation.studies.ptfe`): per incidence angle, the measured and the model
 M11 and polarization elements over the scattering hemisphere as polar maps (azimuth
 ``phi_r``, radius ``theta_r`` in degrees), and the residual map in predictive standard
 deviations."""
