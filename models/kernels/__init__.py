@@ -129,6 +129,7 @@ with _caching_in(cache_dir()):
 #: says when a kernel compiles (the command line shows it: ``scatterbench.validation.cli``)
 log = logging.getLogger(__name__)
 _READY = set()  # the entries this process has called (loaded from the cache or compiled)
+_READY_SAID = []  # whether this process has named the cache folder yet
 
 
 def _announced(fn):
@@ -138,11 +139,10 @@ def _announced(fn):
         _READY.add(fn)
         cache = getattr(fn, "_cache", None)  # None: a Python function (NUMBA_DISABLE_JIT=1)
         if cache is not None and not os.path.exists(cache._cache_file._index_path):
-            log.info(
-                "compiling the %s kernel loop (once per machine: cached in %s)",
-                fn.__name__,
-                fn._cache._cache_path,
-            )
+            # the cache folder once per process: a first run prints a line per loop
+            where = "" if _READY_SAID else f": cached in {cache._cache_path}"
+            _READY_SAID.append(True)
+            log.info("compiling the %s kernel loop (once per machine%s)", fn.__name__, where)
     return fn
 
 
