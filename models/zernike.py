@@ -357,4 +357,7 @@ class ZernikeExpansionBRDF(Model):
 
     def _mueller16(self, ti, tr, pr):
         rot = np.asarray(self.rotation, dtype=float)
+        # a turn beyond one revolution reduced exactly (fmod): 2 x 1.79e308 overflowed to inf,
+        # and its cosine was NaN (issue 31's contract test); ordinary rotations are untouched
+        rot = np.where(np.abs(rot) > 2.0 * math.pi, np.fmod(rot, 2.0 * math.pi), rot)
         return self._evaluate(ti, math.pi - rot + 0.0 * ti, tr, pr - rot, "psps")
