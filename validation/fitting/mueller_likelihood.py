@@ -34,7 +34,7 @@ from scatterbench.models.scene import binding
 
 from .fitspec import FitSpecError
 from .likelihood import BatchPosterior
-from .mueller_data import ELEMENTS, to_basis
+from .mueller_data import ELEMENTS, fold_negative_polar, to_basis
 from .mueller_kernel import loglike_rows, pack_map
 from .mueller_spec import dispersion_index
 
@@ -290,10 +290,10 @@ def _to_data(M, maps):
 
 
 def _offset(rows, off):
-    """Incidence ``|theta_i + off|`` and the azimuth, turned by pi where the sum is negative."""
-    t = rows.theta_i[None, :] + off
-    phi = np.where(t < 0, np.mod(rows.phi[None, :] + 2 * math.pi, 2 * math.pi) - math.pi, rows.phi[None, :])
-    return np.abs(t), phi
+    """Incidence ``theta_i + off`` as the data's own signed polar angles are read
+    (:func:`~scatterbench.validation.fitting.mueller_data.fold_negative_polar`): ``|theta_i + off|``,
+    the azimuth turned by pi where the sum is negative."""
+    return fold_negative_polar(rows.theta_i[None, :] + off, rows.phi[None, :])
 
 
 def _observed(data, elements):
