@@ -69,22 +69,35 @@ def mueller_likelihood(scene, data, free=None) -> MuellerLikelihood:
     return MuellerLikelihood(scene, mueller_spec_from(scene, data.wavelength_nm, free), data)
 
 
-def _coverage(lik, samples, seed, n_draws=200):
-    """Fraction of the fitted rows inside the 68% / 95% posterior-predictive intervals, per element."""
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 3]))
+def interval_coverage(lik, samples, data, rows, rng, n_draws=200) -> dict:
+    """Fraction of the rows of ``data`` inside the 68% / 95% posterior-predictive intervals of
+    ``samples`` evaluated at ``rows`` (``data``'s geometry), per fitted element and ``"all"``
+    pooled: the fit's predictive check and the study's held-out coverage."""
     pick = rng.choice(len(samples), size=min(n_draws, len(samples)), replace=False)
-    rep = predictive_draws(lik, samples[pick], lik.rows, rng)
-    obs = {0: lik.data.mueller[:, 0, 0]}
-    N = lik.data.normalized()
-    out = {}
-    for e in [ELEMENTS.index(x) for x in lik.elements]:
-        o = obs[0] if e == 0 else N[:, e // 4, e % 4]
+    rep = predictive_draws(lik, samples[pick], rows, rng)
+    N = data.normalized()
+    out, pooled = {}, {"68": [], "95": []}
+    for name in lik.elements:
+        e = ELEMENTS.index(name)
+        obs = data.mueller[:, 0, 0] if e == 0 else N[:, e // 4, e % 4]
         lo68, hi68, lo95, hi95 = np.percentile(rep[e], [16, 84, 2.5, 97.5], axis=0)
-        out[ELEMENTS[e]] = {
-            "inside_68": float(np.mean((o >= lo68) & (o <= hi68))),
-            "inside_95": float(np.mean((o >= lo95) & (o <= hi95))),
-            "rows": len(o),
-        }
+        in68, in95 = (obs >= lo68) & (obs <= hi68), (obs >= lo95) & (obs <= hi95)
+        pooled["68"].append(in68)
+        pooled["95"].append(in95)
+        out[name] = {"inside_68": float(in68.mean()), "inside_95": float(in95.mean()), "rows": len(obs)}
+    out["all"] = {
+        "inside_68": float(np.concatenate(pooled["68"]).mean()),
+        "inside_95": float(np.concatenate(pooled["95"]).mean()),
+        "rows": len(data),
+    }
+    return out
+
+
+def _coverage(lik, samples, seed, n_draws=200):
+    """:func:`interval_coverage` of the fitted rows, per element (``posterior.json``)."""
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 3]))
+    out = interval_coverage(lik, samples, lik.data, lik.rows, rng, n_draws)
+    del out["all"]
     return out
 
 

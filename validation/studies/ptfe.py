@@ -19,10 +19,9 @@ import numpy as np
 from scatterbench.models import scene as scene_mod
 from scatterbench.references import scene_path
 from scatterbench.validation.fitting.fit import run_fit
-from scatterbench.validation.fitting.mueller_data import ELEMENTS
 from scatterbench.validation.fitting.mueller_fit import (
+    interval_coverage,
     mueller_likelihood,
-    predictive_draws,
     write_mueller_fit,
 )
 from scatterbench.validation.fitting.mueller_likelihood import Rows
@@ -197,25 +196,8 @@ def heldout_coverage(fit, held, draws=200, seed=0) -> dict:
     intervals, per fitted element and all elements pooled."""
     lik = fit.lik
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 11]))
-    samples = fit.chain.samples()
-    pick = rng.choice(len(samples), size=min(draws, len(samples)), replace=False)
-    rep = predictive_draws(lik, samples[pick], Rows(held, lik.spec.wavelengths, range(16)), rng)
-    N = held.normalized()
-    out, pooled = {}, {"68": [], "95": []}
-    for name in lik.elements:
-        e = ELEMENTS.index(name)
-        obs = held.mueller[:, 0, 0] if e == 0 else N[:, e // 4, e % 4]
-        lo68, hi68, lo95, hi95 = np.percentile(rep[e], [16, 84, 2.5, 97.5], axis=0)
-        in68, in95 = (obs >= lo68) & (obs <= hi68), (obs >= lo95) & (obs <= hi95)
-        pooled["68"].append(in68)
-        pooled["95"].append(in95)
-        out[name] = {"inside_68": float(in68.mean()), "inside_95": float(in95.mean()), "rows": len(obs)}
-    out["all"] = {
-        "inside_68": float(np.concatenate(pooled["68"]).mean()),
-        "inside_95": float(np.concatenate(pooled["95"]).mean()),
-        "rows": len(held),
-    }
-    return out
+    rows = Rows(held, lik.spec.wavelengths, range(16))
+    return interval_coverage(lik, fit.chain.samples(), held, rows, rng, draws)
 
 
 def leave_one_incidence_out(name, data, settings: StudySettings, scene=None) -> dict:
