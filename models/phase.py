@@ -62,8 +62,13 @@ class HenyeyGreenstein(Declared):
         """Scalar HG density per steradian ``p(theta)`` (Eq. 2 with the HG sign)."""
         c = np.asarray(cos_theta, dtype=float)
         g = self.g
-        base = 1.0 + g * g - 2.0 * g * c  # >= (1 - |g|)^2 > 0
-        return (1.0 - g * g) / (4.0 * math.pi * base * np.sqrt(base))
+        # 1 + g^2 - 2 g c as u^2 + 2 |g| v, u = 1 - |g|, v = 1 -+ c by the sign of g: two
+        # non-negative terms (the printed form cancels to 0, and the density to inf, at
+        # g -> -1 and backscatter, c = -1, where it is finite: (1 - g) / (4 pi (1 + g)^2))
+        u = 1.0 - np.abs(g)
+        v = np.maximum(np.where(np.asarray(g) < 0.0, 1.0 + c, 1.0 - c), 0.0)
+        base = u * u + 2.0 * np.abs(g) * v
+        return u * (2.0 - u) / (4.0 * math.pi * base * np.sqrt(base))
 
     def mean_cos(self) -> float:
         """``<cos theta>`` (= g for Henyey-Greenstein)."""

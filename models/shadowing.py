@@ -72,6 +72,13 @@ def check_shadowing(shadowing, slopes):
     """Raise ``ValueError`` unless ``shadowing`` is a known choice that ``slopes`` supports."""
     if shadowing not in SHADOWING:
         raise ValueError(f"shadowing must be one of {', '.join(map(repr, SHADOWING))}; got {shadowing!r}")
+    if shadowing != "none" and not slopes.density:
+        # Lambda's integral diverges (P3 = 1 everywhere): its table holds inf, G came out 0 or
+        # NaN by the geometry
+        raise ValueError(
+            f"shadowing must be 'none' for {type(slopes).__name__} (not a probability density of "
+            f"slopes: Smith's Lambda diverges); got {shadowing!r}"
+        )
     if shadowing != "none" and not _supported(slopes):
         raise ValueError(
             "shadowing 'smith' needs isotropic or elliptical (anisotropic Gaussian, GGX or exponential) "

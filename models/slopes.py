@@ -86,6 +86,9 @@ class SlopeDistribution(Declared):
     """Base class: subclasses define ``_p3_unit`` (normalized ``P3^xy`` for ``C = 1``)."""
 
     isotropic = True
+    #: whether ``P3`` is a probability density (integrates to the coverage): Smith's ``Lambda``,
+    #: the mean slope seen along a direction, is defined only then
+    density = True
     #: the compiled kernels' code of this family (:mod:`scatterbench.models.kernel_specs`), with
     #: :meth:`kernel_row` its parameters; ``None``: no kernel evaluates it (the numpy path)
     kernel_code = None
@@ -501,6 +504,7 @@ class UnitSlopes(SlopeDistribution):
 
     coverage: float = param(1.0, "fixed at 1", ScalarOrArray(Interval(1.0, 1.0)))
 
+    density = False
     kernel_code = kernel_specs.UNIT
 
     def kernel_row(self):

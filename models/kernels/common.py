@@ -194,6 +194,20 @@ def dielectric_transmittance(c, n):
 
 
 @njit(error_model="numpy", forceinline=True)
+def hg_density(g, c):
+    """Henyey-Greenstein density per sr at scattering cosine ``c``
+    (:meth:`scatterbench.models.phase.HenyeyGreenstein.density`, the same form: its base
+    ``1 + g^2 - 2 g c`` written as ``u^2 + 2 |g| v``, ``u = 1 - |g|``, ``v = 1 -+ c`` by the sign
+    of ``g``, a sum of two non-negative terms: the printed form cancels to 0 at g -> -1 and
+    backscatter, c = -1, where the density is large but finite)."""
+    T = type(c)
+    u = T(1.0) - abs(g)
+    v = T(1.0) + c if g < T(0.0) else T(1.0) - c
+    base = u * u + T(2.0) * abs(g) * max(v, T(0.0))
+    return u * (T(2.0) - u) / (T(4.0 * math.pi) * base * sqrt(base))
+
+
+@njit(error_model="numpy", forceinline=True)
 def p3(kind, zx, zy, sx, sy, rot, cov):
     """Slope density ``P3^xy`` of ``kind`` at ``(zx, zy)``; ``sx``, ``sy`` the widths (sigma,
     alpha; ``m_parallel``, ``m_perpendicular`` for strokes), ``rot`` the axes' rotation."""

@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .common import mueller16
+from .common import hg_density, mueller16
 from .facet import btdf_jones, cross3, dot3
 
 __all__ = ["estimate", "exit_transmittance"]
@@ -85,8 +85,7 @@ def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
     scattering (depolarizing: a scalar; polarized: the Jones chain of Eq. 4-5)."""
     diffuse, single, g, polarized = prm[1], prm[2], prm[3], prm[4] != 0.0
     cos_scat = dot3(k1, k2)
-    b = 1.0 + g * g - 2.0 * g * cos_scat
-    dens = (1.0 - g * g) / (4.0 * math.pi * b * math.sqrt(b))
+    dens = hg_density(g, cos_scat)
     rows = (
         0.5 * (ji[0] * ji[0] + ji[1] * ji[1] + ji[2] * ji[2] + ji[3] * ji[3]),
         0.5 * (ji[0] * ji[0] - ji[1] * ji[1] + ji[2] * ji[2] - ji[3] * ji[3]),

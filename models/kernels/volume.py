@@ -4,11 +4,9 @@ call, as :mod:`scatterbench.models.single_scatter` and :mod:`scatterbench.models
 
 from __future__ import annotations
 
-import math
-
 from numba import njit
 
-from .common import coating_cos, mueller16, polar
+from .common import coating_cos, hg_density, mueller16, polar
 from .vector_math import sqrt
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
@@ -58,8 +56,7 @@ def single(geo, p, o):
     si, ci, asi, api = amplitudes(ci_e, si_e, n)
     sr, cr, asr, apr = amplitudes(cr_e, sr_e, n)
     cos_scat = si * sr * cp - ci * cr
-    base = T(1.0) + g * g - T(2.0) * g * cos_scat
-    dens = (T(1.0) - g * g) / (T(4.0 * math.pi) * base * sqrt(base))
+    dens = hg_density(g, cos_scat)
     # both internal cosines zero (grazing under n = 1): no projected flux and zero amplitudes;
     # dens / tiny would overflow float32 and give inf * 0
     K = dens / (ci + cr) if ci + cr > T(0.0) else T(0.0)
