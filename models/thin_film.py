@@ -24,11 +24,13 @@ recursion):
     r <- (r_j + r e) / (1 + r_j r e),   t <- t_j t sqrt(e) / (1 + r_j r e),
     e = exp(2 i beta),  beta = 2 pi d kz / lambda  (the film's phase thickness).
 
-A zero-thickness film therefore changes nothing (``(r01 + r12)/(1 + r01 r12) =
-r02`` for both polarizations, phases included), so the recursion leaves such films
-out: summed, they are 0/0 at exact grazing between media of one index, where
-``1 + r01 r12 = 0``.  Likewise two media of one index meet in no interface
-(``r = 0``, ``t = 1``, set exactly).  A stack without films of positive thickness is
+The code carries the recursion as the admittance below each film (:func:`_rouard_one`):
+the same algebra, multiplied through so that ``1 + r_j r e`` is never formed (it rounds to 0
+for a thin film of extreme index, both reflections near +-1).  A zero-thickness film
+changes nothing (``(r01 + r12)/(1 + r01 r12) = r02`` for both polarizations, phases
+included; in the admittance form its step leaves the admittance as it was), and the
+recursion leaves such films out; two media of one index (equal admittances) meet in no
+interface, their step a pure propagation.  A stack without films of positive thickness is
 the bare interface, evaluated by :func:`scatterbench.models.fresnel.fresnel_coefficients`
 itself.  A perfect-conductor substrate (``math.inf``) has ``r_s = -1``,
 ``r_p = +1``, ``t = 0`` at the last interface.
@@ -250,8 +252,7 @@ class FilmStack(Declared):
             return _coefficients(c, n0, sub)
         kz = [n0 * c + 0j] + [n0 * _w(c, n / n0) for n in films]  # n_j cos(theta_j), Im >= 0
         ns = [complex(n0)] + list(films)
-        r, t = _bottom(kz[-1], ns[-1], c, n0, sub)
-        return _rouard(kz, ns, thickness, self.wavelength_nm, r, t)
+        return _rouard(kz, ns, thickness, self.wavelength_nm, _below(c, n0, sub))
 
     def reflection_rs_k(self, cos_i, n_incident):
         """``r_s`` and ``K = (r_s + r_p) / sin^2(theta)`` (:func:`scatterbench.models.fresnel.reflection_rs_k`).
@@ -318,8 +319,7 @@ class FilmStack(Declared):
         c = np.asarray(cos_top, dtype=float)
         kz = [_w(c, sub)] + [_w(c, n) for n in films[::-1]]
         ns = [sub] + list(films[::-1])
-        r, t = (list(x) for x in _interface(kz[-1], c + 0j, ns[-1], 1.0 + 0j))
-        _, _, us, up = _rouard(kz, ns, thickness[::-1], self.wavelength_nm, r, t)
+        _, _, us, up = _rouard(kz, ns, thickness[::-1], self.wavelength_nm, (c + 0j, 1.0 + 0j))
         return us, up
 
     def _check_coating(self):
@@ -437,42 +437,71 @@ def check_films(name, value):
 INDEX_OR_STACK = OneOf(ScalarOrArray(ComplexIndex()), Instance(FilmStack, text="a models.FilmStack"))
 
 
-def _rouard(kz, ns, thickness, wavelength_nm, r, t):
+def _rouard(kz, ns, thickness, wavelength_nm, below):
     """``(r_s, r_p, t_s, t_p)`` seen from the incident medium: the films summed from the bottom
     up (module docstring).  ``kz`` and ``ns`` list the incident medium then the films in order
-    (film ``j`` has ``thickness[j - 1]`` nm); ``r``, ``t`` are the ``[s, p]`` coefficients of
-    the last film's interface with the medium below it."""
+    (film ``j`` has ``thickness[j - 1]`` nm); ``below`` is ``(kz, n)`` of the medium under the
+    last film, or ``None`` for a perfect conductor."""
+    if not thickness and below is not None and ns[0] == below[1]:  # one medium: no interface
+        zero = np.zeros(np.broadcast(*kz, below[0]).shape, dtype=complex)
+        return zero, zero.copy(), zero + 1.0, zero + 1.0
+    (rs, ts), (rp, tp) = (_rouard_one(q, kz, ns, thickness, wavelength_nm, below) for q in (0, 1))
+    return rs, rp, ts, tp
+
+
+def _admittance(q, kz, n):
+    """The admittance of polarization ``q`` (0: s, ``kz``; 1: p, ``kz / n^2``): in these
+    conventions an interface has ``r = (eta_1 - eta_2) / (eta_1 + eta_2)`` and ``t = 2 eta_1 f /
+    (eta_1 + eta_2)``, ``f = 1`` (s) or ``n_1 / n_2`` (p)."""
+    return kz if q == 0 else kz / (n * n)
+
+
+def _rouard_one(q, kz, ns, thickness, wavelength_nm, below):
+    """``(r, t)`` of polarization ``q`` by Rouard's recursion, carried as the admittance
+    ``Y = P / Q`` below each film and ``w = t / (1 + r)`` (the transmission from the film down
+    over its total field there), so that nothing cancels and nothing divides by an admittance
+    (zero at grazing): the printed form divides by ``1 + r_j r e``, which rounds to 0 when
+    both reflections are near +-1 with opposite signs (a film of index 1e-12(1 + i), 1e-300 nm
+    thick: r_p was 0/0; its error grew as eps / |n|^2 for thin films of small index).  Per
+    film, ``a`` and ``b`` the admittances above and in it, ``x = 1 - e`` and ``xi = x / b``
+    (``-expm1(z) / z`` times ``z / b``: finite at ``kz = 0``),
+
+        P' = (2 - x) P + b x Q,   Q' = xi P + (2 - x) Q,
+        w <- 2 f sqrt(e) w Q (a Q' + P') / (Q' (2 (a Q + P) - xi (a - b) (b Q - P))),
+
+    the printed recursion multiplied through by ``(a + b)(b + Y)``; a zero-thickness film
+    (``x = 0``) leaves ``Y`` as it was.  Then ``r = (a Q - P) / (a Q + P)`` and
+    ``t = w (1 + r)``, ``a`` the incident medium's admittance."""
+    one = np.ones(np.broadcast(*kz).shape, dtype=complex)
+    if below is None:  # a perfect conductor: Y = inf (s), 0 (p); nothing transmitted
+        P, Q, w = (one, 0.0 * one, 0.0 * one) if q == 0 else (0.0 * one, one, 0.0 * one)
+    else:  # w = t / (1 + r) of the last interface is f: 1, or n_last / n_below
+        P, Q, w = _admittance(q, below[0], below[1]) * one, one, (1.0 if q == 0 else ns[-1] / below[1]) * one
     for j in range(len(thickness), 0, -1):
-        e_half = np.exp(2j * math.pi * thickness[j - 1] / wavelength_nm * kz[j])
-        e = e_half * e_half
-        rj, tj = _interface(kz[j - 1], kz[j], ns[j - 1], ns[j])
-        den = [1.0 + rj[q] * r[q] * e for q in (0, 1)]
-        r = [(rj[q] + r[q] * e) / den[q] for q in (0, 1)]
-        t = [tj[q] * t[q] * e_half / den[q] for q in (0, 1)]
-    return r[0], r[1], t[0], t[1]
+        a, b = _admittance(q, kz[j - 1], ns[j - 1]), _admittance(q, kz[j], ns[j])
+        half = 2j * math.pi * thickness[j - 1] / wavelength_nm  # sqrt(e) = exp(half kz)
+        z = 2.0 * half * kz[j]
+        small = np.abs(z) < 1e-8  # expm1(z) / z = 1 + z / 2 + O(z^2): no division by a subnormal z
+        growth = np.where(small, 1.0 + 0.5 * z, np.expm1(z) / np.where(small, 1.0, z))
+        x = -growth * z
+        xi = -growth * 2.0 * half * (1.0 if q == 0 else ns[j] * ns[j])
+        den = 2.0 * (a * Q + P) - xi * (a - b) * (b * Q - P)
+        P2, Q2 = (2.0 - x) * P + b * x * Q, xi * P + (2.0 - x) * Q
+        if below is not None:
+            f = 1.0 if q == 0 else ns[j - 1] / ns[j]
+            w = 2.0 * f * np.exp(half * kz[j]) * w * Q * (a * Q2 + P2) / (Q2 * den)
+        scale = np.maximum(np.abs(P2), np.abs(Q2))  # Y is their ratio: keep both near 1
+        P, Q = P2 / scale, Q2 / scale
+    a = _admittance(q, kz[0], ns[0])
+    # Y = 0 below (P = 0) reflects r = 1 at every incidence; at exact grazing (a = 0) the
+    # quotient is 0/0 and r takes that limit
+    zero = P == 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.where(zero, 1.0, (a * Q - P) / np.where(zero, 1.0, a * Q + P))
+    return r, w * (1.0 + r)
 
 
-def _interface(kz1, kz2, n1, n2):
-    """``((r_s, r_p), (t_s, t_p))`` of one interface (module docstring).
-
-    Two media of one index are no interface: ``r = 0``, ``t = 1`` at every angle, set
-    exactly, since at exact grazing both ``kz`` vanish and the formulas are 0/0 (an
-    index-1 film under the ambient, e.g.)."""
-    if n1 == n2:
-        zero = np.zeros(np.broadcast(kz1, kz2).shape, dtype=complex)
-        return (zero, zero.copy()), (zero + 1.0, zero + 1.0)
-    a = n2 * n2 * kz1
-    b = n1 * n1 * kz2
-    rs = (kz1 - kz2) / (kz1 + kz2)
-    rp = (a - b) / (a + b)
-    return (rs, rp), (2.0 * kz1 / (kz1 + kz2), 2.0 * n1 * n2 * kz1 / (a + b))
-
-
-def _bottom(kz_last, n_last, c, n0, sub):
-    """``([r_s, r_p], [t_s, t_p])`` of the last film's interface with the substrate."""
-    if sub == math.inf:
-        one = np.ones(c.shape, dtype=complex)
-        return [-one, one.copy()], [0.0 * one, 0.0 * one]
-    kz_sub = n0 * _w(c, sub / n0)
-    (rs, rp), (ts, tp) = _interface(kz_last, kz_sub, n_last, sub)
-    return [rs, rp], [ts, tp]
+def _below(c, n0, sub):
+    """``(kz, n)`` of the substrate under the films (:func:`_rouard`; ``None``: a perfect
+    conductor)."""
+    return None if sub == math.inf else (n0 * _w(c, sub / n0), sub)

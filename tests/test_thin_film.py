@@ -132,13 +132,14 @@ def test_energy_on_a_perfect_conductor():
 def test_zero_thickness_film_is_the_bare_interface(n0, film, sub):
     """Both polarizations, phases included (TIR beyond 53 deg for 1.5 -> 1.2): the stack
     (which leaves zero-thickness films out) and the recursion summing such a film, which
-    must give the same by the identity (r01 + r12) / (1 + r01 r12) = r02."""
-    from scatterbench.models.thin_film import _bottom, _rouard, _w
+    must give the same by the identity (r01 + r12) / (1 + r01 r12) = r02 (exact grazing
+    included: in the admittance form the step of a zero-thickness film is no 0/0)."""
+    from scatterbench.models.thin_film import _below, _rouard, _w
 
-    c = np.cos(np.linspace(0, math.pi / 2, 181))[:-1]  # the recursion is 0/0 at exact grazing
+    c = np.cos(np.linspace(0, math.pi / 2, 181))
     got = FilmStack(layers=((film, 0.0),), substrate=sub, wavelength_nm=600.0).coefficients(c, n0)
     kz = [n0 * c + 0j, n0 * _w(c, film / n0)]
-    summed = _rouard(kz, [complex(n0), film], (0.0,), 600.0, *_bottom(kz[1], film, c, n0, sub))
+    summed = _rouard(kz, [complex(n0), film], (0.0,), 600.0, _below(c, n0, sub))
     want = fresnel_coefficients(c, n0, sub)
     for g, s, w in zip(got, summed, want, strict=True):
         assert np.array_equal(g, w)
@@ -285,3 +286,19 @@ def test_interference_flakes_follow_the_stack_reflectance():
 def test_film_thickness_must_be_a_number_not_a_bool_or_text(thickness):
     with pytest.raises(ValueError, match=r"layers\[0\] thickness_nm must be a finite real number"):
         FilmStack(layers=((2.6, thickness),), substrate=1.5, wavelength_nm=550.0)
+
+
+@pytest.mark.parametrize("film", [1e-12 * (1 + 1j), 5.6e-17, 1e-8 + 0j, 1.7e16 + 0j, 0.05 + 3j])
+@pytest.mark.parametrize("sub", [1.5, 0.2 + 3j, math.inf])
+def test_a_vanishing_film_of_extreme_index_is_the_bare_interface(film, sub):
+    """A film 1e-300 nm thick changes nothing at any index in range (its phase and its
+    admittance step are ~1e-280): r and t equal the bare interface's to 1e-14, both
+    polarizations, exact grazing included.  The printed recursion divided by 1 + r01 r12 e,
+    which rounds to 0 when both reflections are near +-1 with opposite signs: at 1e-12(1 + i)
+    it gave NaN, and r_p wrong by 9e-2 at 1e-8."""
+    c = np.cos(np.linspace(0.0, math.pi / 2, 37))
+    got = FilmStack(layers=((film, 1e-300),), substrate=sub, wavelength_nm=500.0).coefficients(c, 1.0)
+    want = fresnel_coefficients(c, 1.0, sub)
+    for g, w in zip(got, want, strict=True):
+        assert np.all(np.isfinite(g))
+        assert np.max(np.abs(g - w)) <= 1e-14 * max(1.0, np.max(np.abs(w)))
