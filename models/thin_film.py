@@ -497,8 +497,10 @@ def _rouard_one(q, kz, ns, thickness, wavelength_nm, below):
     # quotient is 0/0 and r takes that limit
     zero = P == 0
     with np.errstate(invalid="ignore", divide="ignore"):
-        r = np.where(zero, 1.0, (a * Q - P) / np.where(zero, 1.0, a * Q + P))
-    return r, w * (1.0 + r)
+        den = np.where(zero, 1.0, a * Q + P)
+        r = np.where(zero, 1.0, (a * Q - P) / den)
+        one_plus_r = np.where(zero, 2.0, 2.0 * a * Q / den)  # not 1 + r: it cancels near grazing
+    return r, w * one_plus_r
 
 
 def _below(c, n0, sub):

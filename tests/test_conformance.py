@@ -59,7 +59,7 @@ def test_plain_lambertian_passes_every_check():
     assert report.passed and not _failing(report)
     skipped = {r.id: r.detail for r in report.results if r.status == "skip"}
     # the capabilities a plain class lacks, each named
-    assert set(skipped) == {"out_argument", "mirror_symmetry", "parameter_extremes", "scatmech"}
+    assert set(skipped) == {"out_argument", "mirror_symmetry", "stochastic_claim", "parameter_extremes", "scatmech"}
     assert "out=" in skipped["out_argument"] and "scatmech attribute" in skipped["scatmech"]
     ran = {r.id for r in report.results if r.status == "pass"}
     assert ran == {s.name for s in conformance_checks()} - set(skipped)
@@ -336,8 +336,8 @@ def test_cli_check_exit_codes(tmp_path):
     assert "0 fail" in ok.stdout
     doc = json.loads((tmp_path / "ok.json").read_text())
     assert (
-        doc["passed"] and doc["model"] == "kit_models:Lambertian" and len(doc["results"]) == 14
-    )  # 13 checks + mirror symmetry
+        doc["passed"] and doc["model"] == "kit_models:Lambertian" and len(doc["results"]) == 15
+    )  # 13 checks + mirror symmetry + stochastic claim
     energy = next(r for r in doc["results"] if r["id"] == "energy")
     assert (
         energy["status"] == "pass"
@@ -422,4 +422,4 @@ def test_example_package_own_tests_pass(installed_example):
     cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", os.path.join(EXAMPLE, "tests")]
     r = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=EXAMPLE, timeout=600)
     assert r.returncode == 0, r.stdout + r.stderr
-    assert "20 passed, 6 skipped" in r.stdout
+    assert "20 passed, 8 skipped" in r.stdout

@@ -22,6 +22,14 @@ class ClaimsMirrorCreatesEnergy(km.Lambertian):
         return np.where(np.asarray(phi_r, dtype=float) < 0.0, 2.4 / math.pi, 0.0) + 0.0 * f
 
 
+class ClaimsNoiseCreatesEnergy(km.CreatesEnergy):
+    """Claims to be a Monte Carlo model (a seed and ``stochastic = True``) but its numbers do
+    not depend on the seed: were the claim trusted, the energy check would be skipped."""
+
+    stochastic = True
+    seed = 3
+
+
 class WritesIntoInputs(km.Lambertian):
     """Zeroes the incidence angles it is given (a user's in-place 'normalization')."""
 
@@ -63,3 +71,18 @@ def test_a_model_writing_into_its_inputs_fails_clearly_and_corrupts_nothing():
     # the kit's grids are intact for the next model in the same process
     good = check_model(models.FacetBRDF(), checks=["finite", "broadcasting", "reciprocity"], quick=True)
     assert good.passed, good.format()
+
+
+def test_a_false_stochastic_claim_fails_and_the_exact_checks_run():
+    report = check_model(ClaimsNoiseCreatesEnergy(), checks=["stochastic_claim", "energy"], quick=True)
+    claim, energy = report.results
+    assert claim.status == "fail" and claim.measured == 0.0 and "deterministic" in claim.detail
+    assert energy.status == "fail", energy.detail  # run, not skipped: it creates energy
+
+
+def test_a_true_stochastic_claim_passes_and_skips_the_exact_checks():
+    m = models.RoughDiffuseBRDF(pairs=64)
+    report = check_model(m, checks=["stochastic_claim", "reciprocity"], quick=True)
+    claim, recip = report.results
+    assert claim.status == "pass" and claim.measured > 0.0, claim.detail
+    assert recip.status == "skip" and "stochastic" in recip.detail

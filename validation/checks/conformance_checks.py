@@ -11,6 +11,7 @@ parameter extremes for a model with declared parameters.  The SCATMECH compariso
 from __future__ import annotations
 
 import copy
+import dataclasses
 import inspect
 import math
 import pickle
@@ -109,8 +110,48 @@ def _worst(e):
     return float(e[k]), k
 
 
-def _stochastic(model):
+def _claims_stochastic(model):
     return bool(claims(model, "stochastic", hasattr(model, "seed")))
+
+
+def _reseeded(model, seed):
+    """A copy of ``model`` with another ``seed`` (``replace`` for declared models and
+    dataclasses, else a deep copy with the attribute set); ``None`` when none can be made."""
+    try:
+        if isinstance(model, Declared):
+            return model.replace(seed=seed)
+        if dataclasses.is_dataclass(model):
+            return dataclasses.replace(model, seed=seed)
+        other = copy.deepcopy(model)
+        other.seed = seed
+        return other
+    except Exception:  # noqa: BLE001 - a model that refuses a new seed cannot show its noise
+        return None
+
+
+def _seed_spread(model, ctx):
+    """``(difference, seeds, where)``: the largest relative difference between the model's numbers
+    and a copy's with another seed on a few geometries (0: the same numbers, the claim false;
+    NaN: no copy with another seed could be made), memoized."""
+
+    def compute():
+        seed = claims(model, "seed", None)
+        other_seed = (seed + 1) if isinstance(seed, int) and not isinstance(seed, bool) else 12345
+        other = _reseeded(model, other_seed)
+        ti, tr, pr = random_geometries(8, seed=11)
+        if other is None:
+            return math.nan, (seed, other_seed), ""
+        e, k = _same(model, [other], ti, tr, pr)
+        return e, (seed, other_seed), where(ti, tr, pr, k)
+
+    return _memo(ctx, "seed spread", model, compute)
+
+
+def _stochastic(model, ctx):
+    """True when the model claims to be stochastic and the claim holds (two seeds give
+    different numbers): only then are the exact checks (energy, reciprocity, mirror symmetry)
+    skipped.  A claim is not trusted: a deterministic model that claims it would skip them."""
+    return _claims_stochastic(model) and _seed_spread(model, ctx)[0] > 0.0
 
 
 def _memo(ctx, key, model, fn):
@@ -350,7 +391,7 @@ def mirror_verified(model, ctx) -> bool:
     :data:`RECIPROCITY_TOL`): only then may an integral halve its azimuth range.  A claim is
     not trusted: a model that claims it and is brighter at negative azimuths would otherwise
     have half its light (and any energy it creates) integrated away."""
-    if not claims(model, "mirror_symmetric", False) or _stochastic(model):
+    if not claims(model, "mirror_symmetric", False) or _stochastic(model, ctx):
         return False
     e = _mirror_errors(model, ctx)[0]
     return bool(np.all(np.isfinite(e)) and e.max() <= RECIPROCITY_TOL)
@@ -363,7 +404,7 @@ def mirror_verified(model, ctx) -> bool:
 def check_mirror_symmetry(model, ctx):
     if not claims(model, "mirror_symmetric", False):
         return skipped("mirror symmetry", "the model does not claim mirror symmetry (mirror_symmetric)")
-    if _stochastic(model):
+    if _stochastic(model, ctx):
         return skipped("mirror symmetry", "stochastic: its noise differs between phi and -phi")
     e, ti, tr, pr = _mirror_errors(model, ctx)
     v, k = _worst(e)
@@ -399,7 +440,7 @@ def check_reciprocity(model, ctx):
     claim = claims(model, "reciprocal", True)
     if claim is False:
         return skipped("reciprocity", "the model does not claim reciprocity (reciprocal = False)")
-    if _stochastic(model):
+    if _stochastic(model, ctx):
         return skipped("reciprocity", "stochastic: reciprocal only within its sampling error, not exactly")
     geometry, errors, note = _reciprocity_errors(model, ctx)
     e, k = _worst(errors["scalar"])
@@ -477,7 +518,7 @@ def _declared_excess(bound):
     "M00 cos(theta_r) dOmega) at a ladder of incidences stays below 1 or the declared energy_bound"
 )
 def check_energy(model, ctx):
-    if _stochastic(model):
+    if _stochastic(model, ctx):
         return skipped(
             "energy", "stochastic: a noisy integrand leaves the cubature's error estimate meaningless"
         )
@@ -520,6 +561,24 @@ def _same(model, others, ti, tr, pr):
 
 
 @model_check(
+    tests="a claim to be stochastic (stochastic = True, or a seed attribute) holds: a copy with "
+    "another seed gives different numbers (a false claim would skip energy, reciprocity and mirror symmetry)"
+)
+def check_stochastic_claim(model, ctx):
+    if not _claims_stochastic(model):
+        return skipped(
+            "stochastic claim", "the model does not claim to be stochastic (no seed, stochastic unset)"
+        )
+    e, (seed, other), at = _seed_spread(model, ctx)
+    detail = f"max |dM| / M00 between seed {seed!r} and a copy with seed {other!r}"
+    if math.isnan(e):
+        detail += ": no copy with another seed could be made (replace(seed=...) or setting .seed)"
+    elif e == 0.0:
+        detail += ": the same numbers, so the model is deterministic and the exact checks run"
+    return verdict("stochastic claim", e, 0.0, detail, where=at, op=">")
+
+
+@model_check(
     tests="DESIGN.md: the same seed gives the same numbers (a stochastic model: fresh copies with the "
     "same seed and repeated calls; every model: repeated calls)"
 )
@@ -527,7 +586,7 @@ def check_determinism(model, ctx):
     ti, tr, pr = random_geometries(48, seed=9)
     others = [model]
     how = "a repeated call"
-    if _stochastic(model):
+    if _stochastic(model, ctx):
         others += [copy.deepcopy(model), copy.deepcopy(model)]
         how = f"a repeated call and two copies with seed {claims(model, 'seed', None)!r}"
     else:
