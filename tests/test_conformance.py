@@ -59,7 +59,13 @@ def test_plain_lambertian_passes_every_check():
     assert report.passed and not _failing(report)
     skipped = {r.id: r.detail for r in report.results if r.status == "skip"}
     # the capabilities a plain class lacks, each named
-    assert set(skipped) == {"out_argument", "mirror_symmetry", "stochastic_claim", "parameter_extremes", "scatmech"}
+    assert set(skipped) == {
+        "out_argument",
+        "mirror_symmetry",
+        "stochastic_claim",
+        "parameter_extremes",
+        "scatmech",
+    }
     assert "out=" in skipped["out_argument"] and "scatmech attribute" in skipped["scatmech"]
     ran = {r.id for r in report.results if r.status == "pass"}
     assert ran == {s.name for s in conformance_checks()} - set(skipped)
