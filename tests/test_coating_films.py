@@ -96,6 +96,23 @@ def test_the_stack_is_reciprocal():
     assert worst <= 1e-14
 
 
+def test_the_stack_is_reciprocal_relative_to_its_amplitude_near_grazing():
+    """(R) again, relative: near grazing both sides of (R) vanish as cos, and the absolute
+    bound above cannot see an error of their ratio (the top transmission written as
+    w (1 + r), with r -> -1, erred by 1e-7 of it at cos 1e-9; the stability sweep found it)."""
+    rng = np.random.default_rng(12)
+    c = np.geomspace(1e-12, 1e-2, 41)
+    worst = 0.0
+    for _ in range(30):
+        st = _random_stack(rng)
+        n = st.indices[1].real
+        kz_s = n * np.sqrt(1.0 - (1.0 - c * c) / (n * n))
+        (ts, tp), (us, up) = st.transmission(c)
+        for u, t in ((us, ts), (up, tp)):
+            worst = max(worst, np.max(np.abs(u * c - t * kz_s) / np.abs(t * kz_s)))
+    assert worst <= 1e-12
+
+
 @pytest.mark.parametrize("films", [LOSSLESS, ABSORBING], ids=["lossless", "absorbing"])
 def test_energy_of_the_crossings(films):
     """Each crossing's R + T + A = 1: R = |r|^2, T the flux into the far medium (the kz ratios
