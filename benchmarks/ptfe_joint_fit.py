@@ -3,7 +3,7 @@ elements) toward N >= 50 tau: wall time, likelihood evaluations per second, and 
 time goes.
 
     python benchmarks/ptfe_joint_fit.py [--scene FILE] [--walkers W] [--max-steps N]
-                                        [--threads T] [--seed S]
+                                        [--threads T] [--seed S] [--moves stretch|de]
 
 Default scene: ``references/scenes/ptfe_smooth_diffuse_joint.toml`` (facets + totally diffuse
 subsurface under a smooth interface; 11 free parameters: roughness, albedo per wavelength, a
@@ -74,9 +74,15 @@ def main(argv=None):
     ap.add_argument("--max-steps", type=int, default=20000)
     ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS, help="numba threads")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument(
+        "--moves", default="stretch", choices=("stretch", "de"), help="emcee's proposal (ChainSettings.moves)"
+    )
     args = ap.parse_args(argv)
     numba.set_num_threads(args.threads)
-    print(f"load average before: {os.getloadavg()}; cores {os.cpu_count()}; numba threads {args.threads}")
+    print(
+        f"load average before: {os.getloadavg()}; cores {os.cpu_count()}; numba threads {args.threads}; "
+        f"moves {args.moves}"
+    )
     t0 = time.perf_counter()
     data = load_mueller_data(nist_ptfe_path())
     lik = mueller_likelihood(scene_mod.load(args.scene), data)
@@ -92,6 +98,7 @@ def main(argv=None):
         check_every=100,
         tau_factor=50,
         starts=1,
+        moves=args.moves,
     )
     fit = run_fit(lik, settings)
     wall = time.perf_counter() - t0

@@ -1,5 +1,6 @@
-"""The compiled kernels against the numpy reference implementation (1e-12 relative to M00),
-model sets, the small-call path, float32, and the cache location."""
+"""The compiled kernels against the numpy reference implementation (relative to M00, within each
+model's derived tolerance: :mod:`scatterbench.models.kernel_tolerance`), model sets, the
+small-call path, float32, and the cache location."""
 
 import math
 import os
@@ -12,11 +13,11 @@ import pytest
 from scatterbench import models
 from scatterbench.models import kernel_specs
 from scatterbench.models.evaluation import backend
+from scatterbench.models.kernel_tolerance import kernel_tolerance as tol
 from scatterbench.validation.checks.conformance_checks import _relative as relative_per_geometry
 from scatterbench.validation.numerics.probes import extreme_geometries, random_geometries
 
 AL = 1.37 + 7.62j
-TOL = 1e-12
 
 
 def _configs():
@@ -112,14 +113,14 @@ def test_kernel_equals_numpy_reference(model):
         mn = model.mueller(ti, tr, pr)
         bn = model.brdf(ti, tr, pr)
     assert np.all(np.isfinite(mk))
-    assert _relative(mk, mn) <= TOL
+    assert _relative(mk, mn) <= tol(model)
     with np.errstate(divide="ignore", invalid="ignore"):
-        assert float(np.max(np.where(bk == bn, 0.0, np.abs(bk - bn) / np.abs(bn)))) <= TOL
+        assert float(np.max(np.where(bk == bn, 0.0, np.abs(bk - bn) / np.abs(bn)))) <= tol(model)
     # float32 angles are validated (and promoted) the same way on both paths
     t32 = [a.astype(np.float32) for a in (ti, tr, pr)]
     with backend("numpy"):
         mn32 = model.mueller(*t32)
-    assert _relative(model.mueller(*t32), mn32) <= TOL
+    assert _relative(model.mueller(*t32), mn32) <= tol(model)
 
 
 def test_uncovered_options_fall_back_to_numpy():
@@ -148,7 +149,7 @@ def test_model_sets_in_the_kernels():
     assert M.shape == (3, 50, 4, 4)
     with backend("numpy"):
         Mn = m.mueller(ti, tr, pr)
-    assert _relative(M, Mn) <= TOL
+    assert _relative(M, Mn) <= tol(m)
     for w in range(3):
         one = models.SubsurfaceFacetBRDF(
             slopes=models.ExponentialSlopes(float(sig[w, 0])),
@@ -185,7 +186,7 @@ def _perturbed_set(model, rng, w=4):
 
 @pytest.mark.parametrize("model", CONFIGS[::3], ids=lambda m: type(m).__name__)
 def test_random_model_sets_equal_the_numpy_reference_and_their_elements(model):
-    """A set of every kernel's models (random parameters) against numpy within 1e-12, and
+    """A set of every kernel's models (random parameters) against numpy within its tolerance, and
     each element equal, bit for bit, to the single model with its values."""
     from scatterbench.models import modelset
 
@@ -198,7 +199,7 @@ def test_random_model_sets_equal_the_numpy_reference_and_their_elements(model):
     assert M.shape == (4, len(ti), 4, 4) and np.all(np.isfinite(M))
     with backend("numpy"):
         Mn = mset.mueller(ti, tr, pr)
-    assert _relative(M, Mn) <= TOL
+    assert _relative(M, Mn) <= tol(mset)
     for w in (0, 3):
         one = modelset.rebuilt(model, {p: modelset.scalar_value(a[w, 0]) for p, a in leaves.items()})
         assert np.array_equal(one.mueller(ti, tr, pr), M[w])
@@ -316,3 +317,35 @@ def test_a_first_call_compiles_its_own_kernel_alone_and_says_so(tmp_path):
     assert "compiling" not in runs[1].stderr, runs[1].stderr
     cached = {p.name.split("-")[0] for p in tmp_path.rglob("*.nbi")}
     assert cached == {"drive.run_one_diffuse"}, cached
+
+
+NARROW = [
+    *(models.FacetBRDF(slopes=models.GaussianSlopes(w), substrate=1.5) for w in (1e-2, 1e-4, 1e-6, 1e-8)),
+    *(models.FacetBRDF(slopes=models.ExponentialSlopes(w), substrate=1.5) for w in (1e-4, 1e-6)),
+    *(models.FacetBRDF(slopes=models.GGXSlopes(w), substrate=1.5) for w in (1e-4, 1e-6)),
+    models.CookTorranceBRDF(slopes=models.GaussianSlopes(1e-3), substrate=math.inf),
+]
+
+
+def _near_specular(n=2000, seed=5):
+    """Geometries within 1e-9..1e-1 rad of specular (where a narrow lobe is), in and out of plane."""
+    rng = np.random.default_rng(seed)
+    t0 = rng.uniform(0.0, 1.4, n)
+    d = 10 ** rng.uniform(-9, -1, n) * rng.choice([-1.0, 1.0], n)
+    return t0, np.clip(t0 + d, 0.0, math.pi / 2), rng.choice([0.0, math.pi], n) + d * rng.uniform(-1, 1, n)
+
+
+@pytest.mark.parametrize("model", NARROW, ids=lambda m: f"{type(m.slopes).__name__}-{m.slopes.scale:g}")
+def test_narrow_lobes_agree_within_their_derived_tolerance(model):
+    """Kernel and numpy differ by the lobe's conditioning (the slope's last bits over the
+    width), not by a flat 1e-12: measured 2.3e-7 for a Gaussian of width 1e-8, the narrowest
+    declared.  Held to the derived bound; the narrowest ones exceed the old flat 1e-12, which
+    is why the bound is per model."""
+    ti, tr, pr = (np.concatenate(p) for p in zip(_geometries(), _near_specular(), strict=True))
+    mk = model.mueller(ti, tr, pr)
+    with backend("numpy"):
+        mn = model.mueller(ti, tr, pr)
+    err = _relative(mk, mn)
+    assert err <= tol(model)
+    if model.slopes.scale <= 1e-6:
+        assert err > 1e-12  # the flat tolerance these models need more than
