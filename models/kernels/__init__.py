@@ -28,8 +28,9 @@ changes to the file of the function itself).
 
 Only the entry points that Python calls are cached: per kernel, ``run``, ``run_parallel``,
 ``run_checked`` and ``run_one`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel
-and option set the first three of :func:`~scatterbench.models.kernels.vector.lane_entries` (closures
-over the kernel's code, so that a run compiles only the kernels its models use), ``angles_ok``
+and option set the first three of :func:`~scatterbench.models.kernels.vector.lane_entries` and the
+``run_range`` loop they call (closures over the kernel's code, so that a run compiles only
+the kernels its models use), ``angles_ok``
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
 ``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~scatterbench.models.kernels.aperture`'s
 ``nodes`` and ``rotate_sum``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
@@ -129,20 +130,23 @@ with _caching_in(cache_dir()):
 #: says when a kernel compiles (the command line shows it: ``scatterbench.validation.cli``)
 log = logging.getLogger(__name__)
 _READY = set()  # the entries this process has called (loaded from the cache or compiled)
-_READY_SAID = []  # whether this process has named the cache folder yet
+_SAID = set()  # the kernels this process has said it compiles
 
 
 def _announced(fn):
-    """``fn``, after saying, on its first call in this process, when it is not in the cache
-    yet: the command line shows that the kernels compile once per machine."""
+    """``fn``, after saying, on the first call in this process of an entry of a kernel that is
+    not in the cache yet, that the kernel compiles (once per kernel, not per entry: a first
+    report printed 64 lines): the command line shows that the kernels compile once per machine."""
     if fn not in _READY:
         _READY.add(fn)
         cache = getattr(fn, "_cache", None)  # None: a Python function (NUMBA_DISABLE_JIT=1)
         if cache is not None and not os.path.exists(cache._cache_file._index_path):
-            # the cache folder once per process: a first run prints a line per loop
-            where = "" if _READY_SAID else f": cached in {cache._cache_path}"
-            _READY_SAID.append(True)
-            log.info("compiling the %s kernel loop (once per machine%s)", fn.__name__, where)
+            kernel = getattr(fn.py_func, "kernel", fn.__name__)  # drive.named's
+            if kernel not in _SAID:
+                # the cache folder once per process
+                where = "" if _SAID else f": cached in {cache._cache_path}"
+                _SAID.add(kernel)
+                log.info("compiling the %s kernel (once per machine%s)", kernel, where)
     return fn
 
 

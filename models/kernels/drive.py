@@ -130,6 +130,7 @@ def named(code, tag=""):
 
     def rename(fn):
         fn.__name__ = fn.__qualname__ = f"{fn.__name__}_{NAMES[code]}{'_' + tag if tag else ''}"
+        fn.kernel = NAMES[code]  # the compile notice names the kernel, once (kernels._announced)
         return fn
 
     return rename

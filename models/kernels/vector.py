@@ -163,11 +163,15 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
     if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
         raise errors.RequireLiteralValue("blocks' kernel code and options must be constants")
     kernel = KERNELS[code.literal_value]
-    o = (k0.literal_value, k1.literal_value, k2.literal_value)
+    o0, o1, o2 = k0.literal_value, k1.literal_value, k2.literal_value
 
     # the loop written here, with the kernel and its options constants of it (a dispatcher
-    # passed as an argument to a compiled function is a Python object: no caching)
+    # passed as an argument to a compiled function is a Python object: no caching).  The
+    # options reach _loop typed int64, not as literals: numba then types _loop and the kernel
+    # once per kernel, not once per option set (17 sets in a report: 35 s of a cold run),
+    # and LLVM, inlining _loop here, still folds them as constants
     def impl(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+        o = (np.int64(o0), np.int64(o1), np.int64(o2))
         sc = np.empty(_ROWS * VBLOCK)
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
@@ -183,9 +187,18 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
 def entries(code, opts) -> Entries:
     """:func:`scatterbench.models.kernels.drive.entries` on SIMD lanes (``run``, ``run_parallel``,
     ``run_checked``; float64) for kernel ``code`` with options ``opts`` (:func:`lane_options`):
-    closures over those ints, each compiling its one loop."""
+    closures over those ints.  The loop is compiled once, in ``run_range``; the others call it
+    (numba links its compiled code into theirs), so that a cold cache types and optimizes
+    each loop once, not once per entry (``run_parallel`` typed it again in its ``prange`` body:
+    7-9 s of a cold first call)."""
     k0, k1, k2 = opts
     tag = "_".join(str(k) for k in opts)
+
+    @njit(cache=True, error_model="numpy")
+    @named(code, tag)
+    def run_range(ti, tr, pr, prm, out, start, lo, hi):
+        """Geometries ``lo .. hi - 1`` into ``out[:, start + i]`` (:func:`blocks`)."""
+        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi)
 
     @njit(cache=True, error_model="numpy")
     @named(code, tag)
@@ -193,7 +206,7 @@ def entries(code, opts) -> Entries:
         """The scalar ``run`` (same arguments, float64) on SIMD lanes."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
         # np.int64(0), not 0: see drive.entries
-        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, np.int64(0), n)
+        run_range(ti, tr, pr, prm, out, start, np.int64(0), n)
 
     @njit(cache=True, error_model="numpy")
     @named(code, tag)
@@ -202,7 +215,7 @@ def entries(code, opts) -> Entries:
         if not angles_ok(ti, tr, pr):
             return False
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
+        run_range(ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
         return True
 
     @njit(cache=True, error_model="numpy", parallel=True)
@@ -212,7 +225,7 @@ def entries(code, opts) -> Entries:
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
         for blk in prange((n + BLOCK - 1) // BLOCK):
             lo = blk * BLOCK
-            blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
+            run_range(ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
 
     return Entries(run, run_parallel, run_checked, None)
 
