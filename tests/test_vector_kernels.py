@@ -250,3 +250,20 @@ def test_only_the_entry_points_are_cached():
         assert fn._cache._cache_path.startswith(models.kernels.cache_dir()), fn
     names = {fn.py_func.__qualname__ for fn in per_kernel if fn is not None}
     assert len(names) == len([e for e in per_kernel if e is not None])  # cache files of their own
+
+
+def test_option_sets_are_every_set_the_lanes_take():
+    """:func:`~scatterbench.models.kernels.vector.option_sets` (what ``kernels.warm`` compiles
+    ahead) holds every option set :func:`~scatterbench.models.kernels.vector.lane_options` gives a
+    vectorized kernel, over every option value a kernel reads: a set missing there compiles
+    lazily, in each process that reaches it, on a report's first run."""
+    seen = {c: set() for c in drive.CODES.values()}
+    for code in drive.CODES.values():
+        # o[0]: slope kind or form; o[1]: convention or shadowing; o[2]: Cook-Torrance's
+        # shadowing (3 kinds) or Maxwell-Beard's polarized flag (2)
+        for iopt in np.ndindex(8, 2, 2 if code == drive.MAXWELL else 3):
+            iopt = np.array(iopt, dtype=np.int64)
+            if vector.vectorized(code, iopt):
+                seen[code].add(vector.lane_options(code, iopt))
+    for code, sets in seen.items():
+        assert sets == set(vector.option_sets(code)), (drive.NAMES[code], sets)

@@ -150,6 +150,53 @@ def _announced(fn):
     return fn
 
 
+def _signatures(precision) -> dict:
+    """The argument types :class:`Compiled` calls each entry with in ``precision``."""
+    from numba import types
+
+    f = getattr(types, precision)
+    a1, a2, i = types.Array(f, 1, "C"), types.Array(f, 2, "C"), types.int64
+    io = types.Array(types.int64, 1, "C")
+    run = (a1, a1, a1, a2, io, a2, i)
+    return {"run": run, "run_parallel": run, "run_checked": run[:-1], "run_one": (f, f, f, a2, io, a2),
+            "run_range": (a1, a1, a1, a2, a2, i, i, i)}  # fmt: skip
+
+
+def _warm_entries(kernel, precision):
+    """``(entry, signature)`` of every entry :class:`Compiled` may call for kernel ``kernel`` in
+    ``precision``: the scalar ones, and in float64 those of every option set on SIMD lanes."""
+    code, sigs = drive.CODES[kernel], _signatures(precision)
+    if precision != "float64":  # float32 takes call() alone: run or run_parallel
+        return [(getattr(drive.ENTRIES[code], n), sigs[n]) for n in ("run", "run_parallel")]
+    lanes = [vector.lanes_of(code, o) for o in vector.option_sets(code)]
+    # on lanes, call() takes run_range itself: their run entries never run
+    return [(fn, sigs[n]) for n, fn in drive.ENTRIES[code]._asdict().items() if fn is not None] + [
+        (getattr(es, n), sigs[n]) for es in lanes for n in ("run_range", "run_checked", "run_parallel")
+    ]
+
+
+def cold(kernel, precision="float64") -> bool:
+    """Whether an entry of :func:`warm`'s is not in the cache yet."""
+    return any(
+        not os.path.exists(fn._cache._cache_file._index_path)
+        for fn, _ in _warm_entries(kernel, precision)
+        if getattr(fn, "_cache", None) is not None
+    )
+
+
+def warm(kernel, precision="float64"):
+    """Compile (or load from the cache) every entry of kernel ``kernel`` (a name of
+    :data:`~scatterbench.models.kernels.drive.CODES`) that :class:`Compiled` may call in ``precision``,
+    for the argument types it passes, without running it: a first run compiles the kernels
+    on its worker processes at once, each a different kernel, before it needs them
+    (``scatterbench report``).  One process per kernel: its entries share the kernel's
+    typing.  Returns ``kernel``."""
+    for fn, sig in _warm_entries(kernel, precision):
+        if hasattr(fn, "compile"):  # not a Python function (NUMBA_DISABLE_JIT=1)
+            fn.compile(sig)
+    return kernel
+
+
 def _mutable(x):
     """``x``, or a copy of it when it is read-only (a cached array, a user's frozen one)."""
     return x if x.flags.writeable else x.copy()
@@ -225,10 +272,14 @@ class Compiled:
         """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
         loops = self.lanes if precision == "float64" and self.vectorized else self.scalar
-        fn = _announced(loops.run_parallel if n >= PARALLEL_MIN else loops.run)
         # contiguous, writable inputs: one compiled specialization per entry and precision
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
+        if n < PARALLEL_MIN and loops.run_range is not None:
+            # the vector loop itself: its run entry, one more copy of the loop, never compiles
+            _announced(loops.run_range)(ti, tr, pr, self.params(precision), out, start, 0, n)
+            return
+        fn = _announced(loops.run_parallel if n >= PARALLEL_MIN else loops.run)
         fn(ti, tr, pr, self.params(precision), self.iopt, out, start)
 
     def run(self, ti, tr, pr, rows):

@@ -227,7 +227,7 @@ def entries(code, opts) -> Entries:
             lo = blk * BLOCK
             run_range(ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
 
-    return Entries(run, run_parallel, run_checked, None)
+    return Entries(run, run_parallel, run_checked, None, run_range)
 
 
 #: numba's cache directory when this module was imported (:mod:`scatterbench.models.kernels`
@@ -236,10 +236,31 @@ _CACHE_DIR = config.CACHE_DIR
 _ENTRIES = {}
 
 
+def option_sets(code) -> list:
+    """Every option set :func:`lane_options` gives kernel ``code`` (20 in all): what
+    :func:`scatterbench.models.kernels.warm` compiles."""
+    if code == FACET:
+        return [(k, NO_SHADOWING, 0) for k in FACET_KINDS]
+    if code == SINGLE:
+        return [(0, 0, 0), (1, 0, 0)]
+    if code == DIFFUSE:
+        return [(0, 0, 0)]
+    if code == COOK:
+        return [(a, b, c) for a in (0, 1) for b in (0, 1) for c in (NO_COOK_SHADOWING, BLINN)]
+    if code == MAXWELL:
+        return [(k, NO_SHADOWING, c) for k in FACET_KINDS for c in (0, 1)]
+    return []  # no lanes (FacetBTDF)
+
+
 def lane_entries(code, iopt) -> Entries:
     """The vector entries of kernel ``code`` with options ``iopt``: made on first use, once
     per process (there are 20 variants; a run uses a few)."""
-    key = (code, lane_options(code, iopt))
+    return lanes_of(code, lane_options(code, iopt))
+
+
+def lanes_of(code, opts) -> Entries:
+    """The vector entries of kernel ``code`` with the option set ``opts`` (:func:`lane_options`)."""
+    key = (int(code), tuple(int(x) for x in opts))  # ints: the closures' cells key the cache
     got = _ENTRIES.get(key)
     if got is None:
         old, config.CACHE_DIR = config.CACHE_DIR, _CACHE_DIR  # numba reads it when decorating
