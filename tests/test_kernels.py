@@ -338,3 +338,30 @@ def test_warm_compiles_the_types_the_calls_use():
         assert sig in fn.signatures, (fn, sig)
         assert fn.signatures == before[fn], (fn, before[fn], fn.signatures)
     assert not kernels.cold("diffuse") and not kernels.cold("diffuse", "float32")
+
+
+_LANE_CALLS = """
+import numpy as np
+from scatterbench import models
+m = models.SingleScatterBRDF()
+t = np.linspace(0.0, 1.2, 5000)
+m.mueller(0.3, t[:100], 0.5)
+m.mueller(0.3, t, 0.5)
+"""
+
+
+def test_a_second_process_loads_the_vector_entries_without_compiling(tmp_path):
+    """A second process making the same vector calls (small and parallel) loads every entry
+    from the cache: no cache file is added or rewritten.  Fails when an entry's cache key
+    differs between processes (a closure holding a dispatcher: its pickled form, which keys
+    the cache, is new in each process, so every run compiled the loops again)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+
+    def files():
+        return {p.name: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+
+    subprocess.run([sys.executable, "-c", _LANE_CALLS], env=env, check=True)
+    first = files()
+    assert any("run_parallel_single_" in name for name in first), sorted(first)
+    subprocess.run([sys.executable, "-c", _LANE_CALLS], env=env, check=True)
+    assert files() == first

@@ -184,6 +184,27 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
     return impl
 
 
+def lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+    """The ``run_range`` entry of kernel ``code`` with options ``(k0, k1, k2)``: compiled code
+    finds it while typing (:func:`_lane_range_of`), Python (``NUMBA_DISABLE_JIT=1``) here."""
+    lanes_of(code, (k0, k1, k2)).run_range(ti, tr, pr, prm, out, start, lo, hi)
+
+
+@overload(lane_range, prefer_literal=True)
+def _lane_range_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+    """``lane_range`` with constant code and options: a call of that cached ``run_range``.
+    Looked up here, not held in the entries' closures: numba keys a closure's cache by its
+    pickled cells, and a dispatcher pickles differently in every process (each recompiled)."""
+    if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
+        raise errors.RequireLiteralValue("lane_range's kernel code and options must be constants")
+    fn = lanes_of(code.literal_value, (k0.literal_value, k1.literal_value, k2.literal_value)).run_range
+
+    def impl(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+        fn(ti, tr, pr, prm, out, start, lo, hi)
+
+    return impl
+
+
 def entries(code, opts) -> Entries:
     """:func:`scatterbench.models.kernels.drive.entries` on SIMD lanes (``run``, ``run_parallel``,
     ``run_checked``; float64) for kernel ``code`` with options ``opts`` (:func:`lane_options`):
@@ -206,7 +227,7 @@ def entries(code, opts) -> Entries:
         """The scalar ``run`` (same arguments, float64) on SIMD lanes."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
         # np.int64(0), not 0: see drive.entries
-        run_range(ti, tr, pr, prm, out, start, np.int64(0), n)
+        lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, np.int64(0), n)
 
     @njit(cache=True, error_model="numpy")
     @named(code, tag)
@@ -215,7 +236,7 @@ def entries(code, opts) -> Entries:
         if not angles_ok(ti, tr, pr):
             return False
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        run_range(ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
+        lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
         return True
 
     @njit(cache=True, error_model="numpy", parallel=True)
@@ -225,7 +246,7 @@ def entries(code, opts) -> Entries:
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
         for blk in prange((n + BLOCK - 1) // BLOCK):
             lo = blk * BLOCK
-            run_range(ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
+            lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
 
     return Entries(run, run_parallel, run_checked, None, run_range)
 
