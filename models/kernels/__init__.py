@@ -26,6 +26,10 @@ to an installed, read-only package.  ``<hash>`` covers every kernel source file,
 edit to a shared helper recompiles the kernels that inline it (numba alone only notices
 changes to the file of the function itself).
 
+A first ``scatterbench report`` on worker processes compiles the kernels ahead, a kernel per
+process at once (:func:`warm`, ``validation.report.build.compile_ahead``); elsewhere each
+entry compiles on its first call.
+
 Only the entry points that Python calls are cached: per kernel, ``run``, ``run_parallel``,
 ``run_checked`` and ``run_one`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel
 and option set the first three of :func:`~scatterbench.models.kernels.vector.lane_entries` and the
