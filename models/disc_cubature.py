@@ -222,6 +222,9 @@ class Disc:
 
         shape = np.broadcast_shapes((rows.size, 1), np.shape(v), np.shape(chi), np.shape(w))
         v, chi, w = (np.ascontiguousarray(np.broadcast_to(a, shape), dtype=float) for a in (v, chi, w))
+        # writable: a read-only view (broadcast_to of an array of that shape already) is
+        # another argument type, which compiled the loop a second time (6 s on a cold cache)
+        v, chi, w = (a if a.flags.writeable else a.copy() for a in (v, chi, w))
         psi, Phi, J = np.empty(v.shape), np.empty(v.shape), np.empty(v.shape)
         disc.points(self.k, self.h1, self.tan_c[rows], self.sec_c[rows], self.on_h[rows], self.ox[rows],
                     self.xc[rows], v, chi, w, psi, Phi, J)  # fmt: skip

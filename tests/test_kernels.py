@@ -287,7 +287,7 @@ def test_one_compiled_specialization_per_entry_and_precision():
         m.mueller(frozen[:3], 0.3, 0.2)
         m.mueller(0.3, 0.2, 0.1)
     entries = [e for c in (drive.FACET, drive.MAXWELL) for e in drive.ENTRIES[c][:3]]
-    entries += [e for k in vector._ENTRIES.values() for e in k[:3]]
+    entries += [e for k in vector._ENTRIES.values() for e in (*k[:3], k.run_range)]
     assert len(entries) > 6  # the vector entries the calls above made
     for entry in entries:
         for sig in entry.signatures:
@@ -311,12 +311,61 @@ def test_a_first_call_compiles_its_own_kernel_alone_and_says_so(tmp_path):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     runs = [subprocess.run([sys.executable, "-c", _FIRST_CALL], env=env, capture_output=True, text=True, check=True)
             for _ in range(2)]  # fmt: skip
-    assert runs[0].stderr.count("compiling the run_one_diffuse kernel loop (once per machine") == 1, runs[
-        0
-    ].stderr
+    assert runs[0].stderr.count("compiling the diffuse kernel (once per machine") == 1, runs[0].stderr
+    assert runs[0].stderr.count("compiling") == 1, runs[0].stderr
     assert "compiling" not in runs[1].stderr, runs[1].stderr
     cached = {p.name.split("-")[0] for p in tmp_path.rglob("*.nbi")}
     assert cached == {"drive.run_one_diffuse"}, cached
+
+
+def test_warm_compiles_the_types_the_calls_use():
+    """:func:`scatterbench.models.kernels.warm` compiles each entry for the argument types that
+    :class:`~scatterbench.models.kernels.Compiled` passes it: after it, one geometry, 100, 5000
+    and 5000 in float32 add no specialization (a report's first run compiles ahead on its
+    workers, ``validation.report.build.compile_ahead``; a type apart compiled again)."""
+    from scatterbench.models import kernels
+
+    kernels.warm("diffuse")
+    kernels.warm("diffuse", "float32")
+    entries = kernels._warm_entries("diffuse", "float64") + kernels._warm_entries("diffuse", "float32")
+    before = {fn: list(fn.signatures) for fn, _ in entries}
+    m = models.DiffuseSubsurfaceBRDF()
+    t = np.linspace(0.0, 1.2, 5000)
+    for call in (lambda: m.mueller(0.3, 0.2, 0.1), lambda: m.mueller(0.3, t[:100], 0.5),
+                 lambda: m.mueller(0.3, t, 0.5), lambda: m.mueller(0.3, t, 0.5, precision="float32"),
+                 lambda: m.mueller(0.3, t[:100], 0.5, precision="float32")):  # fmt: skip
+        call()
+    for fn, sig in entries:
+        assert sig in fn.signatures, (fn, sig)
+        assert fn.signatures == before[fn], (fn, before[fn], fn.signatures)
+    assert not kernels.cold("diffuse") and not kernels.cold("diffuse", "float32")
+
+
+_LANE_CALLS = """
+import numpy as np
+from scatterbench import models
+m = models.SingleScatterBRDF()
+t = np.linspace(0.0, 1.2, 5000)
+m.mueller(0.3, t[:100], 0.5)
+m.mueller(0.3, t, 0.5)
+"""
+
+
+def test_a_second_process_loads_the_vector_entries_without_compiling(tmp_path):
+    """A second process making the same vector calls (small and parallel) loads every entry
+    from the cache: no cache file is added or rewritten.  Fails when an entry's cache key
+    differs between processes (a closure holding a dispatcher: its pickled form, which keys
+    the cache, is new in each process, so every run compiled the loops again)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+
+    def files():
+        return {p.name: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+
+    subprocess.run([sys.executable, "-c", _LANE_CALLS], env=env, check=True)
+    first = files()
+    assert any("run_parallel_single_" in name for name in first), sorted(first)
+    subprocess.run([sys.executable, "-c", _LANE_CALLS], env=env, check=True)
+    assert files() == first
 
 
 NARROW = [

@@ -103,7 +103,7 @@ for m in (models.FacetBRDF(), models.CookTorranceBRDF(), models.VarnishedCookTor
     k = Compiled(m, *m._kernel_spec())
     k.run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
     k.scalar.run(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], k.iopt, np.empty((16, 4)), 0)
-    for name, fn in (("lanes", k.lanes.run), ("scalar", k.scalar.run)):
+    for name, fn in (("lanes", k.lanes.run_range), ("scalar", k.scalar.run)):  # run_range: the loop
         ir = "".join(fn.inspect_llvm().values())
         print(type(m).__name__, name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
 """
@@ -123,7 +123,7 @@ common.stroke_d(0.1, 0.2, 0.9, 0.3, 0.3, 1.0, 0.0)
 def test_the_lanes_are_vectorized_loops(tmp_path):
     """In a process that compiles the vector loop (its IR is inspected: a function loaded
     from the cache has none), after an earlier process filled the cache with some of the
-    kernels' helpers: each model's vector entry (:func:`scatterbench.models.kernels.vector.lane_entries`)
+    kernels' helpers: each model's vector loop (``run_range`` of :func:`scatterbench.models.kernels.vector.lane_entries`)
     holds LLVM's vectorized loops (their ``vector.body`` blocks, on ``<N x double>`` values);
     its scalar entry (:mod:`~scatterbench.models.kernels.drive`) has none.  Fails when a change puts a call or an exception
     back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
@@ -250,3 +250,20 @@ def test_only_the_entry_points_are_cached():
         assert fn._cache._cache_path.startswith(models.kernels.cache_dir()), fn
     names = {fn.py_func.__qualname__ for fn in per_kernel if fn is not None}
     assert len(names) == len([e for e in per_kernel if e is not None])  # cache files of their own
+
+
+def test_option_sets_are_every_set_the_lanes_take():
+    """:func:`~scatterbench.models.kernels.vector.option_sets` (what ``kernels.warm`` compiles
+    ahead) holds every option set :func:`~scatterbench.models.kernels.vector.lane_options` gives a
+    vectorized kernel, over every option value a kernel reads: a set missing there compiles
+    lazily, in each process that reaches it, on a report's first run."""
+    seen = {c: set() for c in drive.CODES.values()}
+    for code in drive.CODES.values():
+        # o[0]: slope kind or form; o[1]: convention or shadowing; o[2]: Cook-Torrance's
+        # shadowing (3 kinds) or Maxwell-Beard's polarized flag (2)
+        for iopt in np.ndindex(8, 2, 2 if code == drive.MAXWELL else 3):
+            iopt = np.array(iopt, dtype=np.int64)
+            if vector.vectorized(code, iopt):
+                seen[code].add(vector.lane_options(code, iopt))
+    for code, sets in seen.items():
+        assert sets == set(vector.option_sets(code)), (drive.NAMES[code], sets)

@@ -26,10 +26,15 @@ to an installed, read-only package.  ``<hash>`` covers every kernel source file,
 edit to a shared helper recompiles the kernels that inline it (numba alone only notices
 changes to the file of the function itself).
 
+A first ``scatterbench report`` on worker processes compiles the kernels ahead, a kernel per
+process at once (:func:`warm`, ``validation.report.build.compile_ahead``); elsewhere each
+entry compiles on its first call.
+
 Only the entry points that Python calls are cached: per kernel, ``run``, ``run_parallel``,
 ``run_checked`` and ``run_one`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel
-and option set the first three of :func:`~scatterbench.models.kernels.vector.lane_entries` (closures
-over the kernel's code, so that a run compiles only the kernels its models use), ``angles_ok``
+and option set the first three of :func:`~scatterbench.models.kernels.vector.lane_entries` and the
+``run_range`` loop they call (closures over the kernel's code, so that a run compiles only
+the kernels its models use), ``angles_ok``
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
 ``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~scatterbench.models.kernels.aperture`'s
 ``nodes`` and ``rotate_sum``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
@@ -129,21 +134,71 @@ with _caching_in(cache_dir()):
 #: says when a kernel compiles (the command line shows it: ``scatterbench.validation.cli``)
 log = logging.getLogger(__name__)
 _READY = set()  # the entries this process has called (loaded from the cache or compiled)
-_READY_SAID = []  # whether this process has named the cache folder yet
+_SAID = set()  # the kernels this process has said it compiles
 
 
 def _announced(fn):
-    """``fn``, after saying, on its first call in this process, when it is not in the cache
-    yet: the command line shows that the kernels compile once per machine."""
+    """``fn``, after saying, on the first call in this process of an entry of a kernel that is
+    not in the cache yet, that the kernel compiles (once per kernel, not per entry: a first
+    report printed 64 lines): the command line shows that the kernels compile once per machine."""
     if fn not in _READY:
         _READY.add(fn)
         cache = getattr(fn, "_cache", None)  # None: a Python function (NUMBA_DISABLE_JIT=1)
         if cache is not None and not os.path.exists(cache._cache_file._index_path):
-            # the cache folder once per process: a first run prints a line per loop
-            where = "" if _READY_SAID else f": cached in {cache._cache_path}"
-            _READY_SAID.append(True)
-            log.info("compiling the %s kernel loop (once per machine%s)", fn.__name__, where)
+            kernel = getattr(fn.py_func, "kernel", fn.__name__)  # drive.named's
+            if kernel not in _SAID:
+                # the cache folder once per process
+                where = "" if _SAID else f": cached in {cache._cache_path}"
+                _SAID.add(kernel)
+                log.info("compiling the %s kernel (once per machine%s)", kernel, where)
     return fn
+
+
+def _signatures(precision) -> dict:
+    """The argument types :class:`Compiled` calls each entry with in ``precision``."""
+    from numba import types
+
+    f = getattr(types, precision)
+    a1, a2, i = types.Array(f, 1, "C"), types.Array(f, 2, "C"), types.int64
+    io = types.Array(types.int64, 1, "C")
+    run = (a1, a1, a1, a2, io, a2, i)
+    return {"run": run, "run_parallel": run, "run_checked": run[:-1], "run_one": (f, f, f, a2, io, a2),
+            "run_range": (a1, a1, a1, a2, a2, i, i, i)}  # fmt: skip
+
+
+def _warm_entries(kernel, precision):
+    """``(entry, signature)`` of every entry :class:`Compiled` may call for kernel ``kernel`` in
+    ``precision``: the scalar ones, and in float64 those of every option set on SIMD lanes."""
+    code, sigs = drive.CODES[kernel], _signatures(precision)
+    if precision != "float64":  # float32 takes call() alone: run or run_parallel
+        return [(getattr(drive.ENTRIES[code], n), sigs[n]) for n in ("run", "run_parallel")]
+    lanes = [vector.lanes_of(code, o) for o in vector.option_sets(code)]
+    # on lanes, call() takes run_range itself: their run entries never run
+    return [(fn, sigs[n]) for n, fn in drive.ENTRIES[code]._asdict().items() if fn is not None] + [
+        (getattr(es, n), sigs[n]) for es in lanes for n in ("run_range", "run_checked", "run_parallel")
+    ]
+
+
+def cold(kernel, precision="float64") -> bool:
+    """Whether an entry of :func:`warm`'s is not in the cache yet."""
+    return any(
+        not os.path.exists(fn._cache._cache_file._index_path)
+        for fn, _ in _warm_entries(kernel, precision)
+        if getattr(fn, "_cache", None) is not None
+    )
+
+
+def warm(kernel, precision="float64"):
+    """Compile (or load from the cache) every entry of kernel ``kernel`` (a name of
+    :data:`~scatterbench.models.kernels.drive.CODES`) that :class:`Compiled` may call in ``precision``,
+    for the argument types it passes, without running it: a first run compiles the kernels
+    on its worker processes at once, each a different kernel, before it needs them
+    (``scatterbench report``).  One process per kernel: its entries share the kernel's
+    typing.  Returns ``kernel``."""
+    for fn, sig in _warm_entries(kernel, precision):
+        if hasattr(fn, "compile"):  # not a Python function (NUMBA_DISABLE_JIT=1)
+            fn.compile(sig)
+    return kernel
 
 
 def _mutable(x):
@@ -221,10 +276,14 @@ class Compiled:
         """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
         loops = self.lanes if precision == "float64" and self.vectorized else self.scalar
-        fn = _announced(loops.run_parallel if n >= PARALLEL_MIN else loops.run)
         # contiguous, writable inputs: one compiled specialization per entry and precision
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
+        if n < PARALLEL_MIN and loops.run_range is not None:
+            # the vector loop itself: its run entry, one more copy of the loop, never compiles
+            _announced(loops.run_range)(ti, tr, pr, self.params(precision), out, start, 0, n)
+            return
+        fn = _announced(loops.run_parallel if n >= PARALLEL_MIN else loops.run)
         fn(ti, tr, pr, self.params(precision), self.iopt, out, start)
 
     def run(self, ti, tr, pr, rows):

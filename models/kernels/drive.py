@@ -114,12 +114,15 @@ def _serial_of(code, ti, tr, pr, prm, o, out, start, lo, hi):
 
 
 class Entries(NamedTuple):
-    """One kernel's cached entry points (:func:`entries`)."""
+    """One kernel's cached entry points (:func:`entries`); ``run_range`` (the vector ones':
+    :func:`scatterbench.models.kernels.vector.entries`) is the loop the others call, called
+    directly for a serial call of known length."""
 
     run: object
     run_parallel: object
     run_checked: object
     run_one: object
+    run_range: object = None
 
 
 def named(code, tag=""):
@@ -130,6 +133,7 @@ def named(code, tag=""):
 
     def rename(fn):
         fn.__name__ = fn.__qualname__ = f"{fn.__name__}_{NAMES[code]}{'_' + tag if tag else ''}"
+        fn.kernel = NAMES[code]  # the compile notice names the kernel, once (kernels._announced)
         return fn
 
     return rename

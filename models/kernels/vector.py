@@ -163,11 +163,15 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
     if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
         raise errors.RequireLiteralValue("blocks' kernel code and options must be constants")
     kernel = KERNELS[code.literal_value]
-    o = (k0.literal_value, k1.literal_value, k2.literal_value)
+    o0, o1, o2 = k0.literal_value, k1.literal_value, k2.literal_value
 
     # the loop written here, with the kernel and its options constants of it (a dispatcher
-    # passed as an argument to a compiled function is a Python object: no caching)
+    # passed as an argument to a compiled function is a Python object: no caching).  The
+    # options reach _loop typed int64, not as literals: numba then types _loop and the kernel
+    # once per kernel, not once per option set (17 sets in a report: 35 s of a cold run),
+    # and LLVM, inlining _loop here, still folds them as constants
     def impl(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+        o = (np.int64(o0), np.int64(o1), np.int64(o2))
         sc = np.empty(_ROWS * VBLOCK)
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
@@ -180,12 +184,42 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
     return impl
 
 
+def lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+    """The ``run_range`` entry of kernel ``code`` with options ``(k0, k1, k2)``: compiled code
+    finds it while typing (:func:`_lane_range_of`), Python (``NUMBA_DISABLE_JIT=1``) here."""
+    lanes_of(code, (k0, k1, k2)).run_range(ti, tr, pr, prm, out, start, lo, hi)
+
+
+@overload(lane_range, prefer_literal=True)
+def _lane_range_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+    """``lane_range`` with constant code and options: a call of that cached ``run_range``.
+    Looked up here, not held in the entries' closures: numba keys a closure's cache by its
+    pickled cells, and a dispatcher pickles differently in every process (each recompiled)."""
+    if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
+        raise errors.RequireLiteralValue("lane_range's kernel code and options must be constants")
+    fn = lanes_of(code.literal_value, (k0.literal_value, k1.literal_value, k2.literal_value)).run_range
+
+    def impl(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+        fn(ti, tr, pr, prm, out, start, lo, hi)
+
+    return impl
+
+
 def entries(code, opts) -> Entries:
     """:func:`scatterbench.models.kernels.drive.entries` on SIMD lanes (``run``, ``run_parallel``,
     ``run_checked``; float64) for kernel ``code`` with options ``opts`` (:func:`lane_options`):
-    closures over those ints, each compiling its one loop."""
+    closures over those ints.  The loop is compiled once, in ``run_range``; the others call it
+    (numba links its compiled code into theirs), so that a cold cache types and optimizes
+    each loop once, not once per entry (``run_parallel`` typed it again in its ``prange`` body:
+    7-9 s of a cold first call)."""
     k0, k1, k2 = opts
     tag = "_".join(str(k) for k in opts)
+
+    @njit(cache=True, error_model="numpy")
+    @named(code, tag)
+    def run_range(ti, tr, pr, prm, out, start, lo, hi):
+        """Geometries ``lo .. hi - 1`` into ``out[:, start + i]`` (:func:`blocks`)."""
+        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi)
 
     @njit(cache=True, error_model="numpy")
     @named(code, tag)
@@ -193,7 +227,7 @@ def entries(code, opts) -> Entries:
         """The scalar ``run`` (same arguments, float64) on SIMD lanes."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
         # np.int64(0), not 0: see drive.entries
-        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, np.int64(0), n)
+        lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, np.int64(0), n)
 
     @njit(cache=True, error_model="numpy")
     @named(code, tag)
@@ -202,7 +236,7 @@ def entries(code, opts) -> Entries:
         if not angles_ok(ti, tr, pr):
             return False
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
+        lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
         return True
 
     @njit(cache=True, error_model="numpy", parallel=True)
@@ -212,9 +246,9 @@ def entries(code, opts) -> Entries:
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
         for blk in prange((n + BLOCK - 1) // BLOCK):
             lo = blk * BLOCK
-            blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
+            lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
 
-    return Entries(run, run_parallel, run_checked, None)
+    return Entries(run, run_parallel, run_checked, None, run_range)
 
 
 #: numba's cache directory when this module was imported (:mod:`scatterbench.models.kernels`
@@ -223,10 +257,31 @@ _CACHE_DIR = config.CACHE_DIR
 _ENTRIES = {}
 
 
+def option_sets(code) -> list:
+    """Every option set :func:`lane_options` gives kernel ``code`` (20 in all): what
+    :func:`scatterbench.models.kernels.warm` compiles."""
+    if code == FACET:
+        return [(k, NO_SHADOWING, 0) for k in FACET_KINDS]
+    if code == SINGLE:
+        return [(0, 0, 0), (1, 0, 0)]
+    if code == DIFFUSE:
+        return [(0, 0, 0)]
+    if code == COOK:
+        return [(a, b, c) for a in (0, 1) for b in (0, 1) for c in (NO_COOK_SHADOWING, BLINN)]
+    if code == MAXWELL:
+        return [(k, NO_SHADOWING, c) for k in FACET_KINDS for c in (0, 1)]
+    return []  # no lanes (FacetBTDF)
+
+
 def lane_entries(code, iopt) -> Entries:
     """The vector entries of kernel ``code`` with options ``iopt``: made on first use, once
     per process (there are 20 variants; a run uses a few)."""
-    key = (code, lane_options(code, iopt))
+    return lanes_of(code, lane_options(code, iopt))
+
+
+def lanes_of(code, opts) -> Entries:
+    """The vector entries of kernel ``code`` with the option set ``opts`` (:func:`lane_options`)."""
+    key = (int(code), tuple(int(x) for x in opts))  # ints: the closures' cells key the cache
     got = _ENTRIES.get(key)
     if got is None:
         old, config.CACHE_DIR = config.CACHE_DIR, _CACHE_DIR  # numba reads it when decorating
