@@ -39,7 +39,7 @@ def _both(kernel, ti, tr, pr):
     n = max(ti.size, prm.shape[1])
     a, b = np.empty((16, n)), np.empty((16, n))
     kernel.scalar.run(ti, tr, pr, prm, kernel.iopt, a, 0)
-    kernel.lanes.run(ti, tr, pr, prm, kernel.iopt, b, 0)
+    kernel.lanes.run_range(ti, tr, pr, prm, b, 0, 0, n)
     return a, b
 
 

@@ -206,7 +206,7 @@ def _lane_range_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
 
 
 def entries(code, opts) -> Entries:
-    """:func:`scatterbench.models.kernels.drive.entries` on SIMD lanes (``run``, ``run_parallel``,
+    """:func:`scatterbench.models.kernels.drive.entries` on SIMD lanes (``run_range``, ``run_parallel``,
     ``run_checked``; float64) for kernel ``code`` with options ``opts`` (:func:`lane_options`):
     closures over those ints.  The loop is compiled once, in ``run_range``; the others call it
     (numba links its compiled code into theirs), so that a cold cache types and optimizes
@@ -223,14 +223,6 @@ def entries(code, opts) -> Entries:
 
     @njit(cache=True, error_model="numpy")
     @named(code, tag)
-    def run(ti, tr, pr, prm, iopt, out, start):
-        """The scalar ``run`` (same arguments, float64) on SIMD lanes."""
-        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        # np.int64(0), not 0: see drive.entries
-        lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, np.int64(0), n)
-
-    @njit(cache=True, error_model="numpy")
-    @named(code, tag)
     def run_checked(ti, tr, pr, prm, iopt, out):
         """The scalar ``run_checked`` (same arguments, float64) on SIMD lanes."""
         if not angles_ok(ti, tr, pr):
@@ -242,13 +234,14 @@ def entries(code, opts) -> Entries:
     @njit(cache=True, error_model="numpy", parallel=True)
     @named(code, tag)
     def run_parallel(ti, tr, pr, prm, iopt, out, start):
-        """:func:`run` with blocks of :data:`scatterbench.models.kernels.drive.BLOCK` geometries over the cores."""
+        """``run_range`` in blocks of :data:`scatterbench.models.kernels.drive.BLOCK` geometries over the cores."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
         for blk in prange((n + BLOCK - 1) // BLOCK):
             lo = blk * BLOCK
             lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
 
-    return Entries(run, run_parallel, run_checked, None, run_range)
+    # no run entry: a serial call of known length takes run_range itself (Compiled.call)
+    return Entries(None, run_parallel, run_checked, None, run_range)
 
 
 #: numba's cache directory when this module was imported (:mod:`scatterbench.models.kernels`
