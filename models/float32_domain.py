@@ -104,8 +104,8 @@ from .kernel_specs import (
     EXPONENTIAL,
     GAUSSIAN,
     GGX,
-    KERNEL_ROWS,
     STROKE,
+    named_rows,
 )
 
 __all__ = [
@@ -300,7 +300,4 @@ def unsafe(model, code, rows, iopt):
 def model_unsafe(model):
     """:func:`unsafe` of a model a kernel covers (``model._kernel_spec()`` not ``None``): its
     kernel rows broadcast over a model set's elements."""
-    code, rows, options = model._kernel_spec()
-    values = np.broadcast_arrays(*(np.asarray(r, dtype=float) for r in rows))
-    named = {name: v.reshape(-1) for name, v in zip(KERNEL_ROWS[code], values, strict=True)}
-    return unsafe(model, code, named, options)
+    return unsafe(model, *named_rows(model))

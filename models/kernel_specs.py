@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-__all__ = ["SLOPE_CODES", "SHADOWING_KINDS", "slope_rows", "index_rows", "shadowing_kind"]
+__all__ = ["SLOPE_CODES", "SHADOWING_KINDS", "slope_rows", "index_rows", "shadowing_kind", "named_rows"]
 
 # The slope kinds the kernels know (models.kernels.common uses the same numbers); each slope
 # distribution class names its own as ``kernel_code`` (models.slopes).
@@ -78,3 +78,12 @@ def index_rows(index):
         return [math.inf, 0.0]
     z = complex(index)
     return [z.real, z.imag]
+
+
+def named_rows(model):
+    """``(code, rows, options)`` of a model a kernel covers (``model._kernel_spec()`` not
+    ``None``), ``rows`` by name (:data:`KERNEL_ROWS`), each broadcast over a model set's
+    elements and flat: what the float32 domain and the kernels' tolerance are derived from."""
+    code, rows, options = model._kernel_spec()
+    values = np.broadcast_arrays(*(np.asarray(r, dtype=float) for r in rows))
+    return code, {name: v.reshape(-1) for name, v in zip(KERNEL_ROWS[code], values, strict=True)}, options

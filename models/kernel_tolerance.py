@@ -63,8 +63,8 @@ from .kernel_specs import (
     EXPONENTIAL,
     GAUSSIAN,
     GGX,
-    KERNEL_ROWS,
     STROKE,
+    named_rows,
 )
 
 __all__ = [
@@ -160,8 +160,5 @@ def kernel_condition(code, rows, iopt):
 def kernel_tolerance(model) -> float:
     """``EPS * kappa`` of a model a kernel covers (``model._kernel_spec()`` not ``None``; a model
     set: its worst element)."""
-    code, rows, options = model._kernel_spec()
-    values = np.broadcast_arrays(*(np.asarray(r, dtype=float) for r in rows))
-    named = {name: v.reshape(-1) for name, v in zip(KERNEL_ROWS[code], values, strict=True)}
-    kappa, _ = kernel_condition(code, named, options)
+    kappa, _ = kernel_condition(*named_rows(model))
     return float(EPS * np.max(kappa))
