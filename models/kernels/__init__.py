@@ -154,6 +154,18 @@ def _announced(fn):
     return fn
 
 
+def announce(names, how=""):
+    """Say that the kernels ``names`` compile (``how``: e.g. on how many processes), once per
+    kernel and process: :func:`_announced` is then silent for their entries."""
+    todo = [k for k in dict.fromkeys(names) if k not in _SAID]
+    if todo:
+        where = f" {how}" if how else ""
+        log.info(
+            "compiling the %s kernels%s (once per machine: cached in %s)", ", ".join(todo), where, cache_dir()
+        )
+        _SAID.update(todo)
+
+
 def _signatures(precision) -> dict:
     """The argument types :class:`Compiled` calls each entry with in ``precision``."""
     from numba import types
@@ -173,7 +185,7 @@ def _warm_entries(kernel, precision):
     if precision != "float64":  # float32 takes call() alone: run or run_parallel
         return [(getattr(drive.ENTRIES[code], n), sigs[n]) for n in ("run", "run_parallel")]
     lanes = [vector.lanes_of(code, o) for o in vector.option_sets(code)]
-    # on lanes, call() takes run_range itself: their run entries never run
+    # on lanes, call() takes run_range itself (they have no run entry)
     return [(fn, sigs[n]) for n, fn in drive.ENTRIES[code]._asdict().items() if fn is not None] + [
         (getattr(es, n), sigs[n]) for es in lanes for n in ("run_range", "run_checked", "run_parallel")
     ]
@@ -280,7 +292,7 @@ class Compiled:
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
         if n < PARALLEL_MIN and loops.run_range is not None:
-            # the vector loop itself: its run entry, one more copy of the loop, never compiles
+            # the vector loop itself (the lanes have no run entry: one more copy of the loop)
             _announced(loops.run_range)(ti, tr, pr, self.params(precision), out, start, 0, n)
             return
         fn = _announced(loops.run_parallel if n >= PARALLEL_MIN else loops.run)

@@ -103,10 +103,7 @@ def compile_ahead(executor):
 
     todo = [task for task in REPORT_KERNELS if kernels.cold(*task)]
     if todo:
-        names = ", ".join(dict.fromkeys(k for k, _ in todo))
-        kernels.log.info("compiling the %s kernels on %d processes (once per machine: cached in %s)",
-                         names, executor.workers, kernels.cache_dir())  # fmt: skip
-        kernels._SAID.update(k for k, _ in todo)
+        kernels.announce([k for k, _ in todo], f"on {executor.workers} processes")
         executor.map(_warm, todo, tasks=len(todo))
 
 
