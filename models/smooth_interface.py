@@ -59,7 +59,7 @@ import numpy as np
 from scipy import integrate
 
 from .cubature import AccuracyWarning
-from .fresnel import _reflectance, coating_cos
+from .fresnel import coating_cos
 from .geometry import gauss_legendre
 from .thin_film import FilmStack
 
@@ -142,10 +142,19 @@ def internal_hemispherical_reflectance(n: float) -> float:
 def _rbar(n: float) -> float:
     if n == 1.0:
         return 0.0
+    if n == math.inf:  # a conductor: R = 1 everywhere (the float form below would give NaN)
+        return 1.0
+    nn = n * n
 
     def f(c):
-        rs, rp = _reflectance(np.array([c]), 1.0, n)
-        return float(rs[0] + rp[0]) * c  # 0.5 (Rs + Rp) * 2c
+        # 0.5 (Rs + Rp) * 2c: fresnel._reflectance(c, 1, n) written in floats, the operations
+        # numpy's complex ones reduce to with zero imaginary parts (w = sqrt(n^2 - 1 + c^2) is
+        # real for n > 1; a complex quotient is a * (1 / b)), so the same bits (tested) at
+        # 1/40 of the cost: a fit meets a new index per walker and wavelength at every step
+        w = math.sqrt((nn - 1.0) + c * c)
+        rs = (c - w) * (1.0 / (c + w))
+        rp = (nn * c - w) * (1.0 / (nn * c + w))
+        return (rs * rs + rp * rp) * c
 
     # The integrand has a branch point at c = i sqrt(n^2 - 1): near n = 1 it is
     # sharp close to c = 0, so give quad breakpoints there.

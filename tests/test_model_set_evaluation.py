@@ -81,3 +81,27 @@ def test_model_sets_use_the_float32_kernels_like_their_elements(cls, kwargs, tmp
         assert np.array_equal(B32[w], one.brdf(ti, tr, 0.3, precision="float32"))
         ref = one.mueller16(ti, tr, 0.3, precision="float32")[1]
         assert np.array_equal(np.asarray(mm).reshape(16, -1, len(ti))[:, w], ref)
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_indexed_gives_the_bits_of_the_set_broadcast_to_the_geometries(backend):
+    """``evaluation.indexed`` (a fit's walkers x wavelengths gathered per row) equals the set
+    whose parameters are the gathered ones, evaluated at the same angles, bit for bit, on
+    both routes (over two kernel chunks), and derives R-bar once per element, not per row."""
+    rng = np.random.default_rng(3)
+    coating = np.array([1.2, 1.35, 1.5, 1.7])
+    rho = np.array([0.5, 0.9, 0.95, 0.99])
+    n = models.evaluation.KERNEL_CHUNK + 1000
+    index = rng.integers(0, 4, n)
+    ti, tr, pr = rng.uniform(0, 1.5, n), rng.uniform(0, 1.5, n), rng.uniform(-3, 3, n)
+    small = models.DiffuseSubsurfaceBRDF(coating=coating, rho=rho) + models.FacetBRDF(
+        slopes=models.GaussianSlopes(np.array([0.1, 0.2, 0.3, 0.4])), substrate=1.5
+    )
+    whole = models.DiffuseSubsurfaceBRDF(coating=coating[index], rho=rho[index]) + models.FacetBRDF(
+        slopes=models.GaussianSlopes(np.array([0.1, 0.2, 0.3, 0.4])[index]), substrate=1.5
+    )
+    with models.evaluation.backend(backend):
+        for (_, a), (_, b) in zip(small.terms, whole.terms, strict=True):
+            got = models.evaluation.indexed(a, index, ti, tr, pr, np.empty((16, n)))
+            assert np.array_equal(got, b.mueller16(ti, tr, pr)[1])
+    assert small.terms[0][1].rbar.shape == (4,)

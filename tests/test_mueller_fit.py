@@ -434,3 +434,23 @@ def test_a_scene_with_films_fits_its_own_wavelength_only(nist):
     only = scene_mod.loads(text.replace("[fit.mueller]", "[fit.mueller]\nwavelengths_nm = [532]"), "<films>")
     lik = MuellerLikelihood(only, mueller_spec_from(only, d.wavelength_nm), d)
     assert set(lik.data.wavelength_nm) == {532.0}
+
+
+def test_a_refused_walker_is_minus_inf_alone(nist, one_thread):
+    """A position the scene refuses (an albedo above 1 at one wavelength) gives -inf for its
+    walker only; the others keep their own values, and the refusal names the parameter."""
+    from scatterbench.validation.fitting.mueller_fit import mueller_likelihood
+
+    d = nist.subset(np.arange(0, len(nist), 37))
+    lik = mueller_likelihood(scene_mod.load("references/scenes/ptfe_smooth_diffuse_joint.toml"), d)
+    b = lik.spec.u_bounds()
+    U = np.random.default_rng(2).uniform(b[:, 0], b[:, 1], (3, len(b)))
+    k = lik.spec.names.index("volume.rho@532")
+    U[1, k] = b[k, 1] + 10 * (b[k, 1] - b[k, 0])
+    assert lik.spec.free[k].from_u(U[1:2, k])[0] > 1
+    got = lik.pointwise_batch(U)
+    assert np.all(got[1] == -np.inf) and np.all(np.isfinite(got[[0, 2]]))
+    for w in (0, 2):
+        assert np.array_equal(got[w], lik.pointwise_batch(U[w : w + 1])[0])
+    with pytest.raises(ValueError, match="rho"):
+        lik.predict(U[1:2])

@@ -108,3 +108,28 @@ def test_depolarizing_single_structure():
 def test_bad_input(make, name):
     with pytest.raises(ValueError, match=name):
         make()
+
+
+def test_rbar_float_integrand_gives_the_complex_forms_bits():
+    """R-bar's quadrature integrates 0.5 (Rs + Rp) 2c in floats (a fit meets a new index per
+    walker and wavelength at every step); it gives the bits of fresnel's complex form, and so
+    the same R-bar, from just above 1 to the largest index."""
+    from scatterbench.models.fresnel import _reflectance
+    from scatterbench.models.smooth_interface import _rbar
+
+    def complex_form(n):
+        def f(c):
+            rs, rp = _reflectance(np.array([c]), 1.0, n)
+            return float(rs[0] + rp[0]) * c
+
+        pts = [min(0.5, 10.0 * math.sqrt(n * n - 1.0))]
+        val, _ = integrate.quad(f, 0.0, 1.0, points=pts, epsabs=1e-14, epsrel=1e-12, limit=200)
+        return 1.0 - (1.0 - val) / (n * n)
+
+    rng = np.random.default_rng(7)
+    for n in [1.0 + 1e-9, 1.0003, 1.33, 1.5, 2.4, 7.0, 1e4, 4.0 / np.finfo(float).eps] + list(
+        rng.uniform(1.0, 3.0, 12)
+    ):
+        _rbar.cache_clear()
+        assert _rbar(float(n)) == complex_form(float(n)), n
+    assert _rbar(math.inf) == 1.0

@@ -16,10 +16,11 @@ opposite azimuth where ``theta_i + d < 0``: :func:`~.mueller_data.fold_negative_
 the basis change is unchanged, a half-turn of the basis being the identity on Stokes vectors).
 
 Several wavelengths are fitted at once: a scene key's value is one per row, shared, per
-wavelength, from a dispersion law or from a named material, and every walker of an emcee step
-is one model set over ``(walkers, rows)`` evaluated in one call (the scene's
-:mod:`~scatterbench.models.scene.binding`); scenes that cannot be bound are rebuilt per walker
-and wavelength.  The log-likelihood omits the data-only constant ``-sum ln M11_obs``.
+wavelength, from a dispersion law or from a named material, and the walkers of an emcee step
+are one model set over ``(walkers, wavelengths)`` (the scene's
+:mod:`~scatterbench.models.scene.binding`), validated there and gathered per row into its
+models' kernels (:func:`~scatterbench.models.evaluation.indexed`); scenes that cannot be bound
+are rebuilt per walker and wavelength.  The log-likelihood omits the data-only constant ``-sum ln M11_obs``.
 """
 
 from __future__ import annotations
@@ -46,7 +47,13 @@ _LOG2PI = math.log(2.0 * math.pi)
 class Rows:
     """The rows of a :class:`MuellerData` as a model sees them: relative geometry, the index of
     each row's wavelength in ``wavelengths``, and the psps -> data-basis map of the elements
-    ``needed`` (``{element index: [(source index, coefficient per row)]}``)."""
+    ``needed`` (``{element index: [(source index, coefficient per row)]}``).
+
+    Every per-row value of a scene key is a function of the row's wavelength alone, so a batch
+    of walkers evaluates its model set per walker and distinct wavelength (``group``: each
+    row's, in ``group_wavelength_nm``) and gathers by row (:meth:`index`); the angles are
+    flattened over ``(walkers, rows)`` once per batch size, and the two azimuths of
+    :func:`~.mueller_data.fold_negative_polar` are found here, not per batch."""
 
     def __init__(self, data, wavelengths, needed):
         self.data = data
@@ -55,11 +62,46 @@ class Rows:
         pos = np.argmin(np.abs(data.wavelength_nm[:, None] - wl[None, :]), axis=1)
         self.wl_index = pos
         self.wavelength_nm = data.wavelength_nm
-        self.fixed = evaluation.FixedAngles(self.theta_i, self.theta_r, self.phi)
+        self.group_wavelength_nm, first, group = np.unique(
+            data.wavelength_nm, return_index=True, return_inverse=True
+        )
+        self.group = group.reshape(-1)
+        self.group_wl_index = pos[first]
+        # the azimuth fold_negative_polar gives each row at a positive and at a negative polar angle
+        self._phi_folded = tuple(
+            fold_negative_polar(np.full(len(self.phi), t), self.phi)[1] for t in (1.0, -1.0)
+        )
         self.map = _basis_map(data, needed)
+        self._flat = {}  # walkers: (theta_i, theta_r, phi, index), flat over (walkers, rows)
 
     def __len__(self):
         return len(self.theta_i)
+
+    def _tiled(self, walkers):
+        got = self._flat.get(walkers)
+        if got is None:
+            if len(self._flat) > 3:  # a few batch sizes in a fit; bounded for predictions
+                self._flat.clear()
+            G = len(self.group_wavelength_nm)
+            got = [np.tile(a, walkers) for a in (self.theta_i, self.theta_r, self.phi)]
+            got.append((np.arange(walkers)[:, None] * G + self.group[None, :]).reshape(-1))
+            self._flat[walkers] = got
+        return got
+
+    def index(self, walkers):
+        """The element of a ``(walkers, groups)`` model set (flat) that each flat
+        ``(walkers, rows)`` geometry takes."""
+        return self._tiled(walkers)[3]
+
+    def angles(self, off):
+        """``(theta_i, theta_r, phi)`` flat over ``(walkers, rows)`` at incidence offsets
+        ``off`` ``(W, 1)`` radians (:func:`_offset`'s values; the rows' own where all are 0)."""
+        ti, tr, phi, _ = self._tiled(len(off))
+        if not np.any(off != 0):
+            return ti, tr, phi
+        s = self.theta_i[None, :] + off
+        plain, turned = self._phi_folded
+        return np.abs(s).reshape(-1), tr, np.where(s < 0, turned[None, :], plain[None, :]).reshape(-1)
 
 
 def _basis_map(data, needed):
@@ -110,6 +152,14 @@ class MuellerLikelihood(BatchPosterior):
     def scene_values(self, U, rows):
         """The scene keys' values at positions ``U`` ``(W, k)``: ``(W, 1)`` where shared,
         ``(W, rows)`` where they depend on the wavelength."""
+        return {
+            key: v if v.shape[1] == 1 else np.broadcast_to(v[:, rows.group], (len(U), len(rows)))
+            for key, v in self._group_values(U, rows).items()
+        }
+
+    def _group_values(self, U, rows):
+        """:meth:`scene_values` per distinct wavelength of ``rows`` (``rows.group``): ``(W, 1)``
+        where shared, ``(W or 1, groups)`` where they depend on the wavelength."""
         spec, W = self.spec, len(U)
         out, per, disp = {}, {}, {}
         for i, p in enumerate(spec.free):
@@ -121,11 +171,11 @@ class MuellerLikelihood(BatchPosterior):
             elif p.role == "dispersion":
                 disp.setdefault(p.target, []).append(x)
         for key, cols in per.items():
-            out[key] = np.concatenate(cols, axis=1)[:, rows.wl_index]
+            out[key] = np.concatenate(cols, axis=1)[:, rows.group_wl_index]
         for key, coeffs in disp.items():
-            out[key] = dispersion_index(spec.dispersion[key], coeffs, rows.wavelength_nm[None, :])
-        for key, arr in _material_rows(spec, rows).items():
-            out[key] = np.broadcast_to(arr, (W, len(rows)))
+            out[key] = dispersion_index(spec.dispersion[key], coeffs, rows.group_wavelength_nm[None, :])
+        for key, arr in _material_rows(spec, rows.group_wl_index).items():
+            out[key] = np.broadcast_to(arr, (W, arr.shape[1]))
         return out
 
     def nuisance(self, U):
@@ -150,22 +200,23 @@ class MuellerLikelihood(BatchPosterior):
         U = np.atleast_2d(np.asarray(U, dtype=float))
         return _to_data(self.predict_psps(U, rows), rows.map)
 
-    def predict_psps(self, U, rows):
-        """The model's 16 psps elements ``(16, W, rows)`` at positions ``U``."""
+    def predict_psps(self, U, rows, out=None):
+        """The model's 16 psps elements ``(16, W, rows)`` at positions ``U`` (into ``out``,
+        ``(16, W * rows)``, when given): one model set over walkers x distinct wavelengths,
+        validated there and gathered per row (:func:`~scatterbench.models.evaluation.indexed`)."""
         U = np.atleast_2d(np.asarray(U, dtype=float))
-        values = self.scene_values(U, rows)
         _, off, _ = self.nuisance(U)
         if self.binding is None:
-            return self._predict_rebuilt(U, values, off, rows)
-        shape = np.broadcast_shapes(*(np.shape(v) for v in values.values()))
-        model = self.binding.values_model(values, shape)
+            return self._predict_rebuilt(U, self.scene_values(U, rows), off, rows)
+        W, G = len(U), len(rows.group_wavelength_nm)
+        values = {k: np.broadcast_to(v, (W, G)).reshape(-1) for k, v in self._group_values(U, rows).items()}
+        model = self.binding.values_model(values, (W * G,))
         self.binding.check(model)
-        if np.any(off != 0):
-            ti, phi = _offset(rows, off)
-            M = _mueller16(model, lambda m: m.mueller16(ti, rows.theta_r, phi))
-        else:
-            M = _mueller16(model, rows.fixed.mueller16)
-        return M.reshape((16, len(U), len(rows)))
+        ti, tr, phi = rows.angles(off)
+        evaluation.checked_angles(model, ti, rows.theta_r, rows.phi)  # the others: checked per row
+        M = np.empty((16, W * len(rows))) if out is None else out
+        _mueller16(model, rows.index(W), (ti, tr, phi), M)
+        return M.reshape((16, W, len(rows)))
 
     def _predict_rebuilt(self, U, values, off, rows):
         """The scene rebuilt per walker and wavelength (scenes the binding cannot express)."""
@@ -262,19 +313,25 @@ class MuellerLikelihood(BatchPosterior):
         return np.concatenate(parts)
 
 
-def _mueller16(model, evaluate):
-    """``M`` ``(16, N)`` of ``model`` by ``evaluate(m) -> (shape, M)``, a sum term by term: each
-    term then takes its own kernel's long chunks, where the sum as a whole is evaluated in short
-    chunks through numpy (measured: 0.34 s against 0.21 s per batch of 24 walkers x 7296 rows, one thread)."""
+def _mueller16(model, index, angles, out):
+    """``out`` ``(16, N)``: ``model`` (a set, flat parameters) at flat ``angles``, geometry ``k``
+    taking element ``index[k]``; a sum term by term: each term then takes its own kernel's
+    long chunks, where the sum as a whole is evaluated in short chunks through numpy
+    (measured: 0.34 s against 0.21 s per batch of 24 walkers x 7296 rows, one thread).  The
+    terms add in place, in order, as :class:`~scatterbench.models.base.Sum` adds them."""
     if not isinstance(model, Sum):
-        shape, M = evaluate(model)
-        return M if M.shape[1] > 1 or math.prod(shape) <= 1 else M
-    total = None
-    for w, m in model.terms:
-        M = _mueller16(m, evaluate)
-        M = M if isinstance(w, (int, float)) and w == 1 else w * M
-        total = M if total is None else total + M
-    return total
+        return evaluation.indexed(model, index, *angles, out)
+    scratch = None
+    for k, (w, m) in enumerate(model.terms):
+        if k and scratch is None:
+            scratch = np.empty_like(out)
+        term = scratch if k else out
+        _mueller16(m, index, angles, term)
+        if not (isinstance(w, (int, float)) and w == 1):
+            term *= w
+        if k:
+            out += term
+    return out
 
 
 def _to_data(M, maps):
@@ -313,11 +370,12 @@ def _observed(data, elements):
     return out
 
 
-def _material_rows(spec, rows):
-    """``{key: (1, rows)}`` of the named materials' indices (real, imaginary parts as the key's form)."""
+def _material_rows(spec, wl_index):
+    """``{key: (1, len(wl_index))}`` of the named materials' indices at the fitted wavelengths
+    ``wl_index`` (real, imaginary parts as the key's form)."""
     out = {}
     for key, (_, table) in spec.materials.items():
-        vals = np.array([table[w] for w in spec.wavelengths])[rows.wl_index]
+        vals = np.array([table[w] for w in spec.wavelengths])[wl_index]
         if len(set(table.values())) > 1:
             if key.endswith("]"):
                 out[key] = (vals.imag if key.endswith("[1]") else vals.real)[None, :]
