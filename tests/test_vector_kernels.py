@@ -223,8 +223,8 @@ def test_only_the_entry_points_are_cached():
 
     entries = {
         "drive": {"angles_ok"},  # and the entries per kernel, below
-        "montecarlo": {"_serial", "_parallel", "exit_transmittance"},
-        "aperture": {"nodes", "rotate_sum"},
+        "montecarlo": {"_range", "_exit_range"},
+        "aperture": {"nodes", "_tiles"},
         "disc": {"points"},
     }
     seen = 0

@@ -4,7 +4,7 @@ One function per model evaluates one geometry in real arithmetic, with no tempor
 (:mod:`~scatterbench.models.kernels.facet`, :mod:`~scatterbench.models.kernels.volume`, :mod:`~scatterbench.models.kernels.cook`,
 :mod:`~scatterbench.models.kernels.maxwell`, sharing :mod:`~scatterbench.models.kernels.common`);
 :mod:`~scatterbench.models.kernels.drive` loops it over a range of flat arrays, without the GIL;
-:func:`spread` runs that loop serially for small calls and on ranges over the cores (Python
+:func:`~scatterbench.models.kernels.threads.spread` runs that loop serially for small calls and on ranges over the cores (Python
 threads) from :data:`PARALLEL_MIN` geometries on, writing the element-major ``(16, N)``
 result directly.  Parameters are per element (a model set) or shared, so a
 likelihood evaluates all walkers of an emcee step in one call.  Float64 calls of the models
@@ -36,8 +36,8 @@ Only the loops that Python calls are cached: per kernel and precision the scalar
 the vector ``run_range`` of :func:`~scatterbench.models.kernels.vector.lane_entries` (closures
 over the kernel's code, so that a run compiles only the kernels its models use), ``angles_ok``
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
-``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~scatterbench.models.kernels.aperture`'s
-``nodes`` and ``rotate_sum``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
+``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.aperture`'s
+``nodes`` and ``_tiles``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
 holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached
 function as object code, without the LLVM IR that inlining needs: an entry compiled in a
@@ -56,13 +56,12 @@ import logging
 import math
 import os
 import tempfile
-from concurrent.futures import ThreadPoolExecutor
 
-import numba
 import numpy as np
 
 from .. import evaluation
 from ..float32_domain import ANGLE_ROWS
+from .threads import spread
 
 __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 
@@ -229,39 +228,6 @@ def azimuth_as(pr, dtype):
     return pr.astype(dtype)
 
 
-_POOL = []  # the threads spread() hands ranges to: made on first use, forgotten in a fork's child
-
-
-def _forget_pool():
-    _POOL.clear()  # a forked child has the pool object but not its threads
-
-
-os.register_at_fork(after_in_child=_forget_pool)
-
-
-def spread(loop, args, n):
-    """``loop(*args, lo, hi)`` over the geometries ``0 .. n - 1``: on one thread below
-    :data:`PARALLEL_MIN`, otherwise in equal ranges (each at least
-    :data:`~scatterbench.models.kernels.drive.BLOCK`) over ``numba.get_num_threads()`` threads,
-    the calling one taking the first.  The loops are compiled without the GIL, so Python
-    threads run them at once; a ``prange`` entry per loop instead had LLVM optimize each
-    kernel again (a third of a cold first run).  Each range writes its own columns of ``out``:
-    the result does not depend on the number of threads."""
-    k = 1 if n < PARALLEL_MIN else max(1, min(numba.get_num_threads(), n // drive.BLOCK))
-    if k == 1:
-        loop(*args, 0, n)
-        return
-    if not _POOL:
-        _POOL.append(
-            ThreadPoolExecutor(numba.config.NUMBA_NUM_THREADS, thread_name_prefix="scatterbench-kernel")
-        )
-    cuts = [n * j // k for j in range(k + 1)]
-    rest = [_POOL[0].submit(loop, *args, cuts[j], cuts[j + 1]) for j in range(1, k)]
-    loop(*args, cuts[0], cuts[1])
-    for f in rest:
-        f.result()
-
-
 class Compiled:
     """A model's kernel: its code, parameter rows and options, and the calls into it.
 
@@ -322,7 +288,9 @@ class Compiled:
         # contiguous, writable inputs: one compiled specialization per entry and precision
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
-        spread(_announced(loop), (ti, tr, pr, self.params(precision), self.iopt, out, start), n)
+        # below PARALLEL_MIN one range: a thread's start-up costs more than such a call
+        grain = n if n < PARALLEL_MIN else drive.BLOCK
+        spread(_announced(loop), (ti, tr, pr, self.params(precision), self.iopt, out, start), n, grain)
 
     def run(self, ti, tr, pr, rows):
         """``(rows, n)`` float64 of flat float64 angles (:func:`scatterbench.models.evaluation.flat`'s kernel route)."""
