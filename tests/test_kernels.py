@@ -340,6 +340,30 @@ def test_warm_compiles_the_types_the_calls_use():
     assert not kernels.cold("diffuse") and not kernels.cold("diffuse", "float32")
 
 
+def test_warm_compiles_the_node_algebra_and_monte_carlo_for_the_types_the_models_pass():
+    """``kernels.warm("montecarlo" | "aperture" | "disc")`` (a report's compile-ahead tasks)
+    compiles those modules' entries for the types RoughDiffuseBRDF, DetectorAperture and
+    PointSourceBRDF pass: their calls add no specialization.  Fails when a model passes
+    another type (a read-only table, a bool array), which a first report then compiled
+    again, lazily, in each process."""
+    from scatterbench.models import kernels
+
+    entries = [
+        e for name in ("montecarlo", "aperture", "disc") for e in kernels._warm_entries(name, "float64")
+    ]
+    for name in ("montecarlo", "aperture", "disc"):
+        kernels.warm(name)
+    before = {fn: list(fn.signatures) for fn, _ in entries}
+    x = np.linspace(0.1, 1.0, 40)
+    models.RoughDiffuseBRDF().mueller(0.3, x, 0.2)
+    models.DetectorAperture(model=models.FacetBRDF(), aperture=0.05).mueller(0.3, x, 0.2)
+    models.PointSourceBRDF(model=models.CookTorranceBRDF(), distance=1.0, sample_radius=1.0).mueller(
+        0.3, x, 0.2
+    )
+    for fn, sig in entries:
+        assert fn.signatures == before[fn] == [sig], (fn, before[fn], fn.signatures)
+
+
 _LANE_CALLS = """
 import numpy as np
 from scatterbench import models

@@ -176,10 +176,33 @@ def _signature(precision):
     return (a1, a1, a1, a2, types.Array(types.int64, 1, "C"), a2, i, i, i)
 
 
+def _other_entries(name):
+    """``(entry, signature)`` of the cached entries of module ``name`` (``"montecarlo"``,
+    ``"aperture"``, ``"disc"``), for the argument types their models pass."""
+    from numba import types
+
+    f, i, b = types.float64, types.int64, types.boolean
+    a1, a2, ro = types.Array(f, 1, "C"), types.Array(f, 2, "C"), types.Array(f, 1, "C", readonly=True)
+    if name == "montecarlo":  # RoughDiffuseBRDF
+        return [(montecarlo._range, (a1,) * 5 + (a2, a2, a1, f, a2, a2, i, i)),
+                (montecarlo._exit_range, (a1, a1, a1, a2, a2, f, a1, i, i))]  # fmt: skip
+    if name == "aperture":  # DetectorAperture (its node table is read-only)
+        return [
+            (aperture.nodes, (a1, a1, a1, ro, ro, ro, ro, a2)),
+            (aperture._tiles, (a2, a2, i, a2, i, i, i)),
+        ]
+    if name == "disc":  # PointSourceBRDF's disc quadrature
+        return [(disc.points, (f, f, a1, a1, types.Array(b, 1, "C"), a1, a1) + (a2,) * 6)]
+    raise KeyError(name)
+
+
 def _warm_entries(kernel, precision, option_sets=None):
     """``(loop, signature)`` of the loops :class:`Compiled` may call for kernel ``kernel`` in
     ``precision``: the scalar one, and in float64 the vector one of each option set in
-    ``option_sets`` (default: every one, :func:`~scatterbench.models.kernels.vector.option_sets`)."""
+    ``option_sets`` (default: every one, :func:`~scatterbench.models.kernels.vector.option_sets`);
+    for the name of another module with cached entries, those (:func:`_other_entries`)."""
+    if kernel not in drive.CODES:
+        return _other_entries(kernel)
     code, sig = drive.CODES[kernel], _signature(precision)
     loops = [drive.ENTRIES[code]]
     if precision == "float64":  # float32 has no lanes
@@ -199,7 +222,8 @@ def cold(kernel, precision="float64", option_sets=None) -> bool:
 
 def warm(kernel, precision="float64", option_sets=None):
     """Compile (or load from the cache) the loops of kernel ``kernel`` (a name of
-    :data:`~scatterbench.models.kernels.drive.CODES`) that :class:`Compiled` may call in
+    :data:`~scatterbench.models.kernels.drive.CODES`, or ``"montecarlo"``, ``"aperture"``,
+    ``"disc"``: those modules' entries) that :class:`Compiled` may call in
     ``precision`` (the vector ones of ``option_sets`` only, when given), for the argument types
     it passes, without running them: a first run compiles the kernels on its worker processes
     at once, each a different kernel, before it needs them (``scatterbench report``).  One

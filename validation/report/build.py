@@ -92,6 +92,7 @@ REPORT_KERNELS = (
     ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)]), ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)]),
     ("single", "float64", [(0, 0, 0), (1, 0, 0)]), ("facet", "float32", None),
     ("diffuse", "float64", [(0, 0, 0)]), ("btdf", "float64", []),
+    ("montecarlo", "float64", None), ("aperture", "float64", None), ("disc", "float64", None),
 )  # fmt: skip
 
 
@@ -112,7 +113,7 @@ def compile_ahead(executor):
 
     todo = [task for task in REPORT_KERNELS if kernels.cold(*task)]
     if todo:
-        kernels.announce([k for k, _, _ in todo], f"on {executor.workers} processes")
+        kernels.announce(list(dict.fromkeys(k for k, _, _ in todo)), f"on {executor.workers} processes")
         executor.map(_warm, todo, tasks=len(todo))
 
 
