@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 
+import numba
 import numpy as np
 import pytest
 
@@ -362,6 +363,39 @@ def test_warm_compiles_the_node_algebra_and_monte_carlo_for_the_types_the_models
     )
     for fn, sig in entries:
         assert fn.signatures == before[fn] == [sig], (fn, before[fn], fn.signatures)
+
+
+def test_spread_runs_ranges_on_threads_and_the_bits_do_not_depend_on_their_number():
+    """:func:`scatterbench.models.kernels.threads.spread` covers ``0 .. n - 1`` once, in ranges
+    on as many threads as ``numba.set_num_threads`` allows, and the kernels it runs give the
+    same bits on one thread and on two (a vector loop, a scalar one with Smith shadowing, the
+    Monte Carlo, the aperture's rotated sum).  Fails when ranges overlap or leave a gap, or a
+    loop reads another range's columns."""
+    import threading
+
+    from scatterbench.models.kernels.threads import spread
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one thread only (NUMBA_NUM_THREADS)")
+    seen = []
+    spread(lambda lo, hi: seen.append((lo, hi, threading.get_ident())), (), 4096, 1024)
+    assert sorted(r[:2] for r in seen) == [(0, 2048), (2048, 4096)] and len({r[2] for r in seen}) == 2, seen
+    x = np.linspace(0.0, 1.4, 5000)
+    calls = [
+        lambda: models.FacetBRDF().mueller(0.4, x, 0.3),
+        lambda: models.FacetBRDF(shadowing="smith").mueller(0.4, x, 0.3),
+        lambda: models.RoughDiffuseBRDF().mueller(0.4, x[::100], 0.3),
+        lambda: models.DetectorAperture(model=models.FacetBRDF(), aperture=0.05).mueller(0.4, x, 0.3),
+    ]
+    threads = numba.get_num_threads()
+    try:
+        for call in calls:
+            numba.set_num_threads(1)
+            one = call()
+            numba.set_num_threads(2)
+            assert np.array_equal(one, call(), equal_nan=True)
+    finally:
+        numba.set_num_threads(threads)
 
 
 _LANE_CALLS = """
