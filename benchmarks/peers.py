@@ -17,7 +17,7 @@ Pairs (DESIGN.md's mapping):
   when that exists and the variable is unset).
 
 Every side runs on one thread: Dr.Jit is set to one (``dr.set_thread_count(1)``),
-scatterbench's compiled kernels (which run ``prange`` on every core from 1024
+scatterbench's compiled kernels (which run on threads over every core from 1024
 geometries) are pinned to one around its timed calls (``numba.set_num_threads(1)``),
 and numpy's elementwise arithmetic is single-threaded; the JSON records the counts
 (``machine.threads``).
@@ -115,7 +115,7 @@ def time_ours(evaluate, g, loop):
     at the first ``loop`` geometries (for the comparison)."""
     ti, tr, pr = g
     threads = numba.get_num_threads()
-    numba.set_num_threads(THREADS)  # the kernels' prange would use every core from 1024 geometries
+    numba.set_num_threads(THREADS)  # the kernels would use a thread per core from 1024 geometries
     try:
         _, call, call_wall = _us(lambda: evaluate(float(ti[0]), float(tr[0]), float(pr[0])))
         out, geom, geom_wall = _us(lambda: evaluate(ti, tr, pr), per=ti.size)

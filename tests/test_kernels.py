@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 
+import numba
 import numpy as np
 import pytest
 
@@ -276,7 +277,7 @@ def test_one_compiled_specialization_per_entry_and_precision():
     """Read-only angles, a small call, a scalar call and a large one reach each entry point
     with the same argument types (no read-only array type, no ``Literal[int](0)``): each
     other type compiled every kernel again, ~10 s on a cold cache
-    (:meth:`scatterbench.models.kernels.Compiled.call`, :func:`scatterbench.models.kernels.drive.run_one`)."""
+    (:meth:`scatterbench.models.kernels.Compiled.call`, :meth:`scatterbench.models.kernels.Compiled.fast`)."""
     from scatterbench.models.kernels import drive, vector
 
     frozen = np.linspace(0.1, 1.2, 2048)
@@ -286,9 +287,8 @@ def test_one_compiled_specialization_per_entry_and_precision():
         m.mueller(frozen[:100], 0.3, 0.2)
         m.mueller(frozen[:3], 0.3, 0.2)
         m.mueller(0.3, 0.2, 0.1)
-    entries = [e for c in (drive.FACET, drive.MAXWELL) for e in drive.ENTRIES[c][:3]]
-    entries += [e for k in vector._ENTRIES.values() for e in (*k[1:3], k.run_range)]  # lanes: no run
-    assert len(entries) > 6  # the vector entries the calls above made
+    entries = [drive.ENTRIES[c] for c in (drive.FACET, drive.MAXWELL)] + list(vector._ENTRIES.values())
+    assert len(entries) > 2  # the vector loops the calls above made
     for entry in entries:
         for sig in entry.signatures:
             assert "readonly" not in str(sig) and "Literal" not in str(sig), (entry, sig)
@@ -315,7 +315,7 @@ def test_a_first_call_compiles_its_own_kernel_alone_and_says_so(tmp_path):
     assert runs[0].stderr.count("compiling") == 1, runs[0].stderr
     assert "compiling" not in runs[1].stderr, runs[1].stderr
     cached = {p.name.split("-")[0] for p in tmp_path.rglob("*.nbi")}
-    assert cached == {"drive.run_one_diffuse"}, cached
+    assert cached == {"drive.run_range_diffuse"}, cached
 
 
 def test_warm_compiles_the_types_the_calls_use():
@@ -341,6 +341,63 @@ def test_warm_compiles_the_types_the_calls_use():
     assert not kernels.cold("diffuse") and not kernels.cold("diffuse", "float32")
 
 
+def test_warm_compiles_the_node_algebra_and_monte_carlo_for_the_types_the_models_pass():
+    """``kernels.warm("montecarlo" | "aperture" | "disc")`` (a report's compile-ahead tasks)
+    compiles those modules' entries for the types RoughDiffuseBRDF, DetectorAperture and
+    PointSourceBRDF pass: their calls add no specialization.  Fails when a model passes
+    another type (a read-only table, a bool array), which a first report then compiled
+    again, lazily, in each process."""
+    from scatterbench.models import kernels
+
+    entries = [
+        e for name in ("montecarlo", "aperture", "disc") for e in kernels._warm_entries(name, "float64")
+    ]
+    for name in ("montecarlo", "aperture", "disc"):
+        kernels.warm(name)
+    before = {fn: list(fn.signatures) for fn, _ in entries}
+    x = np.linspace(0.1, 1.0, 40)
+    models.RoughDiffuseBRDF().mueller(0.3, x, 0.2)
+    models.DetectorAperture(model=models.FacetBRDF(), aperture=0.05).mueller(0.3, x, 0.2)
+    models.PointSourceBRDF(model=models.CookTorranceBRDF(), distance=1.0, sample_radius=1.0).mueller(
+        0.3, x, 0.2
+    )
+    for fn, sig in entries:
+        assert fn.signatures == before[fn] == [sig], (fn, before[fn], fn.signatures)
+
+
+def test_spread_runs_ranges_on_threads_and_the_bits_do_not_depend_on_their_number():
+    """:func:`scatterbench.models.kernels.threads.spread` covers ``0 .. n - 1`` once, in ranges
+    on as many threads as ``numba.set_num_threads`` allows, and the kernels it runs give the
+    same bits on one thread and on two (a vector loop, a scalar one with Smith shadowing, the
+    Monte Carlo, the aperture's rotated sum).  Fails when ranges overlap or leave a gap, or a
+    loop reads another range's columns."""
+    import threading
+
+    from scatterbench.models.kernels.threads import spread
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one thread only (NUMBA_NUM_THREADS)")
+    seen = []
+    spread(lambda lo, hi: seen.append((lo, hi, threading.get_ident())), (), 4096, 1024)
+    assert sorted(r[:2] for r in seen) == [(0, 2048), (2048, 4096)] and len({r[2] for r in seen}) == 2, seen
+    x = np.linspace(0.0, 1.4, 5000)
+    calls = [
+        lambda: models.FacetBRDF().mueller(0.4, x, 0.3),
+        lambda: models.FacetBRDF(shadowing="smith").mueller(0.4, x, 0.3),
+        lambda: models.RoughDiffuseBRDF().mueller(0.4, x[::100], 0.3),
+        lambda: models.DetectorAperture(model=models.FacetBRDF(), aperture=0.05).mueller(0.4, x, 0.3),
+    ]
+    threads = numba.get_num_threads()
+    try:
+        for call in calls:
+            numba.set_num_threads(1)
+            one = call()
+            numba.set_num_threads(2)
+            assert np.array_equal(one, call(), equal_nan=True)
+    finally:
+        numba.set_num_threads(threads)
+
+
 _LANE_CALLS = """
 import numpy as np
 from scatterbench import models
@@ -363,7 +420,7 @@ def test_a_second_process_loads_the_vector_entries_without_compiling(tmp_path):
 
     subprocess.run([sys.executable, "-c", _LANE_CALLS], env=env, check=True)
     first = files()
-    assert any("run_parallel_single_" in name for name in first), sorted(first)
+    assert any("run_range_single_" in name for name in first), sorted(first)
     subprocess.run([sys.executable, "-c", _LANE_CALLS], env=env, check=True)
     assert files() == first
 

@@ -38,8 +38,8 @@ def _both(kernel, ti, tr, pr):
     prm = kernel.params("float64")
     n = max(ti.size, prm.shape[1])
     a, b = np.empty((16, n)), np.empty((16, n))
-    kernel.scalar.run(ti, tr, pr, prm, kernel.iopt, a, 0)
-    kernel.lanes.run_range(ti, tr, pr, prm, b, 0, 0, n)
+    kernel.scalar(ti, tr, pr, prm, kernel.iopt, a, 0, 0, n)
+    kernel.lanes(ti, tr, pr, prm, kernel.iopt, b, 0, 0, n)
     return a, b
 
 
@@ -102,8 +102,8 @@ from scatterbench.models.kernels import Compiled
 for m in (models.FacetBRDF(), models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
     k = Compiled(m, *m._kernel_spec())
     k.run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
-    k.scalar.run(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], k.iopt, np.empty((16, 4)), 0)
-    for name, fn in (("lanes", k.lanes.run_range), ("scalar", k.scalar.run)):  # run_range: the loop
+    k.scalar(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], k.iopt, np.empty((16, 4)), 0, 0, 4)
+    for name, fn in (("lanes", k.lanes), ("scalar", k.scalar)):  # each kernel's one compiled loop
         ir = "".join(fn.inspect_llvm().values())
         print(type(m).__name__, name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
 """
@@ -123,7 +123,7 @@ common.stroke_d(0.1, 0.2, 0.9, 0.3, 0.3, 1.0, 0.0)
 def test_the_lanes_are_vectorized_loops(tmp_path):
     """In a process that compiles the vector loop (its IR is inspected: a function loaded
     from the cache has none), after an earlier process filled the cache with some of the
-    kernels' helpers: each model's vector loop (``run_range`` of :func:`scatterbench.models.kernels.vector.lane_entries`)
+    kernels' helpers: each model's vector loop (:func:`scatterbench.models.kernels.vector.lane_entries`)
     holds LLVM's vectorized loops (their ``vector.body`` blocks, on ``<N x double>`` values);
     its scalar entry (:mod:`~scatterbench.models.kernels.drive`) has none.  Fails when a change puts a call or an exception
     back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
@@ -223,8 +223,8 @@ def test_only_the_entry_points_are_cached():
 
     entries = {
         "drive": {"angles_ok"},  # and the entries per kernel, below
-        "montecarlo": {"_serial", "_parallel", "exit_transmittance"},
-        "aperture": {"nodes", "rotate_sum"},
+        "montecarlo": {"_range", "_exit_range"},
+        "aperture": {"nodes", "_tiles"},
         "disc": {"points"},
     }
     seen = 0
@@ -240,16 +240,14 @@ def test_only_the_entry_points_are_cached():
                     where = fn._cache._cache_path
                     assert where.startswith(models.kernels.cache_dir()), f"{name}.{attr} caches in {where}"
     assert seen > 40
-    # the entries per kernel (and per option set on SIMD lanes): closures, not module names
-    per_kernel = [e for es in drive.ENTRIES for e in es]
-    per_kernel += [
-        e for es in (vector.lane_entries(c, np.zeros(3, dtype=np.int64)) for c in (0, 2, 3, 4, 5)) for e in es
-    ]
-    for fn in (e for e in per_kernel if e is not None):
+    # the loop per kernel (and per option set on SIMD lanes): closures, not module names
+    per_kernel = list(drive.ENTRIES)
+    per_kernel += [vector.lane_entries(c, np.zeros(3, dtype=np.int64)) for c in (0, 2, 3, 4, 5)]
+    for fn in per_kernel:
         assert type(fn._cache).__name__ != "NullCache", fn
         assert fn._cache._cache_path.startswith(models.kernels.cache_dir()), fn
-    names = {fn.py_func.__qualname__ for fn in per_kernel if fn is not None}
-    assert len(names) == len([e for e in per_kernel if e is not None])  # cache files of their own
+    names = {fn.py_func.__qualname__ for fn in per_kernel}
+    assert len(names) == len(per_kernel)  # cache files of their own
 
 
 def test_option_sets_are_every_set_the_lanes_take():

@@ -3,9 +3,10 @@
 One function per model evaluates one geometry in real arithmetic, with no temporaries
 (:mod:`~scatterbench.models.kernels.facet`, :mod:`~scatterbench.models.kernels.volume`, :mod:`~scatterbench.models.kernels.cook`,
 :mod:`~scatterbench.models.kernels.maxwell`, sharing :mod:`~scatterbench.models.kernels.common`);
-:mod:`~scatterbench.models.kernels.drive` loops it over flat arrays, serially for small calls and over
-the cores (``prange``) from :data:`PARALLEL_MIN` geometries on, writing the element-major
-``(16, N)`` result directly.  Parameters are per element (a model set) or shared, so a
+:mod:`~scatterbench.models.kernels.drive` loops it over a range of flat arrays, without the GIL;
+:func:`~scatterbench.models.kernels.threads.spread` runs that loop serially for small calls and on ranges over the cores (Python
+threads) from :data:`PARALLEL_MIN` geometries on, writing the element-major ``(16, N)``
+result directly.  Parameters are per element (a model set) or shared, so a
 likelihood evaluates all walkers of an emcee step in one call.  Float64 calls of the models
 whose kernels have no C library call left (:func:`~scatterbench.models.kernels.vector.vectorized`: the
 facet reflection models and Maxwell-Beard with exponential, Gaussian or GGX slopes and no
@@ -30,14 +31,13 @@ A first ``scatterbench report`` on worker processes compiles the kernels ahead, 
 process at once (:func:`warm`, ``validation.report.build.compile_ahead``); elsewhere each
 entry compiles on its first call.
 
-Only the entry points that Python calls are cached: per kernel, ``run``, ``run_parallel``,
-``run_checked`` and ``run_one`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel
-and option set the first three of :func:`~scatterbench.models.kernels.vector.lane_entries` and the
-``run_range`` loop they call (closures over the kernel's code, so that a run compiles only
-the kernels its models use), ``angles_ok``
+Only the loops that Python calls are cached: per kernel and precision the scalar
+``run_range`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel and option set
+the vector ``run_range`` of :func:`~scatterbench.models.kernels.vector.lane_entries` (closures
+over the kernel's code, so that a run compiles only the kernels its models use), ``angles_ok``
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
-``_serial``, ``_parallel`` and ``exit_transmittance``, :mod:`~scatterbench.models.kernels.aperture`'s
-``nodes`` and ``rotate_sum``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
+``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.aperture`'s
+``nodes`` and ``_tiles``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
 holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached
 function as object code, without the LLVM IR that inlining needs: an entry compiled in a
@@ -61,6 +61,7 @@ import numpy as np
 
 from .. import evaluation
 from ..float32_domain import ANGLE_ROWS
+from .threads import spread
 
 __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 
@@ -166,48 +167,68 @@ def announce(names, how=""):
         _SAID.update(todo)
 
 
-def _signatures(precision) -> dict:
-    """The argument types :class:`Compiled` calls each entry with in ``precision``."""
+def _signature(precision):
+    """The argument types :class:`Compiled` calls a kernel's loop (``run_range``) with in ``precision``."""
     from numba import types
 
     f = getattr(types, precision)
     a1, a2, i = types.Array(f, 1, "C"), types.Array(f, 2, "C"), types.int64
-    io = types.Array(types.int64, 1, "C")
-    run = (a1, a1, a1, a2, io, a2, i)
-    return {"run": run, "run_parallel": run, "run_checked": run[:-1], "run_one": (f, f, f, a2, io, a2),
-            "run_range": (a1, a1, a1, a2, a2, i, i, i)}  # fmt: skip
+    return (a1, a1, a1, a2, types.Array(types.int64, 1, "C"), a2, i, i, i)
 
 
-def _warm_entries(kernel, precision):
-    """``(entry, signature)`` of every entry :class:`Compiled` may call for kernel ``kernel`` in
-    ``precision``: the scalar ones, and in float64 those of every option set on SIMD lanes."""
-    code, sigs = drive.CODES[kernel], _signatures(precision)
-    if precision != "float64":  # float32 takes call() alone: run or run_parallel
-        return [(getattr(drive.ENTRIES[code], n), sigs[n]) for n in ("run", "run_parallel")]
-    lanes = [vector.lanes_of(code, o) for o in vector.option_sets(code)]
-    # on lanes, call() takes run_range itself (they have no run entry)
-    return [(fn, sigs[n]) for n, fn in drive.ENTRIES[code]._asdict().items() if fn is not None] + [
-        (getattr(es, n), sigs[n]) for es in lanes for n in ("run_range", "run_checked", "run_parallel")
-    ]
+def _other_entries(name):
+    """``(entry, signature)`` of the cached entries of module ``name`` (``"montecarlo"``,
+    ``"aperture"``, ``"disc"``), for the argument types their models pass."""
+    from numba import types
+
+    f, i, b = types.float64, types.int64, types.boolean
+    a1, a2, ro = types.Array(f, 1, "C"), types.Array(f, 2, "C"), types.Array(f, 1, "C", readonly=True)
+    if name == "montecarlo":  # RoughDiffuseBRDF
+        return [(montecarlo._range, (a1,) * 5 + (a2, a2, a1, f, a2, a2, i, i)),
+                (montecarlo._exit_range, (a1, a1, a1, a2, a2, f, a1, i, i))]  # fmt: skip
+    if name == "aperture":  # DetectorAperture (its node table is read-only)
+        return [
+            (aperture.nodes, (a1, a1, a1, ro, ro, ro, ro, a2)),
+            (aperture._tiles, (a2, a2, i, a2, i, i, i)),
+        ]
+    if name == "disc":  # PointSourceBRDF's disc quadrature
+        return [(disc.points, (f, f, a1, a1, types.Array(b, 1, "C"), a1, a1) + (a2,) * 6)]
+    raise KeyError(name)
 
 
-def cold(kernel, precision="float64") -> bool:
-    """Whether an entry of :func:`warm`'s is not in the cache yet."""
+def _warm_entries(kernel, precision, option_sets=None):
+    """``(loop, signature)`` of the loops :class:`Compiled` may call for kernel ``kernel`` in
+    ``precision``: the scalar one, and in float64 the vector one of each option set in
+    ``option_sets`` (default: every one, :func:`~scatterbench.models.kernels.vector.option_sets`);
+    for the name of another module with cached entries, those (:func:`_other_entries`)."""
+    if kernel not in drive.CODES:
+        return _other_entries(kernel)
+    code, sig = drive.CODES[kernel], _signature(precision)
+    loops = [drive.ENTRIES[code]]
+    if precision == "float64":  # float32 has no lanes
+        sets = vector.option_sets(code) if option_sets is None else option_sets
+        loops += [vector.lanes_of(code, o) for o in sets]
+    return [(fn, sig) for fn in loops]
+
+
+def cold(kernel, precision="float64", option_sets=None) -> bool:
+    """Whether a loop of :func:`warm`'s is not in the cache yet."""
     return any(
         not os.path.exists(fn._cache._cache_file._index_path)
-        for fn, _ in _warm_entries(kernel, precision)
+        for fn, _ in _warm_entries(kernel, precision, option_sets)
         if getattr(fn, "_cache", None) is not None
     )
 
 
-def warm(kernel, precision="float64"):
-    """Compile (or load from the cache) every entry of kernel ``kernel`` (a name of
-    :data:`~scatterbench.models.kernels.drive.CODES`) that :class:`Compiled` may call in ``precision``,
-    for the argument types it passes, without running it: a first run compiles the kernels
-    on its worker processes at once, each a different kernel, before it needs them
-    (``scatterbench report``).  One process per kernel: its entries share the kernel's
-    typing.  Returns ``kernel``."""
-    for fn, sig in _warm_entries(kernel, precision):
+def warm(kernel, precision="float64", option_sets=None):
+    """Compile (or load from the cache) the loops of kernel ``kernel`` (a name of
+    :data:`~scatterbench.models.kernels.drive.CODES`, or ``"montecarlo"``, ``"aperture"``,
+    ``"disc"``: those modules' entries) that :class:`Compiled` may call in
+    ``precision`` (the vector ones of ``option_sets`` only, when given), for the argument types
+    it passes, without running them: a first run compiles the kernels on its worker processes
+    at once, each a different kernel, before it needs them (``scatterbench report``).  One
+    process per kernel: its loops share the kernel's typing.  Returns ``kernel``."""
+    for fn, sig in _warm_entries(kernel, precision, option_sets):
         if hasattr(fn, "compile"):  # not a Python function (NUMBA_DISABLE_JIT=1)
             fn.compile(sig)
     return kernel
@@ -263,13 +284,13 @@ class Compiled:
     # looked up, not held: a model pickled to a worker process carries its Compiled, and
     # numba's dispatchers do not pickle to the same (cached) functions
     @property
-    def scalar(self) -> drive.Entries:
-        """The kernel's scalar loops (:data:`scatterbench.models.kernels.drive.ENTRIES`)."""
+    def scalar(self):
+        """The kernel's scalar loop (:data:`scatterbench.models.kernels.drive.ENTRIES`)."""
         return drive.ENTRIES[self.code]
 
     @property
-    def lanes(self) -> drive.Entries:
-        """The kernel's loops on SIMD lanes (:func:`scatterbench.models.kernels.vector.lane_entries`)."""
+    def lanes(self):
+        """The kernel's loop on SIMD lanes (:func:`scatterbench.models.kernels.vector.lane_entries`)."""
         return vector.lane_entries(self.code, self.iopt)
 
     def params(self, precision):
@@ -287,16 +308,13 @@ class Compiled:
     def call(self, ti, tr, pr, out, start, precision="float64"):
         """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
-        loops = self.lanes if precision == "float64" and self.vectorized else self.scalar
+        loop = self.lanes if precision == "float64" and self.vectorized else self.scalar
         # contiguous, writable inputs: one compiled specialization per entry and precision
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
-        if n < PARALLEL_MIN and loops.run_range is not None:
-            # the vector loop itself (the lanes have no run entry: one more copy of the loop)
-            _announced(loops.run_range)(ti, tr, pr, self.params(precision), out, start, 0, n)
-            return
-        fn = _announced(loops.run_parallel if n >= PARALLEL_MIN else loops.run)
-        fn(ti, tr, pr, self.params(precision), self.iopt, out, start)
+        # below PARALLEL_MIN one range: a thread's start-up costs more than such a call
+        grain = n if n < PARALLEL_MIN else drive.BLOCK
+        spread(_announced(loop), (ti, tr, pr, self.params(precision), self.iopt, out, start), n, grain)
 
     def run(self, ti, tr, pr, rows):
         """``(rows, n)`` float64 of flat float64 angles (:func:`scatterbench.models.evaluation.flat`'s kernel route)."""
@@ -343,13 +361,12 @@ class Compiled:
             return None
         elif not out.flags.c_contiguous:
             return None
+        if not drive.angles_ok(ti, tr, pr):
+            return None
         if dtype is _FLOAT64 and n < PARALLEL_MIN:
-            loops = self.lanes if self.vectorized and n >= VECTOR_MIN else self.scalar
-            if not _announced(loops.run_checked)(ti, tr, pr, self.prm["float64"], self.iopt, out):
-                return None
+            loop = self.lanes if self.vectorized and n >= VECTOR_MIN else self.scalar
+            _announced(loop)(ti, tr, pr, self.prm["float64"], self.iopt, out, 0, 0, n)
         else:
-            if not drive.angles_ok(ti, tr, pr):
-                return None
             self.call(ti.astype(dtype), tr.astype(dtype), azimuth_as(pr, dtype), out, 0, precision)
         return out.reshape(shape) if rows == 1 else evaluation.as_matrices(out, shape)
 
@@ -368,5 +385,7 @@ class Compiled:
         if not (0.0 <= a <= _HALF_PI and 0.0 <= b <= _HALF_PI and math.isfinite(c)):
             return None
         out = np.empty((rows, 1))
-        _announced(self.scalar.run_one)(a, b, c, self.prm["float64"], self.iopt, out)
+        _announced(self.scalar)(
+            np.full(1, a), np.full(1, b), np.full(1, c), self.prm["float64"], self.iopt, out, 0, 0, 1
+        )
         return out.reshape(4, 4) if rows == 16 else out.reshape(())

@@ -13,9 +13,10 @@ cosines and sines are taken once, before it.  The sum adds the nodes in order, a
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from .common import azimuths
+from .threads import spread
 from .vector_math import atan2, inverse_binade, sincos, sqrt
 
 
@@ -79,14 +80,19 @@ def _node(ti, pr, frame, a, b, cos_u, w, out, o):
 TILE = 16
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
 def rotate_sum(m, nodes_out, n, out, start):
     """``sum_k wt R_k M_k / sum_k wt`` into ``out[:, start:start + n]`` for the inner model's
     matrices ``m`` ``(16, K * n)`` at the nodes of :func:`nodes` (their rows ``nodes_out``)
     of ``n`` geometries: ``R_k`` keeps rows 0 and 3 and turns rows 1-2 by
     ``[[c2, s2], [-s2, c2]]``.  A tile of :data:`TILE` geometries at a time, tiles over the
-    cores, the nodes added in order."""
-    for t in prange((n + TILE - 1) // TILE):
+    cores (:func:`~scatterbench.models.kernels.threads.spread`), the nodes added in order."""
+    spread(_tiles, (m, nodes_out, n, out, start), (n + TILE - 1) // TILE, 4)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _tiles(m, nodes_out, n, out, start, t0, t1):
+    """Tiles ``t0 .. t1 - 1`` of :func:`rotate_sum`."""
+    for t in range(t0, t1):
         g0 = t * TILE
         _tile(m, nodes_out, n, out, start, g0, min(TILE, n - g0))
 

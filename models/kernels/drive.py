@@ -5,17 +5,15 @@ length 1 (one value for every geometry) or ``n``; ``prm`` holds the model's para
 rows of length 1 (a single model) or ``n`` (a model set, one element per geometry);
 ``iopt`` its options (slope kind, shadowing, conventions); ``out`` the element-major result
 ``(16, N)`` (or ``(1, N)``: ``M00`` only), written from column ``start``.  No Python runs per
-geometry: :func:`run` is serial (small calls), :func:`run_parallel` spreads the geometries
-over the cores with ``prange``.
+geometry: one compiled loop per kernel (:func:`entry`) takes a range of geometries, and
+:class:`scatterbench.models.kernels.Loops` calls it serially or on ranges over the cores.
 """
 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
-import numpy as np
-from numba import errors, njit, prange, types
+from numba import errors, njit, types
 from numba.extending import overload
 
 from ..kernel_specs import KERNEL_ROWS
@@ -72,13 +70,13 @@ def store(out, i, m):
     out[13, i], out[14, i], out[15, i] = m[13], m[14], m[15]
 
 
-#: geometries per task of :func:`run_parallel` (each runs :func:`run_range`'s serial loop)
+#: the fewest geometries of a range given to a thread (:class:`scatterbench.models.kernels.Loops`)
 BLOCK = 1024
 
 
 @njit(error_model="numpy", forceinline=True)
 def _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi):
-    """:func:`run_range`'s loop for one kernel (compiled once per kernel: a loop that
+    """:func:`entry`'s loop for one kernel (compiled once per kernel: a loop that
     dispatches on the model per geometry holds every kernel's code and runs slower)."""
     a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
     for i in range(lo, hi):
@@ -113,18 +111,6 @@ def _serial_of(code, ti, tr, pr, prm, o, out, start, lo, hi):
     return impl
 
 
-class Entries(NamedTuple):
-    """One kernel's cached entry points (:func:`entries`); ``run_range`` (the vector ones':
-    :func:`scatterbench.models.kernels.vector.entries`) is the loop the others call, called
-    directly for a serial call of known length."""
-
-    run: object
-    run_parallel: object
-    run_checked: object
-    run_one: object
-    run_range: object = None
-
-
 def named(code, tag=""):
     """A decorator that renames a function after kernel ``code``, before numba sees it: numba
     names a function's cache files after its qualified name, so each kernel's entries get
@@ -139,53 +125,28 @@ def named(code, tag=""):
     return rename
 
 
-def entries(code) -> Entries:
-    """The entry points of kernel ``code`` (built once, at import: :data:`ENTRIES`).
+def entry(code):
+    """The one compiled entry of kernel ``code``'s scalar loop (built once, at import:
+    :data:`ENTRIES`): ``run_range(ti, tr, pr, prm, iopt, out, start, lo, hi)``, geometries
+    ``lo .. hi - 1`` into ``out[:, start + i]``, without the GIL.  Serial, parallel, checked
+    and one-geometry calls are that loop called from Python
+    (:class:`scatterbench.models.kernels.Loops`): one entry per kernel compiles the kernel once,
+    where four (a serial, a ``prange``, a checked and a scalar one) each had LLVM optimize the
+    inlined kernel again (10 s of a cold first call for Cook-Torrance, a third of it in the
+    three extra copies).
 
-    Each is a closure over ``code``, an int: numba folds it as a constant, so the entry
-    compiles only its own kernel (one entry over every kernel compiled all six on a first
-    call: 23 s of CPU for one geometry of FacetBRDF on a cold cache), and its cache key (the
-    closure's pickled cells) is the same in every process."""
+    A closure over ``code``, an int: numba folds it as a constant, so the entry compiles only
+    its own kernel (one entry over every kernel compiled all six on a first call: 23 s of CPU
+    for one geometry of FacetBRDF on a cold cache), and its cache key (the closure's pickled
+    cells) is the same in every process."""
 
-    @njit(cache=True, error_model="numpy")
+    @njit(cache=True, error_model="numpy", nogil=True)
     @named(code)
-    def run(ti, tr, pr, prm, iopt, out, start):
-        """Serial loop over the geometries ``0 .. len - 1`` of the inputs, into ``out[:, start + i]``."""
-        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        # np.int64(0), not 0: numba gives a literal argument a specialization of its own
-        # (Literal[int](0)), which compiled the kernel a second time
-        serial(code, ti, tr, pr, prm, options(iopt), out, start, np.int64(0), n)
+    def run_range(ti, tr, pr, prm, iopt, out, start, lo, hi):
+        """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``."""
+        serial(code, ti, tr, pr, prm, options(iopt), out, start, lo, hi)
 
-    @njit(cache=True, error_model="numpy", parallel=True)
-    @named(code)
-    def run_parallel(ti, tr, pr, prm, iopt, out, start):
-        """:func:`run` with blocks of :data:`BLOCK` geometries spread over the cores (``prange``;
-        each block the serial loop, which compiles to tighter code than a ``prange`` body)."""
-        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        o = options(iopt)
-        for blk in prange((n + BLOCK - 1) // BLOCK):
-            lo = blk * BLOCK
-            serial(code, ti, tr, pr, prm, o, out, start, lo, min(lo + BLOCK, n))
-
-    @njit(cache=True, error_model="numpy")
-    @named(code)
-    def run_checked(ti, tr, pr, prm, iopt, out):
-        """:func:`run` from column 0 when every angle is valid (:func:`angles_ok`), returning
-        True; False, writing nothing, otherwise (one call into numba for a small call)."""
-        if not angles_ok(ti, tr, pr):
-            return False
-        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        serial(code, ti, tr, pr, prm, options(iopt), out, np.int64(0), np.int64(0), n)
-        return True
-
-    @njit(cache=True, error_model="numpy")
-    @named(code)
-    def run_one(ti, tr, pr, prm, iopt, out):
-        """One geometry given as scalars (the small-call path), through the serial loop."""
-        a, b, c = np.full(1, ti), np.full(1, tr), np.full(1, pr)
-        serial(code, a, b, c, prm, options(iopt), out, np.int64(0), np.int64(0), np.int64(1))
-
-    return Entries(run, run_parallel, run_checked, run_one)
+    return run_range
 
 
 @njit(cache=True, error_model="numpy")
@@ -205,5 +166,5 @@ def angles_ok(ti, tr, pr):
     return True
 
 
-#: every kernel's entry points, by code
-ENTRIES = tuple(entries(c) for c in range(len(KERNELS)))
+#: every kernel's scalar loop (:func:`entry`), by code
+ENTRIES = tuple(entry(c) for c in range(len(KERNELS)))

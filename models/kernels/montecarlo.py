@@ -19,10 +19,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from .common import hg_density, mueller16
 from .facet import btdf_jones, cross3, dot3
+from .threads import spread
 
 __all__ = ["estimate", "exit_transmittance"]
 
@@ -195,15 +196,10 @@ def _geometry(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, col):
         err[e, col] = math.sqrt(ss / (pairs - 1)) / math.sqrt(pairs) * scale[e]
 
 
-@njit(cache=True)
-def _serial(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err):
-    for i in range(mean.shape[1]):
-        _geometry(ti[i], tr[i], pr[i], n_i[i], n_r[i], z, m, prm, safe, mean, err, i)
-
-
-@njit(cache=True, parallel=True)
-def _parallel(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err):
-    for i in prange(mean.shape[1]):
+@njit(cache=True, nogil=True)
+def _range(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, lo, hi):
+    """Geometries ``lo .. hi - 1`` (a range of :func:`~scatterbench.models.kernels.threads.spread`)."""
+    for i in range(lo, hi):
         _geometry(ti[i], tr[i], pr[i], n_i[i], n_r[i], z, m, prm, safe, mean, err, i)
 
 
@@ -230,17 +226,26 @@ def estimate(ti, tr, pr, n_i, n_r, z, m, prm, safe, parallel):
     """
     mean = np.empty((16, ti.size))
     err = np.empty((16, ti.size))
-    run = _parallel if parallel else _serial
-    run(ti, tr, pr, n_i, n_r, z, m, prm, float(safe), mean, err)
+    args = (ti, tr, pr, n_i, n_r, z, m, prm, float(safe), mean, err)
+    spread(
+        _range, args, ti.size, 1 if parallel else ti.size
+    )  # a geometry walks every pair: one is work enough
     return mean, err
 
 
-@njit(cache=True, parallel=True)
 def exit_transmittance(tr, pr, n_r, z, m, n):
     """``<w_r M_out[0, 0]>`` over the exit facets for flat directions ``(tr, pr)``
-    (:meth:`scatterbench.models.RoughDiffuseBRDF._exit_transmittance`; bases from :func:`_ray_basis`)."""
+    (:meth:`scatterbench.models.RoughDiffuseBRDF._exit_transmittance`; bases from :func:`_ray_basis`),
+    the directions over the cores."""
     out = np.empty(tr.size)
-    for i in prange(tr.size):
+    spread(_exit_range, (tr, pr, n_r, z, m, n, out), tr.size, 1)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _exit_range(tr, pr, n_r, z, m, n, out, lo, hi):
+    """:func:`exit_transmittance` of the directions ``lo .. hi - 1`` into ``out``."""
+    for i in range(lo, hi):
         cr, sr, cp, sp = math.cos(tr[i]), math.sin(tr[i]), math.cos(pr[i]), math.sin(pr[i])
         k_r = (sr * cp, sr * sp, cr)
         e_r = _ray_basis(k_r)
@@ -251,4 +256,3 @@ def exit_transmittance(tr, pr, n_r, z, m, n):
             if w > 0.0:
                 total += 0.5 * (jo[0] * jo[0] + jo[1] * jo[1] + jo[2] * jo[2] + jo[3] * jo[3]) * f * w
         out[i] = total / z.shape[1]
-    return out

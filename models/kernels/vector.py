@@ -1,7 +1,7 @@
 """The float64 loops that run on SIMD lanes: the kernels of :mod:`~scatterbench.models.kernels.drive`
 over a block of geometries at a time, compiled so that the compiler vectorizes them.
 
-The scalar entries of :mod:`~scatterbench.models.kernels.drive` call a model's one-geometry function in a loop the
+The scalar loops of :mod:`~scatterbench.models.kernels.drive` call a model's one-geometry function in a loop the
 compiler keeps scalar: the function branches on the model and its options, calls the C
 library, and reads and writes several arrays the compiler must assume overlap.  Here, per
 block of :data:`VBLOCK` geometries:
@@ -27,25 +27,13 @@ shadowing, anisotropic slopes, unit slopes); :class:`scatterbench.models.kernels
 from __future__ import annotations
 
 import numpy as np
-from numba import errors, njit, prange, types
+from numba import errors, njit, types
 from numba.core import config
 from numba.extending import overload
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX
 from .common import NO_SHADOWING, azimuths
-from .drive import (
-    BLOCK,
-    COOK,
-    DIFFUSE,
-    FACET,
-    KERNELS,
-    MAXWELL,
-    PARAM_ROWS,
-    SINGLE,
-    Entries,
-    angles_ok,
-    named,
-)
+from .drive import COOK, DIFFUSE, FACET, KERNELS, MAXWELL, PARAM_ROWS, SINGLE, named
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (55 kB), stays
 #: in the L2 cache
@@ -184,64 +172,24 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
     return impl
 
 
-def lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
-    """The ``run_range`` entry of kernel ``code`` with options ``(k0, k1, k2)``: compiled code
-    finds it while typing (:func:`_lane_range_of`), Python (``NUMBA_DISABLE_JIT=1``) here."""
-    lanes_of(code, (k0, k1, k2)).run_range(ti, tr, pr, prm, out, start, lo, hi)
-
-
-@overload(lane_range, prefer_literal=True)
-def _lane_range_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
-    """``lane_range`` with constant code and options: a call of that cached ``run_range``.
-    Looked up here, not held in the entries' closures: numba keys a closure's cache by its
-    pickled cells, and a dispatcher pickles differently in every process (each recompiled)."""
-    if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
-        raise errors.RequireLiteralValue("lane_range's kernel code and options must be constants")
-    fn = lanes_of(code.literal_value, (k0.literal_value, k1.literal_value, k2.literal_value)).run_range
-
-    def impl(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
-        fn(ti, tr, pr, prm, out, start, lo, hi)
-
-    return impl
-
-
-def entries(code, opts) -> Entries:
-    """:func:`scatterbench.models.kernels.drive.entries` on SIMD lanes (``run_range``, ``run_parallel``,
-    ``run_checked``; float64) for kernel ``code`` with options ``opts`` (:func:`lane_options`):
-    closures over those ints.  The loop is compiled once, in ``run_range``; the others call it
-    (numba links its compiled code into theirs), so that a cold cache types and optimizes
-    each loop once, not once per entry (``run_parallel`` typed it again in its ``prange`` body:
-    7-9 s of a cold first call)."""
+def entry(code, opts):
+    """The one compiled entry of kernel ``code``'s loop on SIMD lanes with options ``opts``
+    (:func:`lane_options`), a closure over those ints: ``run_range(ti, tr, pr, prm, iopt, out,
+    start, lo, hi)``, the arguments of the scalar loop's
+    (:func:`scatterbench.models.kernels.drive.entry`; ``iopt`` unread, the options being
+    constants), without the GIL.  Serial, parallel and checked calls are this loop called from
+    Python (:class:`scatterbench.models.kernels.Loops`): a compiled caller links the loop's code
+    into its own and LLVM optimizes it again (a ``prange`` entry and a checked one took 7.8 s
+    and 3.0 s per option set beside the loop's own 6.2 s, Cook-Torrance on a cold cache)."""
     k0, k1, k2 = opts
-    tag = "_".join(str(k) for k in opts)
 
-    @njit(cache=True, error_model="numpy")
-    @named(code, tag)
-    def run_range(ti, tr, pr, prm, out, start, lo, hi):
+    @njit(cache=True, error_model="numpy", nogil=True)
+    @named(code, "_".join(str(k) for k in opts))
+    def run_range(ti, tr, pr, prm, iopt, out, start, lo, hi):
         """Geometries ``lo .. hi - 1`` into ``out[:, start + i]`` (:func:`blocks`)."""
         blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi)
 
-    @njit(cache=True, error_model="numpy")
-    @named(code, tag)
-    def run_checked(ti, tr, pr, prm, iopt, out):
-        """The scalar ``run_checked`` (same arguments, float64) on SIMD lanes."""
-        if not angles_ok(ti, tr, pr):
-            return False
-        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, np.int64(0), np.int64(0), n)
-        return True
-
-    @njit(cache=True, error_model="numpy", parallel=True)
-    @named(code, tag)
-    def run_parallel(ti, tr, pr, prm, iopt, out, start):
-        """``run_range`` in blocks of :data:`scatterbench.models.kernels.drive.BLOCK` geometries over the cores."""
-        n = max(ti.shape[0], tr.shape[0], pr.shape[0], prm.shape[1])
-        for blk in prange((n + BLOCK - 1) // BLOCK):
-            lo = blk * BLOCK
-            lane_range(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, min(lo + BLOCK, n))
-
-    # no run entry: a serial call of known length takes run_range itself (Compiled.call)
-    return Entries(None, run_parallel, run_checked, None, run_range)
+    return run_range
 
 
 #: numba's cache directory when this module was imported (:mod:`scatterbench.models.kernels`
@@ -266,20 +214,20 @@ def option_sets(code) -> list:
     return []  # no lanes (FacetBTDF)
 
 
-def lane_entries(code, iopt) -> Entries:
-    """The vector entries of kernel ``code`` with options ``iopt``: made on first use, once
-    per process (there are 20 variants; a run uses a few)."""
+def lane_entries(code, iopt):
+    """The vector loop of kernel ``code`` with options ``iopt`` (:func:`entry`): made on first
+    use, once per process (there are 20 variants; a run uses a few)."""
     return lanes_of(code, lane_options(code, iopt))
 
 
-def lanes_of(code, opts) -> Entries:
-    """The vector entries of kernel ``code`` with the option set ``opts`` (:func:`lane_options`)."""
+def lanes_of(code, opts):
+    """The vector loop (:func:`entry`) of kernel ``code`` with the option set ``opts`` (:func:`lane_options`)."""
     key = (int(code), tuple(int(x) for x in opts))  # ints: the closures' cells key the cache
     got = _ENTRIES.get(key)
     if got is None:
         old, config.CACHE_DIR = config.CACHE_DIR, _CACHE_DIR  # numba reads it when decorating
         try:
-            got = _ENTRIES[key] = entries(*key)
+            got = _ENTRIES[key] = entry(*key)
         finally:
             config.CACHE_DIR = old
     return got

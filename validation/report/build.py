@@ -80,10 +80,20 @@ def _run_sections(ctx, specs):
     return [done[spec.id] for spec in specs]
 
 
-#: the kernels a report runs, each a task of :func:`compile_ahead` (every kernel in float64,
-#: FacetBRDF's in float32 too); the largest first (Cook-Torrance: 8 option sets on SIMD lanes)
-REPORT_KERNELS = (("cook", "float64"), ("maxwell", "float64"), ("facet", "float64"), ("facet", "float32"),
-                  ("single", "float64"), ("diffuse", "float64"), ("btdf", "float64"))  # fmt: skip
+#: the loops a report runs, as tasks of :func:`compile_ahead`: ``(kernel, precision, option
+#: sets)``, the option sets of the vector loops its models take (recorded from a ``report
+#: --quick`` by wrapping ``kernels.vector.lanes_of``: all of Cook-Torrance's 8, 3 of
+#: Maxwell-Beard's 6), None for none.  A set missing here still compiles, on first use.
+#: Cook-Torrance's 8 loops are split in two tasks, so that the two processes of a 2-core
+#: machine finish together (each loop ~6 s of a cold cache; a process types the kernel once)
+_COOK = [(a, b, c) for a in (0, 1) for b in (0, 1) for c in (0, 1)]
+REPORT_KERNELS = (
+    ("cook", "float64", _COOK[:4]), ("cook", "float64", _COOK[4:]),
+    ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)]), ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)]),
+    ("single", "float64", [(0, 0, 0), (1, 0, 0)]), ("facet", "float32", None),
+    ("diffuse", "float64", [(0, 0, 0)]), ("btdf", "float64", []),
+    ("montecarlo", "float64", None), ("aperture", "float64", None), ("disc", "float64", None),
+)  # fmt: skip
 
 
 def _warm(task):
@@ -93,9 +103,9 @@ def _warm(task):
 
 
 def compile_ahead(executor):
-    """Compile the kernels a report runs that numba's cache lacks on ``executor``'s local
-    worker processes, a different kernel on each at once (:func:`scatterbench.models.kernels.warm`),
-    before the sections need them: otherwise every process compiled each kernel it reached,
+    """Compile the loops a report runs that numba's cache lacks on ``executor``'s local
+    worker processes, a different task on each at once (:func:`scatterbench.models.kernels.warm`),
+    before the sections need them: otherwise every process compiled each loop it reached,
     the workers the same ones at the same time.  Nothing for one process or a Dask cluster."""
     if getattr(executor, "kind", None) != "processes":
         return
@@ -103,7 +113,7 @@ def compile_ahead(executor):
 
     todo = [task for task in REPORT_KERNELS if kernels.cold(*task)]
     if todo:
-        kernels.announce([k for k, _ in todo], f"on {executor.workers} processes")
+        kernels.announce(list(dict.fromkeys(k for k, _, _ in todo)), f"on {executor.workers} processes")
         executor.map(_warm, todo, tasks=len(todo))
 
 
