@@ -15,6 +15,7 @@ Models combine incoherently with arithmetic, as in ``astropy.modeling``:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -138,6 +139,33 @@ class Model(Declared, ModelFacts):
         choice of kernel or numpy.  Wrappers, sums and fits evaluate their inner models
         through it; users call :meth:`mueller`, which validates and broadcasts."""
         return evaluation.flat(self, ti, tr, pr, 16)
+
+    def flat_mueller16_indexed(self, index, ti, tr, pr, out):
+        """Mueller elements ``(16, n)`` into ``out`` of this model set, whose parameters are flat
+        (length ``G``), at flat float64 angles validated already (length 1 or ``n``), geometry
+        ``k`` taking the set's element ``index[k]``: a fit's walkers x wavelengths, each shared by
+        many rows.  What a model derives from its parameters (the kernel's rows: R-bar's
+        quadrature, a validation) is computed once per element and gathered per geometry; the
+        kernel rows are elementwise in the parameters, so the bits are those of the set
+        broadcast to the geometries.  A model without a kernel here is that broadcast set
+        through :func:`~scatterbench.models.evaluation.flat`."""
+        leaves = self._sets
+        if not evaluation.kernel_path(self):
+            whole = modelset.with_leaves(self, {p: a.reshape(-1)[index] for p, a in leaves.items()})
+            out[...] = evaluation.flat(whole, ti, tr, pr)
+            return out
+        from . import kernels  # numba (heavy): compiled kernels load when one first runs
+
+        code, rows, options = self._kernel_spec()
+        g = math.prod(self.param_shape)
+        n = out.shape[1]
+        for start in range(0, n, evaluation.KERNEL_CHUNK):  # chunks bound the gathered parameter rows
+            sl = slice(start, min(start + evaluation.KERNEL_CHUNK, n))
+            at = index[sl]
+            part = [np.asarray(r).reshape(-1)[at] if np.size(r) == g and np.ndim(r) else r for r in rows]
+            angles = [a if a.shape[0] == 1 else a[sl] for a in (ti, tr, pr)]
+            kernels.Compiled(self, code, part, options).write(out, sl, *angles, "float64")
+        return out
 
     def flat_brdf(self, ti, tr, pr):
         """:meth:`flat_mueller16`'s ``M00`` ``(n,)`` alone."""

@@ -18,9 +18,9 @@ made in one place each:
   a small call of a single compiled model straight into its kernel (:func:`small`), or the
   angles validated and broadcast once (:class:`Plan`) and evaluated chunk by chunk
   (:func:`fill`); :func:`blocks` streams the same chunks (``iter_mueller``), and
-  :class:`FixedAngles` keeps one set of validated angles for many models (a fit's rows),
-  and :func:`indexed` evaluates a small model set gathered per geometry (a fit's walkers x
-  wavelengths over its rows);
+  :class:`FixedAngles` keeps one set of validated angles for many models (a fit's rows)
+  (:meth:`scatterbench.models.base.Model.flat_mueller16_indexed` evaluates a small model set
+  gathered per geometry: a fit's walkers x wavelengths over its rows);
 * :func:`kernel_precision` decides, once per model, whether a float32 request runs the
   float32 kernel or the float64 one (:mod:`scatterbench.models.float32_domain`).
 
@@ -54,7 +54,6 @@ __all__ = [
     "blocks",
     "Plan",
     "FixedAngles",
-    "indexed",
     "small_angles",
     "as_matrices",
     "float32_guarded",
@@ -299,34 +298,6 @@ class FixedAngles:
         if leaves:
             model = with_leaves(model, {k: _whole(v, shape) for k, v in leaves.items()})
         return shape, model._kernel.run(*angles, 16)
-
-
-def indexed(model, index, ti, tr, pr, out):
-    """Mueller elements ``(16, n)`` into ``out`` of a model set whose parameters are flat
-    (length ``G``), at flat float64 angles validated already (length 1 or ``n``), geometry ``k``
-    taking the set's element ``index[k]``: a fit's walkers x wavelengths, each shared by many
-    rows.  What a model derives from its parameters (the kernel's rows: R-bar's quadrature, a
-    validation) is computed once per element and gathered per geometry rather than per
-    geometry; the kernel rows are elementwise in the parameters, so the bits are those of the
-    set broadcast to the geometries.  A model without a kernel here is that broadcast set
-    through :func:`flat`."""
-    leaves = model._sets
-    if not kernel_path(model):
-        whole = with_leaves(model, {p: a.reshape(-1)[index] for p, a in leaves.items()})
-        out[...] = flat(whole, ti, tr, pr)
-        return out
-    from . import kernels  # numba (heavy): loaded with the first kernel
-
-    code, rows, options = model._kernel_spec()
-    g = math.prod(model.param_shape)
-    n = out.shape[1]
-    for start in range(0, n, KERNEL_CHUNK):  # chunks bound the gathered parameter rows
-        sl = slice(start, min(start + KERNEL_CHUNK, n))
-        at = index[sl]
-        part = [np.asarray(r).reshape(-1)[at] if np.size(r) == g and np.ndim(r) else r for r in rows]
-        angles = [a if a.shape[0] == 1 else a[sl] for a in (ti, tr, pr)]
-        kernels.Compiled(model, code, part, options).write(out, sl, *angles, "float64")
-    return out
 
 
 def _whole(a, shape):

@@ -84,8 +84,8 @@ def test_model_sets_use_the_float32_kernels_like_their_elements(cls, kwargs, tmp
 
 
 @pytest.mark.parametrize("backend", ["numba", "numpy"])
-def test_indexed_gives_the_bits_of_the_set_broadcast_to_the_geometries(backend):
-    """``evaluation.indexed`` (a fit's walkers x wavelengths gathered per row) equals the set
+def test_flat_mueller16_indexed_gives_the_bits_of_the_set_broadcast_to_the_geometries(backend):
+    """``Model.flat_mueller16_indexed`` (a fit's walkers x wavelengths gathered per row) equals the set
     whose parameters are the gathered ones, evaluated at the same angles, bit for bit, on
     both routes (over two kernel chunks), and derives R-bar once per element, not per row."""
     rng = np.random.default_rng(3)
@@ -102,6 +102,6 @@ def test_indexed_gives_the_bits_of_the_set_broadcast_to_the_geometries(backend):
     )
     with models.evaluation.backend(backend):
         for (_, a), (_, b) in zip(small.terms, whole.terms, strict=True):
-            got = models.evaluation.indexed(a, index, ti, tr, pr, np.empty((16, n)))
+            got = a.flat_mueller16_indexed(index, ti, tr, pr, np.empty((16, n)))
             assert np.array_equal(got, b.mueller16(ti, tr, pr)[1])
     assert small.terms[0][1].rbar.shape == (4,)

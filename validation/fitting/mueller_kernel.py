@@ -16,6 +16,8 @@ import math
 import numba
 import numpy as np
 
+from scatterbench.models.kernels.threads import spread
+
 __all__ = ["pack_map", "loglike_rows"]
 
 _LOG2PI = math.log(2.0 * math.pi)
@@ -34,14 +36,23 @@ def pack_map(maps, elements):
     return src, coef, nsrc
 
 
-@numba.njit(cache=True, parallel=True)
-def loglike_rows(M, src, coef, nsrc, obs, is_m11, c, s2, errvar, out):  # pragma: no cover - compiled
+def loglike_rows(M, src, coef, nsrc, obs, is_m11, c, s2, errvar, out):
     """Per-row log-likelihood into ``out`` ``(W, N)`` from the psps elements ``M`` ``(16, W, N)``
     (element 0 is M11 in every basis); ``obs`` ``(E, N)``: ln M11 or the normalized element;
     ``c`` ``(W,)`` the calibration; ``s2`` ``(E, W)`` the noise variances; ``errvar`` ``(E, N)``.
-    The walkers over the cores, each walker's rows in the serial order (:func:`_walker`)."""
-    has_err = np.any(errvar != 0.0)
-    for w in numba.prange(out.shape[0]):
+    The walkers over the cores (:func:`~scatterbench.models.kernels.threads.spread`: a
+    ``prange`` entry compiles through numba's parallel pipeline, seconds more of a cold
+    cache), each walker's rows in the serial order (:func:`_walker`)."""
+    has_err = bool(np.any(errvar != 0.0))
+    spread(_walkers, (M, src, coef, nsrc, obs, is_m11, c, s2, errvar, has_err, out), out.shape[0], 1)
+
+
+@numba.njit(cache=True, nogil=True)
+def _walkers(
+    M, src, coef, nsrc, obs, is_m11, c, s2, errvar, has_err, out, lo, hi
+):  # pragma: no cover - compiled
+    """Walkers ``lo .. hi - 1`` of :func:`loglike_rows`."""
+    for w in range(lo, hi):
         _walker(M, w, src, coef, nsrc, obs, is_m11, math.log(c[w]), s2[:, w], errvar, has_err, out[w])
 
 
