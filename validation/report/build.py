@@ -83,16 +83,18 @@ def _run_sections(ctx, specs):
 #: the loops a report runs, as tasks of :func:`compile_ahead`: ``(kernel, precision, option
 #: sets)``, the option sets of the vector loops its models take (recorded from a ``report
 #: --quick`` by wrapping ``kernels.vector.lanes_of``: all of Cook-Torrance's 8, 3 of
-#: Maxwell-Beard's 6), None for none.  A set missing here still compiles, on first use.
-#: Cook-Torrance's 8 loops are split in two tasks, so that the two processes of a 2-core
-#: machine finish together (each loop ~6 s of a cold cache; a process types the kernel once)
+#: Maxwell-Beard's 6; None: every one, or a module's entries), and the Monte Carlo, aperture
+#: and disc entries.  A loop missing here still compiles, on first use.  Largest first (CPU
+#: seconds of each task on a cold cache, one process, 2026-11-29: 21, 19, 16, 12, 12, 10, 10,
+#: 8, 8, 7, 3), so that the processes of a 2-core machine finish together; Cook-Torrance's 8
+#: loops in two tasks (a process types the kernel once, each loop then costs ~3 s)
 _COOK = [(a, b, c) for a in (0, 1) for b in (0, 1) for c in (0, 1)]
 REPORT_KERNELS = (
-    ("cook", "float64", _COOK[:4]), ("cook", "float64", _COOK[4:]),
-    ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)]), ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)]),
-    ("single", "float64", [(0, 0, 0), (1, 0, 0)]), ("facet", "float32", None),
-    ("diffuse", "float64", [(0, 0, 0)]), ("btdf", "float64", []),
-    ("montecarlo", "float64", None), ("aperture", "float64", None), ("disc", "float64", None),
+    ("cook", "float64", _COOK[:4]), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)]),
+    ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)]), ("montecarlo", "float64", None),
+    ("cook", "float64", _COOK[4:]), ("single", "float64", [(0, 0, 0), (1, 0, 0)]), ("facet", "float32", None),
+    ("aperture", "float64", None), ("disc", "float64", None), ("diffuse", "float64", [(0, 0, 0)]),
+    ("btdf", "float64", []),
 )  # fmt: skip
 
 
