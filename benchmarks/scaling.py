@@ -2,7 +2,8 @@
 count, and the first ``report --quick`` cold and warm.
 
     python benchmarks/scaling.py [--geometries 1000000] [--threads 1 2 ...] [--workers 1 2 ...]
-                                 [--studies sweep-quick presets ...] [--first-run] [--repeat 3]
+                                 [--studies sweep-quick presets ...] [--first-run] [--compile]
+                                 [--repeat 3]
 
 * **Kernels.** ``FacetBRDF.mueller16`` (Gaussian slopes, aluminium, no shadowing) on ``--geometries``
   random geometries, ``numba.set_num_threads(t)`` for every ``t`` in ``--threads`` (default
@@ -16,6 +17,10 @@ count, and the first ``report --quick`` cold and warm.
 * **First run** (``--first-run``): ``scatterbench report --quick`` with an empty numba cache
   (``NUMBA_CACHE_DIR`` a fresh folder: every kernel compiles) and then again with that cache
   (warm), with the default ``--workers``.
+* **Compilation** (``--compile``): each compile-ahead task of a report
+  (``validation.report.build.REPORT_KERNELS``: a kernel's loops, or the Monte Carlo, aperture or
+  disc entries) in turn, in one fresh process with an empty numba cache: wall and CPU seconds
+  per task and their sum (what the report's worker processes share on a first run).
 
 The machine's load average is printed before and after each part: figures from a shared
 machine are noisy.
@@ -114,6 +119,30 @@ def first_run():
             print(f"  {label:<25} {time.perf_counter() - t:7.1f} s  exit {r.returncode}")
 
 
+_COMPILE = """
+import time
+from scatterbench.models import kernels
+from scatterbench.validation.report.build import REPORT_KERNELS
+total = 0.0
+for task in REPORT_KERNELS:
+    t, c = time.perf_counter(), time.process_time()
+    kernels.warm(*task)
+    cpu = time.process_time() - c
+    total += cpu
+    sets = "all" if task[2] is None else len(task[2])
+    print(f"  {task[0]:<10} {task[1]:<8} option sets {sets!s:>3}  {time.perf_counter() - t:6.1f} s  cpu {cpu:6.1f} s")
+print(f"  all tasks: cpu {total:.1f} s")
+"""
+
+
+def compile_tasks():
+    """The report's compile-ahead tasks one after another in a fresh process, empty cache."""
+    print(f"\ncompilation: the report's compile-ahead tasks, one process, empty numba cache; {_load()}")
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        subprocess.run([sys.executable, "-c", _COMPILE], env=env, check=True)
+
+
 def _powers(top):
     out, k = [], 1
     while k < top:
@@ -130,11 +159,14 @@ def main():
     ap.add_argument("--studies", nargs="*", choices=STUDY_NAMES, default=list(REPORT_STUDIES))
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--first-run", action="store_true", help="also time report --quick cold and warm")
+    ap.add_argument("--compile", action="store_true", help="also time each compile-ahead task, empty cache")
     args = ap.parse_args()
     c = cores()
     print(f"{c} cores in this process's affinity mask; {_load()}")
     kernels(int(args.geometries), args.threads or list(range(1, c + 1)), args.repeat)
     ok = studies(args.studies, args.workers or _powers(c))
+    if args.compile:
+        compile_tasks()
     if args.first_run:
         first_run()
     print(f"\nend; {_load()}")

@@ -28,6 +28,9 @@ SMITH_KINDS = (GAUSSIAN, GGX, ANISO_GAUSSIAN, ANISO_GGX)
 SHADOWING_KINDS = {"none": 0, "smith": 1, "smith-correlated": 2}
 #: the Cook-Torrance kernel's shadowing codes (Smith's ``G`` of its Gaussian slopes)
 COOK_SHADOWING = {"none": 0, "blinn": 1, "smith": 2}
+#: in a vector loop's option set, an option the loop reads at run time
+#: (:func:`scatterbench.models.kernels.vector.lane_options`)
+RUNTIME = -1
 
 
 #: each kernel's parameter rows, by name and in order: a model's ``_kernel_spec`` gives its

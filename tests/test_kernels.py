@@ -6,6 +6,7 @@ import math
 import os
 import subprocess
 import sys
+import time
 
 import numba
 import numpy as np
@@ -378,8 +379,14 @@ def test_spread_runs_ranges_on_threads_and_the_bits_do_not_depend_on_their_numbe
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("one thread only (NUMBA_NUM_THREADS)")
     seen = []
-    spread(lambda lo, hi: seen.append((lo, hi, threading.get_ident())), (), 4096, 1024)
-    assert sorted(r[:2] for r in seen) == [(0, 2048), (2048, 4096)] and len({r[2] for r in seen}) == 2, seen
+
+    def loop(lo, hi):
+        seen.append((lo, hi, threading.get_ident()))
+        time.sleep(0.05)  # long enough that the other thread takes a range too
+
+    spread(loop, (), 4096, 1024)
+    assert sorted(r[:2] for r in seen) == [(0, 1024), (1024, 2048), (2048, 3072), (3072, 4096)], seen
+    assert len({r[2] for r in seen}) == 2, seen
     x = np.linspace(0.0, 1.4, 5000)
     calls = [
         lambda: models.FacetBRDF().mueller(0.4, x, 0.3),

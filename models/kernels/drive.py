@@ -6,7 +6,8 @@ rows of length 1 (a single model) or ``n`` (a model set, one element per geometr
 ``iopt`` its options (slope kind, shadowing, conventions); ``out`` the element-major result
 ``(16, N)`` (or ``(1, N)``: ``M00`` only), written from column ``start``.  No Python runs per
 geometry: one compiled loop per kernel (:func:`entry`) takes a range of geometries, and
-:class:`scatterbench.models.kernels.Loops` calls it serially or on ranges over the cores.
+:class:`scatterbench.models.kernels.Compiled` calls it serially or on ranges over the cores
+(:func:`scatterbench.models.kernels.threads.spread`).
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def store(out, i, m):
     out[13, i], out[14, i], out[15, i] = m[13], m[14], m[15]
 
 
-#: the fewest geometries of a range given to a thread (:class:`scatterbench.models.kernels.Loops`)
+#: the fewest geometries of a range given to a thread (:func:`scatterbench.models.kernels.threads.spread`)
 BLOCK = 1024
 
 
@@ -130,7 +131,7 @@ def entry(code):
     :data:`ENTRIES`): ``run_range(ti, tr, pr, prm, iopt, out, start, lo, hi)``, geometries
     ``lo .. hi - 1`` into ``out[:, start + i]``, without the GIL.  Serial, parallel, checked
     and one-geometry calls are that loop called from Python
-    (:class:`scatterbench.models.kernels.Loops`): one entry per kernel compiles the kernel once,
+    (:func:`scatterbench.models.kernels.threads.spread`): one entry per kernel compiles the kernel once,
     where four (a serial, a ``prange``, a checked and a scalar one) each had LLVM optimize the
     inlined kernel again (10 s of a cold first call for Cook-Torrance, a third of it in the
     three extra copies).

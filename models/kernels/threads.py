@@ -10,6 +10,7 @@ detector aperture's 20-line sum.
 
 from __future__ import annotations
 
+import itertools
 import os
 from concurrent.futures import ThreadPoolExecutor
 
@@ -27,11 +28,16 @@ def _forget():
 os.register_at_fork(after_in_child=_forget)
 
 
+#: ranges per thread: a thread that finishes early (or was descheduled less) takes the next
+#: one, so that one slow thread does not hold the call up as with one range each
+PER_THREAD = 4
+
+
 def spread(loop, args, n, grain):
     """``loop(*args, lo, hi)`` over ``0 .. n - 1``: in one call below ``2 * grain``, otherwise
-    in equal ranges of at least ``grain`` over up to ``numba.get_num_threads()`` threads (what
-    ``numba.set_num_threads`` sets, as for numba's own parallel loops), the calling thread
-    taking the first."""
+    on up to ``numba.get_num_threads()`` threads (what ``numba.set_num_threads`` sets, as for
+    numba's own parallel loops), the calling thread one of them, each taking the next of up to
+    :data:`PER_THREAD` equal ranges per thread (each at least ``grain``) until none is left."""
     k = min(numba.get_num_threads(), n // max(grain, 1))
     if k <= 1:
         loop(*args, 0, n)
@@ -40,8 +46,15 @@ def spread(loop, args, n, grain):
         _POOL.append(
             ThreadPoolExecutor(numba.config.NUMBA_NUM_THREADS, thread_name_prefix="scatterbench-kernel")
         )
-    cuts = [n * j // k for j in range(k + 1)]
-    rest = [_POOL[0].submit(loop, *args, cuts[j], cuts[j + 1]) for j in range(1, k)]
-    loop(*args, cuts[0], cuts[1])
+    parts = min(PER_THREAD * k, n // grain)
+    cuts = [n * j // parts for j in range(parts + 1)]
+    ticket = itertools.count()  # next() on it is atomic under the GIL: each range runs once
+
+    def work():
+        while (j := next(ticket)) < parts:
+            loop(*args, cuts[j], cuts[j + 1])
+
+    rest = [_POOL[0].submit(work) for _ in range(k - 1)]
+    work()
     for f in rest:
         f.result()

@@ -31,7 +31,7 @@ from numba import errors, njit, types
 from numba.core import config
 from numba.extending import overload
 
-from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX
+from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME
 from .common import NO_SHADOWING, azimuths
 from .drive import COOK, DIFFUSE, FACET, KERNELS, MAXWELL, PARAM_ROWS, SINGLE, named
 
@@ -121,8 +121,10 @@ def gather(sc, ti, tr, pr, prm, lo, m):
 
 def lane_options(code, iopt) -> tuple:
     """The options kernel ``code``'s lanes are compiled for: those its kernel reads, as
-    constants (a loop per slope kind, phase, varnish, convention, shadowing), so that the
-    branches left in the loop are selects and each variant compiles only when a model uses it."""
+    constants (a loop per slope kind, phase, varnish, shadowing), so that the branches left in
+    the loop are selects and each variant compiles only when a model uses it; :data:`RUNTIME`
+    where the loop reads the option from ``iopt`` instead (Cook-Torrance's convention, a choice
+    of scale: a loop per convention cost ~3 s more of a cold cache each, for nothing at run time)."""
     o0, o1, o2 = (int(x) for x in iopt[:3])
     kind = o0 if o0 in (EXPONENTIAL, GAUSSIAN) else GGX
     if code == FACET:
@@ -131,23 +133,23 @@ def lane_options(code, iopt) -> tuple:
         return (int(o0 != 0), 0, 0)
     if code == DIFFUSE:
         return (0, 0, 0)
-    if code == COOK:
-        return (int(o0 == 1), o1, BLINN if o2 == BLINN else NO_COOK_SHADOWING)
+    if code == COOK:  # the convention is one scale or another: read at run time
+        return (int(o0 == 1), RUNTIME, BLINN if o2 == BLINN else NO_COOK_SHADOWING)
     return (kind, NO_SHADOWING, o2)  # MAXWELL
 
 
-def blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+def blocks(code, k0, k1, k2, ti, tr, pr, prm, iopt, out, start, lo, hi):
     """Geometries ``lo .. hi - 1`` into ``out[:, start + i]``, a block at a time, through
-    kernel ``code`` with options ``(k0, k1, k2)`` (:func:`lane_options`), all constants;
-    compiled code builds the loop while typing (:func:`_blocks_of`), Python
-    (``NUMBA_DISABLE_JIT=1``) runs the same here."""
-    _blocks_of(types.literal(code), types.literal(k0), types.literal(k1), types.literal(k2), *[None] * 8)(
-        code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi
+    kernel ``code`` with options ``(k0, k1, k2)`` (:func:`lane_options`), all constants (those
+    :data:`RUNTIME` read from ``iopt``); compiled code builds the loop while typing
+    (:func:`_blocks_of`), Python (``NUMBA_DISABLE_JIT=1``) runs the same here."""
+    _blocks_of(types.literal(code), types.literal(k0), types.literal(k1), types.literal(k2), *[None] * 9)(
+        code, k0, k1, k2, ti, tr, pr, prm, iopt, out, start, lo, hi
     )
 
 
 @overload(blocks, prefer_literal=True)
-def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
+def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, iopt, out, start, lo, hi):
     if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
         raise errors.RequireLiteralValue("blocks' kernel code and options must be constants")
     kernel = KERNELS[code.literal_value]
@@ -158,8 +160,14 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
     # options reach _loop typed int64, not as literals: numba then types _loop and the kernel
     # once per kernel, not once per option set (17 sets in a report: 35 s of a cold run),
     # and LLVM, inlining _loop here, still folds them as constants
-    def impl(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi):
-        o = (np.int64(o0), np.int64(o1), np.int64(o2))
+    r0, r1, r2 = o0 == RUNTIME, o1 == RUNTIME, o2 == RUNTIME
+
+    def impl(code, k0, k1, k2, ti, tr, pr, prm, iopt, out, start, lo, hi):
+        o = (
+            iopt[0] if r0 else np.int64(o0),
+            iopt[1] if r1 else np.int64(o1),
+            iopt[2] if r2 else np.int64(o2),
+        )
         sc = np.empty(_ROWS * VBLOCK)
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
@@ -176,18 +184,18 @@ def entry(code, opts):
     """The one compiled entry of kernel ``code``'s loop on SIMD lanes with options ``opts``
     (:func:`lane_options`), a closure over those ints: ``run_range(ti, tr, pr, prm, iopt, out,
     start, lo, hi)``, the arguments of the scalar loop's
-    (:func:`scatterbench.models.kernels.drive.entry`; ``iopt`` unread, the options being
-    constants), without the GIL.  Serial, parallel and checked calls are this loop called from
-    Python (:class:`scatterbench.models.kernels.Loops`): a compiled caller links the loop's code
+    (:func:`scatterbench.models.kernels.drive.entry`; ``iopt`` read only for the options
+    :data:`RUNTIME`), without the GIL.  Serial, parallel and checked calls are this loop called from
+    Python (:func:`scatterbench.models.kernels.threads.spread`): a compiled caller links the loop's code
     into its own and LLVM optimizes it again (a ``prange`` entry and a checked one took 7.8 s
     and 3.0 s per option set beside the loop's own 6.2 s, Cook-Torrance on a cold cache)."""
     k0, k1, k2 = opts
 
     @njit(cache=True, error_model="numpy", nogil=True)
-    @named(code, "_".join(str(k) for k in opts))
+    @named(code, "_".join("r" if k == RUNTIME else str(k) for k in opts))
     def run_range(ti, tr, pr, prm, iopt, out, start, lo, hi):
         """Geometries ``lo .. hi - 1`` into ``out[:, start + i]`` (:func:`blocks`)."""
-        blocks(code, k0, k1, k2, ti, tr, pr, prm, out, start, lo, hi)
+        blocks(code, k0, k1, k2, ti, tr, pr, prm, iopt, out, start, lo, hi)
 
     return run_range
 
@@ -199,7 +207,7 @@ _ENTRIES = {}
 
 
 def option_sets(code) -> list:
-    """Every option set :func:`lane_options` gives kernel ``code`` (20 in all): what
+    """Every option set :func:`lane_options` gives kernel ``code`` (16 in all): what
     :func:`scatterbench.models.kernels.warm` compiles."""
     if code == FACET:
         return [(k, NO_SHADOWING, 0) for k in FACET_KINDS]
@@ -208,7 +216,7 @@ def option_sets(code) -> list:
     if code == DIFFUSE:
         return [(0, 0, 0)]
     if code == COOK:
-        return [(a, b, c) for a in (0, 1) for b in (0, 1) for c in (NO_COOK_SHADOWING, BLINN)]
+        return [(a, RUNTIME, c) for a in (0, 1) for c in (NO_COOK_SHADOWING, BLINN)]
     if code == MAXWELL:
         return [(k, NO_SHADOWING, c) for k in FACET_KINDS for c in (0, 1)]
     return []  # no lanes (FacetBTDF)
@@ -216,7 +224,7 @@ def option_sets(code) -> list:
 
 def lane_entries(code, iopt):
     """The vector loop of kernel ``code`` with options ``iopt`` (:func:`entry`): made on first
-    use, once per process (there are 20 variants; a run uses a few)."""
+    use, once per process (there are 16 variants; a run uses a few)."""
     return lanes_of(code, lane_options(code, iopt))
 
 

@@ -11,6 +11,7 @@ import traceback
 
 from tqdm import tqdm
 
+from scatterbench.models.kernel_specs import RUNTIME
 from scatterbench.validation.atomic import atomic_write_json, atomic_write_text, replacing_folder
 from scatterbench.validation.checks.registry import SEED, check_record, judge, select, tally
 
@@ -82,17 +83,16 @@ def _run_sections(ctx, specs):
 
 #: the loops a report runs, as tasks of :func:`compile_ahead`: ``(kernel, precision, option
 #: sets)``, the option sets of the vector loops its models take (recorded from a ``report
-#: --quick`` by wrapping ``kernels.vector.lanes_of``: all of Cook-Torrance's 8, 3 of
+#: --quick`` by wrapping ``kernels.vector.lanes_of``: all 4 of Cook-Torrance's, 3 of
 #: Maxwell-Beard's 6; None: every one, or a module's entries), and the Monte Carlo, aperture
-#: and disc entries.  A loop missing here still compiles, on first use.  Largest first (CPU
-#: seconds of each task on a cold cache, one process, 2026-11-29: 21, 19, 16, 12, 12, 10, 10,
-#: 8, 8, 7, 3), so that the processes of a 2-core machine finish together; Cook-Torrance's 8
-#: loops in two tasks (a process types the kernel once, each loop then costs ~3 s)
-_COOK = [(a, b, c) for a in (0, 1) for b in (0, 1) for c in (0, 1)]
+#: and disc entries.  A loop missing here still compiles, on first use.  Largest first
+#: (``python benchmarks/scaling.py --threads 1 --studies --compile`` times each), so that
+#: the processes of a 2-core machine finish together; Cook-Torrance's loops in two tasks
+_COOK = [(a, RUNTIME, c) for a in (0, 1) for c in (0, 1)]
 REPORT_KERNELS = (
-    ("cook", "float64", _COOK[:4]), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)]),
+    ("cook", "float64", _COOK[:2]), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)]),
     ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)]), ("montecarlo", "float64", None),
-    ("cook", "float64", _COOK[4:]), ("single", "float64", [(0, 0, 0), (1, 0, 0)]), ("facet", "float32", None),
+    ("cook", "float64", _COOK[2:]), ("single", "float64", [(0, 0, 0), (1, 0, 0)]), ("facet", "float32", None),
     ("aperture", "float64", None), ("disc", "float64", None), ("diffuse", "float64", [(0, 0, 0)]),
     ("btdf", "float64", []),
 )  # fmt: skip
