@@ -13,8 +13,8 @@ question (issue 29 part 4); this measures the speed of a joint fit.
 
 The run is ``run_fit`` (optimum, then emcee, every walker of a step in one call) with a step
 budget; the script prints the chain's own evaluations per second, the autocorrelation time it
-reached and, when the budget ends before N >= 50 tau, the time 50 tau would take at the measured
-rate.  It prints the load average before and after: on a shared machine the figures scale with
+reached (per parameter too, with each one's largest correlation) and, when the budget ends
+before N >= 50 tau, the time 50 tau would take at the measured rate.  It prints the load average before and after: on a shared machine the figures scale with
 the share of the cores this process got.
 """
 
@@ -113,6 +113,12 @@ def main(argv=None):
     print(ch.stop_reason)
     print(f"steps {ch.steps}, tau (max) {tau:.1f} steps, N / tau {ch.steps / tau:.1f}")
     print(f"evaluations per second (walker log posteriors): {rate:.0f}")
+    print("tau per parameter (steps), and each one's largest correlation with another:")
+    corr = np.corrcoef(ch.samples().T)
+    np.fill_diagonal(corr, 0.0)
+    for k, name in enumerate(lik.spec.names):
+        j = int(np.argmax(np.abs(corr[k])))
+        print(f"  {name:<28} {ch.tau[k]:8.1f}   r = {corr[k, j]:+.2f} with {lik.spec.names[j]}")
     print(f"sampling {ch.seconds:.1f} s; wall time (load, optimum, chain) {wall:.1f} s")
     if not ch.converged and np.isfinite(tau):
         need = 50 * tau * args.walkers / rate
