@@ -21,6 +21,7 @@ from scatterbench.validation.fitting.sampling import (
     ChainSettings,
     CheckpointBackend,
     CheckpointError,
+    at_bounds,
     initial_ball,
     optimize,
     run_chain,
@@ -542,3 +543,26 @@ def test_the_data_sidecar_sets_the_aperture_and_the_choice_is_fixed_for_the_fit(
         lik7.predict(lik7.model({"substrate.sigma": 0.1}))["brdf"].max()
         < lik.predict(lik.model({"substrate.sigma": 0.1}))["brdf"].max()
     )
+
+
+def test_at_bounds_says_when_a_posterior_is_pressed_against_its_prior_box(capsys):
+    """``at_bounds``: samples spread over the box put about 2% within 1% of the range of its
+    two bounds; samples piled at a bound put there nearly all; the fit's printout names such a
+    parameter (the PTFE joint fit's Cauchy A sat at 1.25001 on its bound 1.25), and only
+    such a one.  Fails when the band or the threshold changes what a flat posterior shows."""
+    from scatterbench.validation.cli.fit import _print_posterior
+
+    rng = np.random.default_rng(1)
+    bounds = np.array([[0.0, 1.0], [1.25, 1.45]])
+    u = np.column_stack([rng.uniform(0.0, 1.0, 20000), 1.25 + rng.exponential(5e-4, 20000)])
+    near = at_bounds(u, bounds)
+    assert 0.015 < near[0] < 0.025 and near[1] > 0.95, near
+    stats = {"p2.5": 0.0, "p16": 0.0, "p50": 0.0, "p84": 0.0, "p97.5": 0.0}
+    post = {
+        "parameters": {"flat": {**stats, "at_bound": near[0]}, "pressed": {**stats, "at_bound": near[1]}},
+        "information_criteria": {"max_log_likelihood": 0.0, "AIC": 0.0, "BIC": 0.0},
+        "posterior_predictive": {},
+    }
+    _print_posterior(post)
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if "pressed against" in ln)
+    assert "pressed 0.9" in line and "flat" not in line, line

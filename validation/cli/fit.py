@@ -279,6 +279,13 @@ def _print_posterior(post):
         if tc:
             line += f"  {tc['true']:g} ({'inside' if tc['inside_95'] else 'OUTSIDE'} 95%, {'inside' if tc['inside_68'] else 'outside'} 68%)"
         print(line)
+    pressed = {k: p["at_bound"] for k, p in post["parameters"].items() if p.get("at_bound", 0.0) > 0.1}
+    if pressed:  # more than 5x what a flat posterior puts within 1% of its two bounds
+        print(
+            "posterior pressed against a prior bound (fraction of samples within 1% of the range from it): "
+            + ", ".join(f"{k} {v:.2f}" for k, v in pressed.items())
+            + "; the model reaches the data only at the bound, or the bound is too narrow"
+        )
     ic = post["information_criteria"]
     print(f"max ln L {ic['max_log_likelihood']:.2f}, AIC {ic['AIC']:.2f}, BIC {ic['BIC']:.2f}")
     for t, c in post["posterior_predictive"].items():

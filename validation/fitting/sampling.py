@@ -405,10 +405,27 @@ def _result(backend, settings) -> ChainResult:
     )
 
 
+#: a sample within this fraction of its parameter's sampling-coordinate range from a bound is
+#: "at" the bound (:func:`at_bounds`)
+BOUND_BAND = 0.01
+
+
+def at_bounds(u, bounds):
+    """Per parameter, the fraction of samples ``u`` ``(S, k)`` within :data:`BOUND_BAND` of the
+    sampling-coordinate range of either bound (``bounds`` ``(k, 2)``): a posterior pressed
+    against its prior box (a model that reaches the data only at the box's edge, or bounds
+    too narrow), which also mixes slowly there.  Uniform samples give about 0.02."""
+    b = np.asarray(bounds, float)
+    band = BOUND_BAND * (b[:, 1] - b[:, 0])
+    return np.mean((u <= b[:, 0] + band) | (u >= b[:, 1] - band), axis=0)
+
+
 def summarize(result: ChainResult, spec):
-    """Posterior summary in physical units: percentiles, mean, std, correlations."""
+    """Posterior summary in physical units: percentiles, mean, std, correlations, and the
+    fraction of samples at a bound (:func:`at_bounds`)."""
     u = result.samples()
     x = np.column_stack([p.from_u(u[:, i]) for i, p in enumerate(spec.free)])
+    near = at_bounds(u, spec.u_bounds())
     q = np.percentile(x, [2.5, 16, 50, 84, 97.5], axis=0)
     burn, thin = result.burn_thin()
     params = {}
@@ -425,6 +442,7 @@ def summarize(result: ChainResult, spec):
             "tau_steps": float(result.tau[i]),
             "prior": p.prior,
             "bounds": [p.low, p.high],
+            "at_bound": float(near[i]),
         }
     corr = np.corrcoef(x.T) if x.shape[1] > 1 else np.ones((1, 1))
     i_best = np.unravel_index(np.argmax(result.log_prob), result.log_prob.shape)
