@@ -363,7 +363,12 @@ def test_warm_compiles_the_node_algebra_and_monte_carlo_for_the_types_the_models
         0.3, x, 0.2
     )
     for fn, sig in entries:
-        assert fn.signatures == before[fn] == [sig], (fn, before[fn], fn.signatures)
+        assert sig in before[fn] and fn.signatures == before[fn], (fn, before[fn], fn.signatures)
+    # read-only angles (the conformance kit gives models read-only inputs) take the same loop
+    frozen = x.copy()
+    frozen.flags.writeable = False
+    models.RoughDiffuseBRDF().mueller(0.3, frozen, frozen)
+    assert all(fn.signatures == before[fn] for fn, _ in entries)
 
 
 def test_spread_runs_ranges_on_threads_and_the_bits_do_not_depend_on_their_number():

@@ -224,6 +224,9 @@ def estimate(ti, tr, pr, n_i, n_r, z, m, prm, safe, parallel):
     parallel : bool
         Spread the geometries over the cores.
     """
+    # writable, contiguous float64: a read-only array (the conformance kit's inputs) is another
+    # argument type, which compiled the loop again
+    ti, tr, pr, n_i, n_r = (np.require(a, np.float64, ["C", "W"]) for a in (ti, tr, pr, n_i, n_r))
     mean = np.empty((16, ti.size))
     err = np.empty((16, ti.size))
     args = (ti, tr, pr, n_i, n_r, z, m, prm, float(safe), mean, err)
