@@ -224,9 +224,11 @@ def estimate(ti, tr, pr, n_i, n_r, z, m, prm, safe, parallel):
     parallel : bool
         Spread the geometries over the cores.
     """
-    # writable, contiguous float64: a read-only array (the conformance kit's inputs) is another
-    # argument type, which compiled the loop again
-    ti, tr, pr, n_i, n_r = (np.require(a, np.float64, ["C", "W"]) for a in (ti, tr, pr, n_i, n_r))
+    # copies, writable and contiguous: a read-only array (the conformance kit's inputs) is
+    # another argument type, which compiled the loop again; a copy, not np.require, which
+    # reads the writeable flag of a broadcast view (numpy's FutureWarning); n floats beside
+    # the walk over every facet pair of each geometry
+    ti, tr, pr, n_i, n_r = (np.array(a, dtype=np.float64, order="C") for a in (ti, tr, pr, n_i, n_r))
     mean = np.empty((16, ti.size))
     err = np.empty((16, ti.size))
     args = (ti, tr, pr, n_i, n_r, z, m, prm, float(safe), mean, err)
