@@ -71,9 +71,6 @@ __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
 #: ``fit`` command of ``benchmarks/fit_speed.py``, best of three runs each, 2 cores); small
 #: calls (<= 100 geometries) stay serial
 PARALLEL_MIN = 1024
-#: geometries from which a small call of a vectorized model takes :mod:`~scatterbench.models.kernels.vector`
-#: (below: the scalar loop, which needs no scratch)
-VECTOR_MIN = 16
 _HALF_PI = 0.5 * math.pi
 _FLOAT64 = np.dtype(np.float64)
 _DTYPES = {"float64": _FLOAT64, "float32": np.dtype(np.float32)}
@@ -196,39 +193,41 @@ def _other_entries(name):
     raise KeyError(name)
 
 
-def _warm_entries(kernel, precision, option_sets=None):
+def _warm_entries(kernel, precision, option_sets=None, scalar=True):
     """``(loop, signature)`` of the loops :class:`Compiled` may call for kernel ``kernel`` in
-    ``precision``: the scalar one, and in float64 the vector one of each option set in
+    ``precision``: the scalar one (unless ``scalar`` is false: a run whose models of this kernel
+    all take the vector loop), and in float64 the vector one of each option set in
     ``option_sets`` (default: every one, :func:`~scatterbench.models.kernels.vector.option_sets`);
     for the name of another module with cached entries, those (:func:`_other_entries`)."""
     if kernel not in drive.CODES:
         return _other_entries(kernel)
     code, sig = drive.CODES[kernel], _signature(precision)
-    loops = [drive.ENTRIES[code]]
+    loops = [drive.ENTRIES[code]] if scalar or precision != "float64" else []
     if precision == "float64":  # float32 has no lanes
         sets = vector.option_sets(code) if option_sets is None else option_sets
         loops += [vector.lanes_of(code, o) for o in sets]
     return [(fn, sig) for fn in loops]
 
 
-def cold(kernel, precision="float64", option_sets=None) -> bool:
+def cold(kernel, precision="float64", option_sets=None, scalar=True) -> bool:
     """Whether a loop of :func:`warm`'s is not in the cache yet."""
     return any(
         not os.path.exists(fn._cache._cache_file._index_path)
-        for fn, _ in _warm_entries(kernel, precision, option_sets)
+        for fn, _ in _warm_entries(kernel, precision, option_sets, scalar)
         if getattr(fn, "_cache", None) is not None
     )
 
 
-def warm(kernel, precision="float64", option_sets=None):
+def warm(kernel, precision="float64", option_sets=None, scalar=True):
     """Compile (or load from the cache) the loops of kernel ``kernel`` (a name of
     :data:`~scatterbench.models.kernels.drive.CODES`, or ``"montecarlo"``, ``"aperture"``,
     ``"disc"``: those modules' entries) that :class:`Compiled` may call in
-    ``precision`` (the vector ones of ``option_sets`` only, when given), for the argument types
+    ``precision`` (the vector ones of ``option_sets`` only, when given; the scalar one unless
+    ``scalar`` is false), for the argument types
     it passes, without running them: a first run compiles the kernels on its worker processes
     at once, each a different kernel, before it needs them (``scatterbench report``).  One
     process per kernel: its loops share the kernel's typing.  Returns ``kernel``."""
-    for fn, sig in _warm_entries(kernel, precision, option_sets):
+    for fn, sig in _warm_entries(kernel, precision, option_sets, scalar):
         if hasattr(fn, "compile"):  # not a Python function (NUMBA_DISABLE_JIT=1)
             fn.compile(sig)
     return kernel
@@ -293,6 +292,13 @@ class Compiled:
         """The kernel's loop on SIMD lanes (:func:`scatterbench.models.kernels.vector.lane_entries`)."""
         return vector.lane_entries(self.code, self.iopt)
 
+    @property
+    def _loop(self):
+        """The float64 loop: on SIMD lanes for a vectorized kernel, whatever the call's size (one
+        geometry costs 0.4 us more there than in the scalar loop, whose compilation a run of such
+        models then skips: 3-8 s of CPU per kernel on a cold cache), else the scalar one."""
+        return self.lanes if self.vectorized else self.scalar
+
     def params(self, precision):
         """The parameter rows in ``precision``; float32 rows take the angle rows (rotations)
         reduced to (-pi, pi] in float64 first, so that rounding keeps their cosines and sines."""
@@ -308,7 +314,7 @@ class Compiled:
     def call(self, ti, tr, pr, out, start, precision="float64"):
         """Evaluate flat angles (length 1 or n) into ``out[:, start:start + n]``."""
         n = max(ti.shape[0], tr.shape[0], pr.shape[0], self.prm["float64"].shape[1])
-        loop = self.lanes if precision == "float64" and self.vectorized else self.scalar
+        loop = self._loop if precision == "float64" else self.scalar
         # contiguous, writable inputs: one compiled specialization per entry and precision
         # (numba types a read-only array apart and compiles every kernel again, ~10 s cold)
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
@@ -364,14 +370,13 @@ class Compiled:
         if not drive.angles_ok(ti, tr, pr):
             return None
         if dtype is _FLOAT64 and n < PARALLEL_MIN:
-            loop = self.lanes if self.vectorized and n >= VECTOR_MIN else self.scalar
-            _announced(loop)(ti, tr, pr, self.prm["float64"], self.iopt, out, 0, 0, n)
+            _announced(self._loop)(ti, tr, pr, self.prm["float64"], self.iopt, out, 0, 0, n)
         else:
             self.call(ti.astype(dtype), tr.astype(dtype), azimuth_as(pr, dtype), out, 0, precision)
         return out.reshape(shape) if rows == 1 else evaluation.as_matrices(out, shape)
 
     def _one(self, theta_i, theta_r, phi_r, rows):
-        """One geometry given as three numbers, straight into the scalar loop; ``None`` for
+        """One geometry given as three numbers, straight into the float64 loop; ``None`` for
         anything else (arrays, a bad angle)."""
         if type(theta_i) is float and type(theta_r) is float and type(phi_r) is float:
             a, b, c = theta_i, theta_r, phi_r
@@ -385,7 +390,7 @@ class Compiled:
         if not (0.0 <= a <= _HALF_PI and 0.0 <= b <= _HALF_PI and math.isfinite(c)):
             return None
         out = np.empty((rows, 1))
-        _announced(self.scalar)(
+        _announced(self._loop)(
             np.full(1, a), np.full(1, b), np.full(1, c), self.prm["float64"], self.iopt, out, 0, 0, 1
         )
         return out.reshape(4, 4) if rows == 16 else out.reshape(())

@@ -82,19 +82,22 @@ def _run_sections(ctx, specs):
 
 
 #: the loops a report runs, as tasks of :func:`compile_ahead`: ``(kernel, precision, option
-#: sets)``, the option sets of the vector loops its models take (recorded from a ``report
+#: sets, scalar)``, the option sets of the vector loops its models take (recorded from a ``report
 #: --quick`` by wrapping ``kernels.vector.lanes_of``: all 4 of Cook-Torrance's, 3 of
-#: Maxwell-Beard's 6; None: every one, or a module's entries), and the Monte Carlo, aperture
-#: and disc entries.  A loop missing here still compiles, on first use.  Largest first
-#: (``python benchmarks/scaling.py --threads 1 --studies --compile`` times each), so that
-#: the processes of a 2-core machine finish together; Cook-Torrance's loops in two tasks
+#: Maxwell-Beard's 6; None: every one, or a module's entries), whether it calls the scalar loop
+#: (recorded by wrapping ``kernels.Compiled.scalar``: only for the options without lanes, Smith
+#: shadowing and other slopes of the facets and Cook-Torrance, and FacetBTDF), and the Monte
+#: Carlo, aperture and disc entries.  A loop missing here still compiles, on first use.  Largest
+#: first (``python benchmarks/scaling.py --threads 1 --studies --compile`` times each), so that
+#: the processes of a 2-core machine finish together; Cook-Torrance's loops in two tasks, the
+#: scalar one in one of them
 _COOK = [(a, RUNTIME, c) for a in (0, 1) for c in (0, 1)]
 REPORT_KERNELS = (
-    ("cook", "float64", _COOK[:2]), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)]),
-    ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)]), ("montecarlo", "float64", None),
-    ("cook", "float64", _COOK[2:]), ("single", "float64", [(0, 0, 0), (1, 0, 0)]), ("facet", "float32", None),
-    ("aperture", "float64", None), ("disc", "float64", None), ("diffuse", "float64", [(0, 0, 0)]),
-    ("btdf", "float64", []),
+    ("cook", "float64", _COOK[:2], True), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)], False),
+    ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)], True), ("montecarlo", "float64", None, False),
+    ("cook", "float64", _COOK[2:], False), ("single", "float64", [(0, 0, 0), (1, 0, 0)], False),
+    ("facet", "float32", None, True), ("aperture", "float64", None, False), ("disc", "float64", None, False),
+    ("diffuse", "float64", [(0, 0, 0)], False), ("btdf", "float64", [], True),
 )  # fmt: skip
 
 
@@ -115,7 +118,7 @@ def compile_ahead(executor):
 
     todo = [task for task in REPORT_KERNELS if kernels.cold(*task)]
     if todo:
-        kernels.announce(list(dict.fromkeys(k for k, _, _ in todo)), f"on {executor.workers} processes")
+        kernels.announce(list(dict.fromkeys(task[0] for task in todo)), f"on {executor.workers} processes")
         executor.map(_warm, todo, tasks=len(todo))
 
 
