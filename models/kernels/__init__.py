@@ -46,6 +46,14 @@ left the loop scalar (CookTorranceBRDF's vector loop ran at 0.118 instead of 0.0
 geometry, depending on which process had filled the cache first).  Uncached, every callee
 is compiled with its IR in the process that compiles an entry, so the code an entry gets
 does not depend on the order in which processes filled the cache.
+
+The kernels' helpers are inlined by LLVM (``forceinline=True``), not by numba
+(``inline="always"``, which types and lowers a callee's body again at every call site): the
+report's compile-ahead tasks took 101.9 s of CPU with numba's inlining and 80.9 s with LLVM's
+(one process, empty cache, the helper of the same session's other work sharing the 2 cores;
+``python benchmarks/scaling.py --compile``), the loops as fast and as vectorized.  Only
+:mod:`~scatterbench.models.kernels.vector`'s scratch accessors keep numba's inlining: they take
+the scratch array, and a call that passes an array counts references.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ from .threads import spread
 from .vector_math import atan2, inverse_binade, sincos, sqrt
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def _double_angle(c, s):
     """``(cos 2x, sin 2x)`` of the angle of ``(c, s)``, both scaled first by the power of two
     that brings the larger near 1 (squares that would underflow near the normal: exact, and
@@ -61,7 +61,7 @@ def nodes(ti, tr, pr, a, b, cos_u, w, out):
         _node(ti, pr, frame, a[k], b[k], cos_u[k], w[k], out, k * n)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def _node(ti, pr, frame, a, b, cos_u, w, out, o):
     """One node of every geometry into ``out[:, o:o + n]`` (a loop on SIMD lanes)."""
     for g in range(pr.shape[0]):
@@ -97,7 +97,7 @@ def _tiles(m, nodes_out, n, out, start, t0, t1):
         _tile(m, nodes_out, n, out, start, g0, min(TILE, n - g0))
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def _tile(m, nodes_out, n, out, start, g0, size):
     """:func:`rotate_sum` for geometries ``g0 .. g0 + size - 1``."""
     acc = np.zeros((17, TILE))  # the 16 rows and the weights' sum

@@ -34,7 +34,7 @@ _SQRT6 = math.sqrt(6.0)
 _INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def polar(t):
     """``(cos t, sin t)`` of a polar angle ``t`` in its precision, the sine as the numpy path
     takes it, ``sqrt(1 - cos^2)``, both computed in float64: in float32 that formula loses the
@@ -44,14 +44,14 @@ def polar(t):
     return polar_from(sincos(t)[1], t)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def polar_from(c, t):
     """:func:`polar` of ``t`` from its cosine ``c``, computed in float64."""
     T = type(t)
     return T(c), T(sqrt(1.0 - c * c))
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def azimuth(p):
     """``(cos p, sin p)`` of an azimuth (float64; :func:`~scatterbench.models.kernels.vector_math.sincos`,
     the C library beyond its range)."""
@@ -62,7 +62,7 @@ def azimuth(p):
     return math.cos(v), math.sin(v)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def azimuths(p, c, s):
     """:func:`azimuth` of every element of ``p`` into ``c``, ``s`` (float64 arrays of its
     length), in two passes: the polynomial over all of them (a loop on SIMD lanes), then the
@@ -76,7 +76,7 @@ def azimuths(p, c, s):
             s[k], c[k] = math.sin(v), math.cos(v)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def internal_sine(c_int, s_ext, n):
     """Sine of the refracted angle in a coating ``n`` of cosine ``c_int``, external sine
     ``s_ext``: float64 ``sqrt(1 - c_int^2)`` (the numpy path's); float32 ``s_ext / n`` (Snell;
@@ -300,7 +300,7 @@ def smith_g(shadowing, kind, di, dio, sx, sy, rot):
     return T(1.0) / (T(1.0) + (li + lo))
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     """The 16 Mueller elements (row-major) of a Jones matrix (Bohren & Huffman, as
     :func:`scatterbench.models.polarization.mueller16_from_jones`)."""
@@ -328,14 +328,14 @@ def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     )  # fmt: skip
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def diag16(m00):
     """A depolarizer ``diag(m00, 0, 0, 0)`` (the scalar models)."""
     z = type(m00)(0.0)
     return (m00, z, z, z, z, z, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def scaled16(m, f):
     """The 16 elements ``m`` times ``f``."""
     return (

@@ -57,7 +57,7 @@ def fresnel_average(c, mr, mi, pec):
     return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     """``D G F`` of Eq. 7 (:func:`scatterbench.models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
     and sines ``si``, ``sr``;
@@ -84,7 +84,7 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     return val
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def cook(geo, p, o):
     """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
     convention, ``o[2]``: the shadowing (:data:`scatterbench.models.kernel_specs.COOK_SHADOWING`)."""

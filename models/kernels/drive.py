@@ -38,7 +38,7 @@ OPTIONS = 3
 assert PARAM_ROWS == 11, "params() reads 11 rows"
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def geometry(ti, tr, pr):
     """``(theta_i, theta_r, phi_r, cos phi_r, sin phi_r)`` in the angles' precision."""
     T = type(pr)

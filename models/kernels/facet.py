@@ -13,7 +13,7 @@ from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, 
 from .vector_math import sqrt
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def facet_jones(g, p, o):
     """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
     Mueller matrix is the BRDF (:func:`scatterbench.models.facet.facet_jones`); ``g``: the geometry
@@ -21,7 +21,7 @@ def facet_jones(g, p, o):
     return facet_jones_at(g, polar(g[0]), polar(g[1]), p, o)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def facet_jones_at(g, pol_i, pol_r, p, o):
     """:func:`facet_jones` given the polar angles' ``(cos, sin)`` (:func:`~scatterbench.models.kernels.common.polar`)."""
     ti, tr, _, cp, sp = g
@@ -77,7 +77,7 @@ def facet_jones_at(g, pol_i, pol_r, p, o):
     )
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def facet(geo, p, o):
     """:class:`scatterbench.models.FacetBRDF` and :class:`scatterbench.models.SubsurfaceFacetBRDF` at one geometry."""
     a, b, c, d, e, f, g, h = facet_jones(geo, p, o)
@@ -115,7 +115,7 @@ def transmission_factors(c, mr):
     return ts, delta * (T(1.0) / (w + mr * c))
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     """Real Jones elements ``(ss, ps, sp, pp)`` of refraction through facet ``m`` and the local
     cosines ``(cos iota_in, cos iota_out)`` (the dyadic of seed 003 Eq. 40, Rodrigues' rotation)."""
@@ -137,14 +137,14 @@ def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     return ss, ps, sp, pp, c, c_out
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def _btdf_element(ea, eb, v, a_in, a_out, cg, inv1, ts, delta):
     """One element of :func:`btdf_jones`: out-basis vector ``ea``, in-basis vector ``eb``."""
     rot = cg * dot3(ea, eb) + dot3(ea, cross3(v, eb)) + dot3(ea, v) * dot3(v, eb) * inv1
     return ts * rot + delta * dot3(ea, a_out) * dot3(a_in, eb)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def btdf(g, p, o):
     """:class:`scatterbench.models.FacetBTDF` (``convention="paper"``) at one geometry."""
     ti, tt, pt, _, _ = g

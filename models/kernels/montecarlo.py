@@ -33,7 +33,7 @@ _REACHED = np.array([0, 1, 2, 4, 5, 6, 8, 9, 10, 15])
 _NO_BASIS = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _ray_basis(k):
     """``(s, p)`` of ray ``k``: ``s = unit(z x k)``, ``+y`` along the z axis
     (:func:`scatterbench.models.facet_btdf.ray_basis`)."""
@@ -45,7 +45,7 @@ def _ray_basis(k):
     return s, cross3(k, s)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     """The incident ray through facet ``m`` (slope x ``zx``): ``(weight, k1, basis of k1,
     Jones, flux factor)``; weight 0 where the facet is not struck or the ray does not go
@@ -63,7 +63,7 @@ def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     return w, k1, e1, (ss, ps, sp, pp), n * c_out / (c_in if c_in > 0.0 else 1.0)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
     """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
     ``(weight, k2, basis of k2, Jones, flux factor)``, weight 0 where no such ray exists."""
@@ -80,7 +80,7 @@ def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
     return w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
     """One live pair's Mueller estimate into ``x``: the totally diffuse term and the single
     scattering (depolarizing: a scalar; polarized: the Jones chain of Eq. 4-5)."""

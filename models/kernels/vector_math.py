@@ -98,7 +98,7 @@ def _to_bits(typingctx, x):
     return sig, codegen
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def inverse_binade(x):
     """``2^-e`` for the float64 ``x > 0`` of exponent ``e`` (``1 <= x 2^-e < 2`` for a normal
     ``x``): an exact scale that brings ``x`` near 1 without a division (subnormal ``x``: the
@@ -136,7 +136,7 @@ if config.DISABLE_JIT:
             return np.sqrt(x)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def sincos(x):
     """``(sin x, cos x)`` in float64 for ``|x| <= REDUCED_MAX`` (no branch, no call)."""
     v = np.float64(x)
@@ -152,7 +152,7 @@ def sincos(x):
     return (-sv if quad >= 2 else sv), (-cv if (quad == 1 or quad == 2) else cv)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def exp_neg(x):
     """``exp(-x)`` in the precision of ``x >= 0``, exactly zero from :data:`EXP_ZERO` on."""
     T = type(x)
@@ -166,7 +166,7 @@ def exp_neg(x):
     return T(e if v < EXP_ZERO else 0.0)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def hypot(x, y):
     """``hypot(x, y)`` without overflow or underflow and without a call: both scaled by the
     power of two that brings the larger near 1 (exact), within about an ulp of the C
@@ -180,7 +180,7 @@ def hypot(x, y):
     return sqrt(a * a + b * b) / scale
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def atan2(y, x):
     """``atan2(y, x)`` in float64 for finite ``x``, ``y`` (no branch, no call): the angle of
     ``(x, y)`` in [-pi, pi], with the C library's signs at zeros (``atan2(+-0, -0) = +-pi``)."""

@@ -32,7 +32,7 @@ def amplitudes(c, s, n):
     return s_int, c_int, a_s, a_p
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def depolarized16(asi, api, asr, apr, scale):
     """:func:`scatterbench.models.smooth_interface.depolarized_between`'s 16 elements."""
     T = type(asi)
@@ -45,7 +45,7 @@ def depolarized16(asi, api, asr, apr, scale):
     return (s_out * s_in, s_out * d_in, z, z, d_out * s_in, d_out * d_in, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def single(geo, p, o):
     """Single scattering under a smooth interface (seed 003 Eq. 20); ``o[0]``: polarized phase."""
     ti, tr, _, cp, sp = geo
@@ -71,7 +71,7 @@ def single(geo, p, o):
     return mueller16(ss, z, ps, z, sp_, z, pp, z)
 
 
-@njit(error_model="numpy", inline="always")
+@njit(error_model="numpy", forceinline=True)
 def diffuse(geo, p, o):
     """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``p[1]``: its scale."""
     ti, tr = geo[0], geo[1]
