@@ -130,7 +130,8 @@ for task in REPORT_KERNELS:
     cpu = time.process_time() - c
     total += cpu
     sets = "all" if task[2] is None else len(task[2])
-    print(f"  {task[0]:<10} {task[1]:<8} option sets {sets!s:>3}  {time.perf_counter() - t:6.1f} s  cpu {cpu:6.1f} s")
+    loops = f"option sets {sets!s:>3}" + (" + scalar" if task[3] else "         ")
+    print(f"  {task[0]:<10} {task[1]:<8} {loops}  {time.perf_counter() - t:6.1f} s  cpu {cpu:6.1f} s")
 print(f"  all tasks: cpu {total:.1f} s")
 """
 

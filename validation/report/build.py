@@ -94,10 +94,10 @@ def _run_sections(ctx, specs):
 _COOK = [(a, RUNTIME, c) for a in (0, 1) for c in (0, 1)]
 REPORT_KERNELS = (
     ("cook", "float64", _COOK[:2], True), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)], False),
-    ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)], True), ("montecarlo", "float64", None, False),
-    ("cook", "float64", _COOK[2:], False), ("single", "float64", [(0, 0, 0), (1, 0, 0)], False),
-    ("facet", "float32", None, True), ("aperture", "float64", None, False), ("disc", "float64", None, False),
-    ("diffuse", "float64", [(0, 0, 0)], False), ("btdf", "float64", [], True),
+    ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)], True), ("single", "float64", [(0, 0, 0), (1, 0, 0)], False),
+    ("montecarlo", "float64", None, False), ("facet", "float32", None, True), ("cook", "float64", _COOK[2:], False),
+    ("aperture", "float64", None, False), ("diffuse", "float64", [(0, 0, 0)], False), ("disc", "float64", None, False),
+    ("btdf", "float64", [], True),
 )  # fmt: skip
 
 
