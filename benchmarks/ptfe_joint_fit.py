@@ -36,7 +36,7 @@ from scatterbench.validation.fitting.fit import run_fit  # noqa: E402
 from scatterbench.validation.fitting.mueller_data import load_mueller_data  # noqa: E402
 from scatterbench.validation.fitting.mueller_fit import mueller_likelihood  # noqa: E402
 from scatterbench.validation.fitting.mueller_kernel import loglike_rows  # noqa: E402
-from scatterbench.validation.fitting.sampling import _default_start  # noqa: E402
+from scatterbench.validation.fitting.sampling import _default_start, at_bounds  # noqa: E402
 from scatterbench.validation.fitting.settings import ChainSettings  # noqa: E402
 
 
@@ -115,12 +115,20 @@ def main(argv=None):
     print(ch.stop_reason)
     print(f"steps {ch.steps}, tau (max) {tau:.1f} steps, N / tau {ch.steps / tau:.1f}")
     print(f"evaluations per second (walker log posteriors): {rate:.0f}")
-    print("tau per parameter (steps), and each one's largest correlation with another:")
-    corr = np.corrcoef(ch.samples().T)
+    print(
+        "tau per parameter (steps), each one's largest correlation with another, and the fraction"
+        " of the kept samples within 1% of a bound (at_bound; ~0.02 for a flat posterior):"
+    )
+    kept = ch.samples()
+    corr = np.corrcoef(kept.T)
     np.fill_diagonal(corr, 0.0)
+    near = at_bounds(kept, lik.spec.u_bounds())
     for k, name in enumerate(lik.spec.names):
         j = int(np.argmax(np.abs(corr[k])))
-        print(f"  {name:<28} {ch.tau[k]:8.1f}   r = {corr[k, j]:+.2f} with {lik.spec.names[j]}")
+        print(
+            f"  {name:<28} {ch.tau[k]:8.1f}   r = {corr[k, j]:+.2f} with {lik.spec.names[j]:<28}"
+            f" at_bound {near[k]:.2f}"
+        )
     print(f"sampling {ch.seconds:.1f} s; wall time (load, optimum, chain) {wall:.1f} s")
     if not ch.converged and np.isfinite(tau):
         need = 50 * tau * args.walkers / rate
