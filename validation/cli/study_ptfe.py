@@ -11,6 +11,7 @@ import time
 from scatterbench.references import nist_ptfe_path
 from scatterbench.validation.atomic import atomic_savefig, atomic_write_json, replacing_folder
 from scatterbench.validation.fitting.mueller_data import load_mueller_data
+from scatterbench.validation.fitting.settings import MOVES
 from scatterbench.validation.studies import ptfe
 from scatterbench.validation.studies.ptfe_figures import incidence_figure, incidence_maps
 
@@ -33,7 +34,9 @@ def settings_from(args) -> ptfe.StudySettings:
         except ValueError:
             raise UsageError(f"--cv-incidences: {args.cv_incidences!r} is not a list of degrees") from None
     try:
-        return ptfe.StudySettings(wavelength_nm=args.wavelength, seed=args.seed, cv=not args.no_cv, **kw)
+        return ptfe.StudySettings(
+            wavelength_nm=args.wavelength, seed=args.seed, cv=not args.no_cv, moves=args.moves, **kw
+        )
     except ValueError as exc:
         raise UsageError(f"--{str(exc).split(':')[0].replace('_', '-')}: {exc}") from None
 
@@ -133,6 +136,12 @@ def register_ptfe(ss):
     p.add_argument("--steps", type=int_at_least(10), default=None, help="emcee steps (default 200)")
     p.add_argument("--walkers", type=int_at_least(2), default=None)
     p.add_argument("--seed", type=int_at_least(0), default=0)
+    p.add_argument(
+        "--moves",
+        choices=MOVES,
+        default="stretch",
+        help="emcee's proposal: stretch, or differential evolution",
+    )
     p.add_argument("--models", default=None, help=f"comma separated, of {', '.join(ptfe.MODELS)}")
     p.add_argument("--cv-incidences", default=None, help="held-out incidences (deg); default: all")
     p.add_argument("--no-cv", action="store_true", help="skip the leave-one-incidence-out fits")

@@ -25,7 +25,7 @@ from scatterbench.validation.fitting.mueller_fit import (
     write_mueller_fit,
 )
 from scatterbench.validation.fitting.mueller_likelihood import Rows
-from scatterbench.validation.fitting.settings import ChainSettings
+from scatterbench.validation.fitting.settings import MOVES, ChainSettings
 
 __all__ = [
     "MODELS",
@@ -88,8 +88,11 @@ class StudySettings:
     cv: bool = True
     cv_incidences: tuple | None = None  # None: every incidence of the subset
     draws: int = 200
+    moves: str = "stretch"  # emcee's proposal (ChainSettings.moves: "stretch" or "de")
 
     def __post_init__(self):
+        if self.moves not in MOVES:
+            raise ValueError(f"moves: {self.moves!r} is not one of {', '.join(MOVES)}")
         if not (isinstance(self.row_step, int) and self.row_step >= 1):
             raise ValueError(f"row_step: {self.row_step!r} is not an integer >= 1")
         if not (isinstance(self.steps, int) and self.steps >= 10):
@@ -107,6 +110,7 @@ class StudySettings:
             check_every=self.steps,  # short chains: one autocorrelation estimate, at the end
             starts=1,
             seed=self.seed + seed_offset,
+            moves=self.moves,
         )
 
 
