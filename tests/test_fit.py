@@ -21,6 +21,8 @@ from scatterbench.validation.fitting.sampling import (
     ChainSettings,
     CheckpointBackend,
     CheckpointError,
+    _converged,
+    _unsettled,
     at_bounds,
     initial_ball,
     optimize,
@@ -566,3 +568,15 @@ def test_at_bounds_says_when_a_posterior_is_pressed_against_its_prior_box(capsys
     _print_posterior(post)
     line = next(ln for ln in capsys.readouterr().out.splitlines() if "pressed against" in ln)
     assert "pressed 0.9" in line and "flat" not in line, line
+
+
+def test_a_chain_past_50_tau_says_why_it_is_not_converged():
+    """The N >= 50 tau rule needs two autocorrelation estimates with max(tau) stable: a chain
+    past 50 tau at its only check, or with tau still moving, says which (the PTFE study's
+    chains, checked once at the end, each read "NOT converged" without saying why)."""
+    s = ChainSettings(max_steps=1000, check_every=1000)
+    tau = np.array([5.0, 10.0])
+    assert _unsettled([(1000, tau)], s).startswith(" (N is, but tau was estimated once")
+    assert "moved by 50%" in _unsettled([(500, tau / 2), (1000, tau)], s)
+    assert _unsettled([(1000, tau * 30)], s) == ""  # N < 50 tau: the rule's first half says it
+    assert _converged([(500, tau), (1000, tau)], s) and _unsettled([(500, tau), (1000, tau)], s) == ""

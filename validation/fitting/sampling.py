@@ -380,6 +380,17 @@ def _segment(sampler, state, n, bar, hold_sigint):
                 break  # the interrupt is raised when the block closes, the step stored
 
 
+def _unsettled(hist, settings):
+    """Why a chain whose last ``N >= tau_factor * max(tau)`` is still not converged: a single
+    autocorrelation estimate, or ``max(tau)`` still moving (the rule needs both); else ``""``."""
+    if not hist or _converged(hist, settings) or hist[-1][0] < settings.tau_factor * np.max(hist[-1][1]):
+        return ""
+    if len(hist) < 2:
+        return " (N is, but tau was estimated once: its stability is untested; check more often)"
+    moved = abs(np.max(hist[-1][1]) - np.max(hist[-2][1])) / np.max(hist[-1][1])
+    return f" (N is, but max(tau) moved by {moved:.0%} since the previous check, more than tau_rtol = {settings.tau_rtol:g})"
+
+
 def _result(backend, settings) -> ChainResult:
     """The chain in ``backend`` with its convergence verdict and the reason it stopped."""
     hist, f = backend.tau_history, settings.tau_factor
@@ -390,7 +401,7 @@ def _result(backend, settings) -> ChainResult:
     else:
         reason = (
             f"step budget reached: N = {backend.iteration} (max_steps), {f:g} tau = "
-            f"{f * np.max(tau):.0f}: NOT converged by the N >= {f:g} tau rule"
+            f"{f * np.max(tau):.0f}: NOT converged by the N >= {f:g} tau rule{_unsettled(hist, settings)}"
         )
     return ChainResult(
         chain=backend.get_chain(),

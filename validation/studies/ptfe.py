@@ -107,7 +107,9 @@ class StudySettings:
         return ChainSettings(
             walkers=self.walkers,  # raised to 2 x free parameters per model by fit_model
             max_steps=self.steps,
-            check_every=self.steps,  # short chains: one autocorrelation estimate, at the end
+            # ten autocorrelation estimates: the N >= 50 tau rule needs two to say a chain
+            # converged (one, at the end, left every long chain "NOT converged"), and stops there
+            check_every=max(1, self.steps // 10),
             starts=1,
             seed=self.seed + seed_offset,
             moves=self.moves,
