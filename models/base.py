@@ -158,13 +158,19 @@ class Model(Declared, ModelFacts):
 
         code, rows, options = self._kernel_spec()
         g = math.prod(self.param_shape)
+        # the rows once, one column per element (shared values repeated): the loops read column
+        # index[k] in place (drive.column), where a gather per chunk built (11, chunk) arrays
+        flat = [np.broadcast_to(np.asarray(r).reshape(-1) if np.size(r) == g else r, (g,)) for r in rows]
+        kernel = kernels.Compiled(self, code, flat, options)
+        index = kernel.indexed(index)
         n = out.shape[1]
-        for start in range(0, n, evaluation.KERNEL_CHUNK):  # chunks bound the gathered parameter rows
-            sl = slice(start, min(start + evaluation.KERNEL_CHUNK, n))
-            at = index[sl]
-            part = [np.asarray(r).reshape(-1)[at] if np.size(r) == g and np.ndim(r) else r for r in rows]
+        # in place, one call (the loops spread it over the cores); otherwise chunks bound write's buffer
+        inplace = type(out) is np.ndarray and out.flags.c_contiguous and out.dtype == np.float64
+        step = max(n if inplace else evaluation.KERNEL_CHUNK, 1)
+        for start in range(0, n, step):
+            sl = slice(start, min(start + step, n))
             angles = [a if a.shape[0] == 1 else a[sl] for a in (ti, tr, pr)]
-            kernels.Compiled(self, code, part, options).write(out, sl, *angles, "float64")
+            kernel.write(out, sl, *angles, "float64", index[sl])
         return out
 
     def flat_brdf(self, ti, tr, pr):
