@@ -129,6 +129,15 @@ with _caching_in(cache_dir()):
     from . import aperture, disc, drive, montecarlo, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
+def rbar_integrand():
+    """R-bar's compiled integrand (:mod:`~scatterbench.models.kernels.rbar`, a ``cfunc``), imported
+    on first use: a ``cfunc`` compiles (or loads from the cache) when decorated, and only models
+    with a smooth interface need it.  Imported here, so that it caches with the kernels."""
+    with _caching_in(cache_dir()):
+        from . import rbar
+    return rbar.integrand
+
+
 #: says when a kernel compiles (the command line shows it: ``scatterbench.validation.cli``)
 log = logging.getLogger(__name__)
 _READY = set()  # the entries this process has called (loaded from the cache or compiled)
