@@ -11,22 +11,24 @@ from scatterbench.models import smooth_interface
 
 
 def test_diffuse_subsurface_set_runs_one_quadrature_per_distinct_coating(monkeypatch):
-    """R-bar is a scipy quadrature: a set of 64 coatings evaluated in several chunks runs
-    it 64 times (it ran twice per coating: once deciding on the kernel, once per chunk)."""
+    """R-bar is a quadrature (QUADPACK, ``_compiled_quad``; ``quad`` in Python where that gives
+    nothing): a set of 64 coatings evaluated in several chunks runs it 64 times (it ran twice
+    per coating: once deciding on the kernel, once per chunk)."""
     calls = []
-    quad = smooth_interface.integrate.quad
-    monkeypatch.setattr(smooth_interface.integrate, "quad", lambda *a, **k: calls.append(1) or quad(*a, **k))
+    quad, python = smooth_interface._compiled_quad, smooth_interface._python_quad
+    monkeypatch.setattr(smooth_interface, "_compiled_quad", lambda *a: calls.append(1) or quad(*a))
+    monkeypatch.setattr(smooth_interface, "_python_quad", lambda *a: calls.append(2) or python(*a))
     smooth_interface._rbar.cache_clear()
     coating = np.linspace(1.1, 1.9, 64).reshape(64, 1)
     m = models.DiffuseSubsurfaceBRDF(coating=coating, rho=0.9)
     ti = np.linspace(0.0, 1.4, 2000)  # 128000 geometries: two kernel chunks
     M = m.mueller(ti, 0.3, 0.0)
-    assert len(calls) == 64
+    assert calls == [1] * 64
     for w in (0, 37, 63):
         one = models.DiffuseSubsurfaceBRDF(coating=float(coating[w, 0]), rho=0.9)
         assert one.rbar == m.rbar[w, 0]
         assert np.array_equal(one.mueller(ti, 0.3, 0.0), M[w])
-    assert len(calls) == 64
+    assert calls == [1] * 64
 
 
 SETS = [
@@ -124,8 +126,9 @@ def _gathered(model, index, ti, tr, pr):
 def test_indexed_kernel_call_gives_the_gathered_rows_bits(kind, tmp_path):
     """The kernels reading parameter column ``index[k]`` in place give, bit for bit, the kernel
     over rows gathered per geometry (FacetBRDF, DiffuseSubsurfaceBRDF, each term of a sum and
-    the sum as a fit adds it), into an ndarray in one call and into a memmap by chunks; an
-    index outside the set is refused."""
+    the sum as a fit adds it), into an ndarray in one call and into a memmap by chunks, and
+    added to what ``out`` holds (``add=True``: cache-sized buffers over the cores, or the memmap's
+    fallback) as ``out + result``; an index outside the set is refused."""
     from scatterbench.validation.fitting.mueller_likelihood import _mueller16
 
     rng = np.random.default_rng(11)
@@ -144,6 +147,16 @@ def test_indexed_kernel_call_gives_the_gathered_rows_bits(kind, tmp_path):
         assert np.array_equal(m.flat_mueller16_indexed(index, ti, tr, pr, np.empty((16, n))), r)
         mm = np.lib.format.open_memmap(tmp_path / f"{kind}.npy", mode="w+", dtype=np.float64, shape=(16, n))
         assert np.array_equal(np.asarray(m.flat_mueller16_indexed(index, ti, tr, pr, mm)), r)
+        base = rng.standard_normal((16, n))
+        for into in (base.copy(), np.lib.format.open_memmap(tmp_path / "add.npy", mode="w+", shape=(16, n))):
+            into[...] = base
+            assert np.array_equal(
+                np.asarray(m.flat_mueller16_indexed(index, ti, tr, pr, into, add=True)), base + r
+            )
+        row = _gathered(m, index, ti[:1], tr, pr[:1])  # angles of length 1 broadcast
+        assert np.array_equal(
+            m.flat_mueller16_indexed(index, ti[:1], tr, pr[:1], base.copy(), add=True), base + row
+        )
         one = m.flat_mueller16_indexed(index[7:8], ti[7:8], tr[7:8], pr[7:8], np.empty((16, 1)))
         assert np.array_equal(one[:, 0], r[:, 7])
         with pytest.raises(ValueError, match="index"):
