@@ -140,7 +140,7 @@ class Model(Declared, ModelFacts):
         through it; users call :meth:`mueller`, which validates and broadcasts."""
         return evaluation.flat(self, ti, tr, pr, 16)
 
-    def flat_mueller16_indexed(self, index, ti, tr, pr, out):
+    def flat_mueller16_indexed(self, index, ti, tr, pr, out, add=False):
         """Mueller elements ``(16, n)`` into ``out`` of this model set, whose parameters are flat
         (length ``G``), at flat float64 angles validated already (length 1 or ``n``), geometry
         ``k`` taking the set's element ``index[k]``: a fit's walkers x wavelengths, each shared by
@@ -148,8 +148,13 @@ class Model(Declared, ModelFacts):
         quadrature, a validation) is computed once per element and gathered per geometry; the
         kernel rows are elementwise in the parameters, so the bits are those of the set
         broadcast to the geometries.  A model without a kernel here is that broadcast set
-        through :func:`~scatterbench.models.evaluation.flat`."""
+        through :func:`~scatterbench.models.evaluation.flat`.  ``add``: ``out +=`` the elements
+        (a sum's later terms), the bits of adding them from an array of their own."""
         leaves = self._sets
+        inplace = type(out) is np.ndarray and out.flags.c_contiguous and out.dtype == np.float64
+        if add and not (inplace and evaluation.kernel_path(self)):
+            out += self.flat_mueller16_indexed(index, ti, tr, pr, np.empty(out.shape))
+            return out
         if not evaluation.kernel_path(self):
             whole = modelset.with_leaves(self, {p: a.reshape(-1)[index] for p, a in leaves.items()})
             out[...] = evaluation.flat(whole, ti, tr, pr)
@@ -158,13 +163,21 @@ class Model(Declared, ModelFacts):
 
         code, rows, options = self._kernel_spec()
         g = math.prod(self.param_shape)
+        # the rows once, one column per element (shared values repeated): the loops read column
+        # index[k] in place (drive.column), where a gather per chunk built (11, chunk) arrays
+        flat = [np.broadcast_to(np.asarray(r).reshape(-1) if np.size(r) == g else r, (g,)) for r in rows]
+        kernel = kernels.Compiled(self, code, flat, options)
+        index = kernel.indexed(index)
         n = out.shape[1]
-        for start in range(0, n, evaluation.KERNEL_CHUNK):  # chunks bound the gathered parameter rows
-            sl = slice(start, min(start + evaluation.KERNEL_CHUNK, n))
-            at = index[sl]
-            part = [np.asarray(r).reshape(-1)[at] if np.size(r) == g and np.ndim(r) else r for r in rows]
+        if add:  # through cache-sized buffers (Compiled.accumulate)
+            kernel.accumulate(ti, tr, pr, out, index)
+            return out
+        # in place, one call (the loops spread it over the cores); otherwise chunks bound write's buffer
+        step = max(n if inplace else evaluation.KERNEL_CHUNK, 1)
+        for start in range(0, n, step):
+            sl = slice(start, min(start + step, n))
             angles = [a if a.shape[0] == 1 else a[sl] for a in (ti, tr, pr)]
-            kernels.Compiled(self, code, part, options).write(out, sl, *angles, "float64")
+            kernel.write(out, sl, *angles, "float64", index[sl])
         return out
 
     def flat_brdf(self, ti, tr, pr):

@@ -11,22 +11,24 @@ from scatterbench.models import smooth_interface
 
 
 def test_diffuse_subsurface_set_runs_one_quadrature_per_distinct_coating(monkeypatch):
-    """R-bar is a scipy quadrature: a set of 64 coatings evaluated in several chunks runs
-    it 64 times (it ran twice per coating: once deciding on the kernel, once per chunk)."""
+    """R-bar is a quadrature (QUADPACK, ``_compiled_quad``; ``quad`` in Python where that gives
+    nothing): a set of 64 coatings evaluated in several chunks runs it 64 times (it ran twice
+    per coating: once deciding on the kernel, once per chunk)."""
     calls = []
-    quad = smooth_interface.integrate.quad
-    monkeypatch.setattr(smooth_interface.integrate, "quad", lambda *a, **k: calls.append(1) or quad(*a, **k))
+    quad, python = smooth_interface._compiled_quad, smooth_interface._python_quad
+    monkeypatch.setattr(smooth_interface, "_compiled_quad", lambda *a: calls.append(1) or quad(*a))
+    monkeypatch.setattr(smooth_interface, "_python_quad", lambda *a: calls.append(2) or python(*a))
     smooth_interface._rbar.cache_clear()
     coating = np.linspace(1.1, 1.9, 64).reshape(64, 1)
     m = models.DiffuseSubsurfaceBRDF(coating=coating, rho=0.9)
     ti = np.linspace(0.0, 1.4, 2000)  # 128000 geometries: two kernel chunks
     M = m.mueller(ti, 0.3, 0.0)
-    assert len(calls) == 64
+    assert calls == [1] * 64
     for w in (0, 37, 63):
         one = models.DiffuseSubsurfaceBRDF(coating=float(coating[w, 0]), rho=0.9)
         assert one.rbar == m.rbar[w, 0]
         assert np.array_equal(one.mueller(ti, 0.3, 0.0), M[w])
-    assert len(calls) == 64
+    assert calls == [1] * 64
 
 
 SETS = [
@@ -105,3 +107,57 @@ def test_flat_mueller16_indexed_gives_the_bits_of_the_set_broadcast_to_the_geome
             got = a.flat_mueller16_indexed(index, ti, tr, pr, np.empty((16, n)))
             assert np.array_equal(got, b.mueller16(ti, tr, pr)[1])
     assert small.terms[0][1].rbar.shape == (4,)
+
+
+def _gathered(model, index, ti, tr, pr):
+    """The route ``flat_mueller16_indexed`` took before it read columns through an index: the
+    kernel rows gathered per geometry into a kernel of their own."""
+    from scatterbench.models.kernels import Compiled
+
+    code, rows, options = model._kernel_spec()
+    g = math.prod(model.param_shape)
+    part = [np.asarray(r).reshape(-1)[index] if np.size(r) == g and np.ndim(r) else r for r in rows]
+    out = np.empty((16, index.size))
+    Compiled(model, code, part, options).write(out, slice(0, index.size), ti, tr, pr, "float64")
+    return out
+
+
+@pytest.mark.parametrize("kind", ["facet", "diffuse", "sum"])
+def test_indexed_kernel_call_gives_the_gathered_rows_bits(kind, tmp_path):
+    """The kernels reading parameter column ``index[k]`` in place give, bit for bit, the kernel
+    over rows gathered per geometry (FacetBRDF, DiffuseSubsurfaceBRDF, each term of a sum and
+    the sum as a fit adds it), into an ndarray in one call and into a memmap by chunks, and
+    added to what ``out`` holds (``add=True``: cache-sized buffers over the cores, or the memmap's
+    fallback) as ``out + result``; an index outside the set is refused."""
+    from scatterbench.validation.fitting.mueller_likelihood import _mueller16
+
+    rng = np.random.default_rng(11)
+    G, n = 6, models.evaluation.KERNEL_CHUNK + 500  # the memmap by two chunks
+    sig, nn, rho = rng.uniform(0.05, 0.5, G), rng.uniform(1.1, 1.8, G), rng.uniform(0.5, 0.99, G)
+    facet = models.FacetBRDF(slopes=models.GaussianSlopes(sig), substrate=nn)
+    diffuse = models.DiffuseSubsurfaceBRDF(coating=nn, rho=rho)
+    model = {"facet": facet, "diffuse": diffuse, "sum": diffuse + facet}[kind]
+    index = rng.integers(0, G, n)
+    ti, tr, pr = rng.uniform(0, 1.5, n), rng.uniform(0, 1.5, n), rng.uniform(-3, 3, n)
+    terms = [m for _, m in model.terms] if kind == "sum" else [model]
+    ref = [_gathered(m, index, ti, tr, pr) for m in terms]
+    got = _mueller16(model, index, (ti, tr, pr), np.empty((16, n)))
+    assert np.array_equal(got, ref[0] + ref[1] if kind == "sum" else ref[0])
+    for m, r in zip(terms, ref, strict=True):
+        assert np.array_equal(m.flat_mueller16_indexed(index, ti, tr, pr, np.empty((16, n))), r)
+        mm = np.lib.format.open_memmap(tmp_path / f"{kind}.npy", mode="w+", dtype=np.float64, shape=(16, n))
+        assert np.array_equal(np.asarray(m.flat_mueller16_indexed(index, ti, tr, pr, mm)), r)
+        base = rng.standard_normal((16, n))
+        for into in (base.copy(), np.lib.format.open_memmap(tmp_path / "add.npy", mode="w+", shape=(16, n))):
+            into[...] = base
+            assert np.array_equal(
+                np.asarray(m.flat_mueller16_indexed(index, ti, tr, pr, into, add=True)), base + r
+            )
+        row = _gathered(m, index, ti[:1], tr, pr[:1])  # angles of length 1 broadcast
+        assert np.array_equal(
+            m.flat_mueller16_indexed(index, ti[:1], tr, pr[:1], base.copy(), add=True), base + row
+        )
+        one = m.flat_mueller16_indexed(index[7:8], ti[7:8], tr[7:8], pr[7:8], np.empty((16, 1)))
+        assert np.array_equal(one[:, 0], r[:, 7])
+        with pytest.raises(ValueError, match="index"):
+            m.flat_mueller16_indexed(np.full(n, G), ti, tr, pr, np.empty((16, n)))

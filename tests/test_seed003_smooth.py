@@ -133,3 +133,27 @@ def test_rbar_float_integrand_gives_the_complex_forms_bits():
         _rbar.cache_clear()
         assert _rbar(float(n)) == complex_form(float(n)), n
     assert _rbar(math.inf) == 1.0
+
+
+def test_rbar_compiled_integrand_gives_the_python_quadratures_bits(monkeypatch):
+    """R-bar's quadrature with the compiled integrand (``kernels.rbar``, through QUADPACK's
+    ``qagpe`` directly: 20x faster, a fit meets 96 new indices per batch) gives the bits of
+    ``quad`` with the Python integrand, over a dense grid of indices from just above 1 to
+    1e150; where QUADPACK reports a problem (an index whose square overflows) it gives nothing
+    and ``_rbar`` takes ``quad``, which warns as before; without numba (no ``ctypes``) too."""
+    from scatterbench.models import smooth_interface as si
+
+    ns = np.concatenate(
+        [1.0 + np.logspace(-15.5, 0.0, 600), np.linspace(1.0001, 4.0, 600), np.logspace(0.6, 150.0, 300)]
+    )
+    for n in ns:
+        point = min(0.5, 10.0 * math.sqrt(n * n - 1.0))
+        got = si._compiled_quad(n * n, point)
+        assert got is not None and got == si._python_quad(n * n, point), n
+    assert si._compiled_quad(math.inf, 0.5) is None  # n^2 overflowed: the integrand is NaN
+    si._rbar.cache_clear()
+    fast = [si._rbar(float(n)) for n in ns[::10]]
+    monkeypatch.setattr(si, "_compiled_integrand", lambda: None)
+    si._rbar.cache_clear()
+    assert fast == [si._rbar(float(n)) for n in ns[::10]]
+    si._rbar.cache_clear()

@@ -38,8 +38,8 @@ def _both(kernel, ti, tr, pr):
     prm = kernel.params("float64")
     n = max(ti.size, prm.shape[1])
     a, b = np.empty((16, n)), np.empty((16, n))
-    kernel.scalar(ti, tr, pr, prm, kernel.iopt, a, 0, 0, n)
-    kernel.lanes(ti, tr, pr, prm, kernel.iopt, b, 0, 0, n)
+    kernel.scalar(ti, tr, pr, prm, drive.NO_INDEX, kernel.iopt, a, 0, 0, n)
+    kernel.lanes(ti, tr, pr, prm, drive.NO_INDEX, kernel.iopt, b, 0, 0, n)
     return a, b
 
 
@@ -81,6 +81,39 @@ def test_vector_loop_model_sets_and_broadcast_angles(model):
     assert np.array_equal(a, b)
 
 
+@pytest.mark.parametrize("model", VECTORIZED[::3], ids=lambda m: type(m).__name__)
+def test_loops_read_parameter_columns_through_an_index(model):
+    """An index (``drive.column``): geometry ``k`` reads parameter column ``index[k]`` of ``G``
+    columns, bit for bit the rows gathered per geometry, in the scalar and the vector loop;
+    ``[j]`` alone reads column ``j + k * p`` (one geometry: column ``j``)."""
+    ti, tr, pr = _inputs()
+    kernel = Compiled(model, *model._kernel_spec())
+    rng = np.random.default_rng(5)
+    cols = kernel.params("float64") * (1.0 + 0.01 * rng.random((drive.PARAM_ROWS, 7)))
+    index = rng.integers(0, 7, ti.size)
+    n = ti.size
+    for loop in (kernel.scalar, kernel.lanes):
+        got, ref = np.empty((16, n)), np.empty((16, n))
+        loop(ti, tr, pr, cols, index, kernel.iopt, got, 0, 0, n)
+        loop(ti, tr, pr, np.ascontiguousarray(cols[:, index]), drive.NO_INDEX, kernel.iopt, ref, 0, 0, n)
+        assert np.array_equal(got, ref)
+        one = np.empty((16, 1))
+        loop(ti[3:4], tr[3:4], pr[3:4], cols, np.array([5]), kernel.iopt, one, 0, 0, 1)
+        loop(
+            ti[3:4],
+            tr[3:4],
+            pr[3:4],
+            np.ascontiguousarray(cols[:, 5:6]),
+            drive.NO_INDEX,
+            kernel.iopt,
+            ref,
+            0,
+            0,
+            1,
+        )
+        assert np.array_equal(one[:, 0], ref[:, 0])
+
+
 def test_models_take_the_vector_loop_and_agree_with_numpy():
     """Large calls of a vectorized model run :mod:`~scatterbench.models.kernels.vector` and stay within
     the model's derived tolerance of the numpy reference (relative to M00)."""
@@ -98,11 +131,11 @@ _PROBE = """
 import re
 import numpy as np
 from scatterbench import models
-from scatterbench.models.kernels import Compiled
+from scatterbench.models.kernels import Compiled, drive
 for m in (models.FacetBRDF(), models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
     k = Compiled(m, *m._kernel_spec())
     k.run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
-    k.scalar(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], k.iopt, np.empty((16, 4)), 0, 0, 4)
+    k.scalar(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], drive.NO_INDEX, k.iopt, np.empty((16, 4)), 0, 0, 4)
     for name, fn in (("lanes", k.lanes), ("scalar", k.scalar)):  # each kernel's one compiled loop
         ir = "".join(fn.inspect_llvm().values())
         print(type(m).__name__, name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))

@@ -2,7 +2,9 @@
 
 ``code`` picks the model (:data:`CODES`); ``ti``, ``tr``, ``pr`` are flat angle arrays of
 length 1 (one value for every geometry) or ``n``; ``prm`` holds the model's parameters as
-rows of length 1 (a single model) or ``n`` (a model set, one element per geometry);
+rows of length 1 (a single model) or ``n`` (a model set, one element per geometry), or of
+any length ``G`` read through ``index`` (:func:`column`: a fit's walkers x wavelengths, each
+shared by many geometries, read in place rather than gathered per geometry);
 ``iopt`` its options (slope kind, shadowing, conventions); ``out`` the element-major result
 ``(16, N)`` (or ``(1, N)``: ``M00`` only), written from column ``start``.  No Python runs per
 geometry: one compiled loop per kernel (:func:`entry`) takes a range of geometries, and
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import errors, njit, types
 from numba.extending import overload
 
@@ -71,18 +74,32 @@ def store(out, i, m):
     out[13, i], out[14, i], out[15, i] = m[13], m[14], m[15]
 
 
+@njit(error_model="numpy", inline="always")
+def column(index, p, i):
+    """The parameter column geometry ``i`` reads: ``index[i]`` for an ``index`` longer than 1,
+    otherwise ``index[0] + i * p`` (``p``: whether ``prm`` has a column per geometry), so that
+    :data:`NO_INDEX` (``[0]``) is the plain rule ``i * p``, and a one-geometry call's index
+    ``[j]`` reads column ``j``.  Arithmetic, without a branch (``p > q``: ``p and not q``, whose
+    short circuit is one): LLVM may unswitch a loop on a branch that does not change in it,
+    copying the loop, inlined kernel and all, once per side (compile time; measured on a cold
+    cache, one FacetBRDF vector loop and the FacetBTDF scalar loop compile in the CPU time they
+    took before the index, within the machine's noise)."""
+    q = index.shape[0] > 1
+    return index[i * q] + i * (p > q)
+
+
 #: the fewest geometries of a range given to a thread (:func:`scatterbench.models.kernels.threads.spread`)
 BLOCK = 1024
 
 
 @njit(error_model="numpy", forceinline=True)
-def _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi):
+def _serial(kernel, ti, tr, pr, prm, index, o, out, start, lo, hi):
     """:func:`entry`'s loop for one kernel (compiled once per kernel: a loop that
     dispatches on the model per geometry holds every kernel's code and runs slower)."""
     a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
     for i in range(lo, hi):
         g = geometry(ti[i * a], tr[i * b], pr[i * c])
-        store(out, start + i, kernel(g, params(prm, i * p), o))
+        store(out, start + i, kernel(g, params(prm, column(index, p, i)), o))
 
 
 #: the one-geometry functions by code
@@ -90,14 +107,14 @@ KERNELS = (facet, btdf, single, diffuse, cook, maxwell)
 assert [KERNELS[c] for c in CODES.values()] == [facet, btdf, single, diffuse, cook, maxwell]
 
 
-def serial(code, ti, tr, pr, prm, o, out, start, lo, hi):
+def serial(code, ti, tr, pr, prm, index, o, out, start, lo, hi):
     """:func:`_serial` for kernel ``code``; compiled code picks the kernel while typing
     (:func:`_serial_of`), Python (``NUMBA_DISABLE_JIT=1``) here."""
-    _serial(KERNELS[code], ti, tr, pr, prm, o, out, start, lo, hi)
+    _serial(KERNELS[code], ti, tr, pr, prm, index, o, out, start, lo, hi)
 
 
 @overload(serial, prefer_literal=True)
-def _serial_of(code, ti, tr, pr, prm, o, out, start, lo, hi):
+def _serial_of(code, ti, tr, pr, prm, index, o, out, start, lo, hi):
     """``serial`` with ``code`` a constant (an entry's closure cell, typed as a literal): the
     loop over that one kernel, picked while typing, so that numba types and compiles it alone
     (a branch on the code compiles every kernel; a tuple of them indexed in compiled code
@@ -106,8 +123,8 @@ def _serial_of(code, ti, tr, pr, prm, o, out, start, lo, hi):
         raise errors.RequireLiteralValue("serial's kernel code must be a constant")
     kernel = KERNELS[code.literal_value]
 
-    def impl(code, ti, tr, pr, prm, o, out, start, lo, hi):
-        _serial(kernel, ti, tr, pr, prm, o, out, start, lo, hi)
+    def impl(code, ti, tr, pr, prm, index, o, out, start, lo, hi):
+        _serial(kernel, ti, tr, pr, prm, index, o, out, start, lo, hi)
 
     return impl
 
@@ -128,8 +145,9 @@ def named(code, tag=""):
 
 def entry(code):
     """The one compiled entry of kernel ``code``'s scalar loop (built once, at import:
-    :data:`ENTRIES`): ``run_range(ti, tr, pr, prm, iopt, out, start, lo, hi)``, geometries
-    ``lo .. hi - 1`` into ``out[:, start + i]``, without the GIL.  Serial, parallel, checked
+    :data:`ENTRIES`): ``run_range(ti, tr, pr, prm, index, iopt, out, start, lo, hi)``, geometries
+    ``lo .. hi - 1`` into ``out[:, start + i]``, geometry ``i`` with the parameters of column
+    :func:`column` of ``prm`` (``index``: :data:`NO_INDEX` or one column per geometry), without the GIL.  Serial, parallel, checked
     and one-geometry calls are that loop called from Python
     (:func:`scatterbench.models.kernels.threads.spread`): one entry per kernel compiles the kernel once,
     where four (a serial, a ``prange``, a checked and a scalar one) each had LLVM optimize the
@@ -143,9 +161,9 @@ def entry(code):
 
     @njit(cache=True, error_model="numpy", nogil=True)
     @named(code)
-    def run_range(ti, tr, pr, prm, iopt, out, start, lo, hi):
+    def run_range(ti, tr, pr, prm, index, iopt, out, start, lo, hi):
         """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``."""
-        serial(code, ti, tr, pr, prm, options(iopt), out, start, lo, hi)
+        serial(code, ti, tr, pr, prm, index, options(iopt), out, start, lo, hi)
 
     return run_range
 
@@ -166,6 +184,9 @@ def angles_ok(ti, tr, pr):
             return False
     return True
 
+
+#: the index of a call without one (:func:`column`: geometry ``i`` reads column ``i * p``)
+NO_INDEX = np.zeros(1, dtype=np.int64)
 
 #: every kernel's scalar loop (:func:`entry`), by code
 ENTRIES = tuple(entry(c) for c in range(len(KERNELS)))
