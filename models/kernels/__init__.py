@@ -51,9 +51,10 @@ The kernels' helpers are inlined by LLVM (``forceinline=True``), not by numba
 (``inline="always"``, which types and lowers a callee's body again at every call site): the
 report's compile-ahead tasks took 101.9 s of CPU with numba's inlining and 80.9 s with LLVM's
 (one process, empty cache, the helper of the same session's other work sharing the 2 cores;
-``python benchmarks/scaling.py --compile``), the loops as fast and as vectorized.  Only
-:mod:`~scatterbench.models.kernels.vector`'s scratch accessors keep numba's inlining: they take
-the scratch array, and a call that passes an array counts references.
+``python benchmarks/scaling.py --compile``), the loops as fast and as vectorized.  Only the
+helpers that take an array keep numba's inlining (:mod:`~scatterbench.models.kernels.vector`'s
+scratch accessors, :func:`~scatterbench.models.kernels.drive.column`): a call that passes an
+array counts references.
 """
 
 from __future__ import annotations
