@@ -177,15 +177,24 @@ def _python_quad(nn, point):
     return val
 
 
-@functools.cache
+#: where R-bar's compiled integrand comes from: a function that returns the numba ``cfunc``
+#: (:func:`scatterbench.models.kernels.rbar_integrand`), set by :mod:`scatterbench.models.kernels`
+#: when it loads, since the kernels sit above this module's layer; until then (and with numba's
+#: JIT off) R-bar integrates the Python integrand: the same bits, 20x slower
+INTEGRAND_SOURCE = None
+
+
 def _compiled_integrand():
-    """:mod:`scatterbench.models.kernels.rbar`'s integrand as a :class:`scipy.LowLevelCallable`;
-    ``None`` where it cannot be had (``NUMBA_DISABLE_JIT=1``: a Python function)."""
+    """The compiled integrand as a :class:`scipy.LowLevelCallable`; ``None`` where it cannot be
+    had (the kernels not loaded yet; ``NUMBA_DISABLE_JIT=1``: a Python function)."""
+    return None if INTEGRAND_SOURCE is None else _low_level(INTEGRAND_SOURCE)
+
+
+@functools.cache
+def _low_level(source):
     from scipy import LowLevelCallable
 
-    from . import kernels  # numba (heavy): loads when R-bar is first needed
-
-    fn = getattr(kernels.rbar_integrand(), "ctypes", None)
+    fn = getattr(source(), "ctypes", None)
     return None if fn is None else LowLevelCallable(fn)
 
 

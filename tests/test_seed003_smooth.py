@@ -141,6 +141,7 @@ def test_rbar_compiled_integrand_gives_the_python_quadratures_bits(monkeypatch):
     ``quad`` with the Python integrand, over a dense grid of indices from just above 1 to
     1e150; where QUADPACK reports a problem (an index whose square overflows) it gives nothing
     and ``_rbar`` takes ``quad``, which warns as before; without numba (no ``ctypes``) too."""
+    from scatterbench.models import kernels  # noqa: F401  (loading the kernels hands R-bar its integrand)
     from scatterbench.models import smooth_interface as si
 
     ns = np.concatenate(

@@ -68,7 +68,7 @@ import tempfile
 
 import numpy as np
 
-from .. import evaluation
+from .. import evaluation, smooth_interface
 from ..float32_domain import ANGLE_ROWS
 from .threads import spread
 
@@ -148,6 +148,9 @@ def rbar_integrand():
         from . import rbar
     return rbar.integrand
 
+
+# R-bar's quadrature (an ingredient, below the kernels) takes its compiled integrand from here
+smooth_interface.INTEGRAND_SOURCE = rbar_integrand
 
 #: says when a kernel compiles (the command line shows it: ``scatterbench.validation.cli``)
 log = logging.getLogger(__name__)
