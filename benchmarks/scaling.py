@@ -121,17 +121,16 @@ def first_run():
 
 _COMPILE = """
 import time
-from scatterbench.models import kernels
-from scatterbench.validation.report.build import REPORT_KERNELS
+from scatterbench.validation.report.build import REPORT_KERNELS, warm_task
 total = 0.0
 for task in REPORT_KERNELS:
     t, c = time.perf_counter(), time.process_time()
-    kernels.warm(*task)
+    warm_task(task)
     cpu = time.process_time() - c
     total += cpu
     sets = "all" if task[2] is None else len(task[2])
     loops = f"option sets {sets!s:>3}" + (" + scalar" if task[3] else "         ")
-    print(f"  {task[0]:<10} {task[1]:<8} {loops}  {time.perf_counter() - t:6.1f} s  cpu {cpu:6.1f} s")
+    print(f"  {task[0]:<10} {task[1] or '':<8} {loops}  {time.perf_counter() - t:6.1f} s  cpu {cpu:6.1f} s")
 print(f"  all tasks: cpu {total:.1f} s")
 """
 

@@ -346,17 +346,20 @@ def test_warm_compiles_the_types_the_calls_use():
 
 
 def test_warm_compiles_the_node_algebra_and_monte_carlo_for_the_types_the_models_pass():
-    """``kernels.warm("montecarlo" | "aperture" | "disc")`` (a report's compile-ahead tasks)
-    compiles those modules' entries for the types RoughDiffuseBRDF, DetectorAperture and
-    PointSourceBRDF pass: their calls add no specialization.  Fails when a model passes
+    """``kernels.warm("montecarlo" | "aperture" | "disc" | "angles")`` (a report's compile-ahead
+    tasks) compiles those modules' entries for the types RoughDiffuseBRDF, DetectorAperture and
+    PointSourceBRDF pass, and the small calls' angle check for theirs (a few geometries as a
+    list): their calls add no specialization.  Fails when a model passes
     another type (a read-only table, a bool array), which a first report then compiled
     again, lazily, in each process."""
     from scatterbench.models import kernels
 
     entries = [
-        e for name in ("montecarlo", "aperture", "disc") for e in kernels._warm_entries(name, "float64")
+        e
+        for name in ("montecarlo", "aperture", "disc", "angles")
+        for e in kernels._warm_entries(name, "float64")
     ]
-    for name in ("montecarlo", "aperture", "disc"):
+    for name in ("montecarlo", "aperture", "disc", "angles"):
         kernels.warm(name)
     before = {fn: list(fn.signatures) for fn, _ in entries}
     x = np.linspace(0.1, 1.0, 40)
@@ -365,6 +368,7 @@ def test_warm_compiles_the_node_algebra_and_monte_carlo_for_the_types_the_models
     models.PointSourceBRDF(model=models.CookTorranceBRDF(), distance=1.0, sample_radius=1.0).mueller(
         0.3, x, 0.2
     )
+    models.FacetBRDF().mueller([0.1, 0.2, 0.3], 0.4, 0.5)  # the small-call path checks its angles
     for fn, sig in entries:
         assert sig in before[fn] and fn.signatures == before[fn], (fn, before[fn], fn.signatures)
     # read-only angles (the conformance kit gives models read-only inputs) take the same loop

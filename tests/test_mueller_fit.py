@@ -421,6 +421,27 @@ def test_fused_kernel_equals_the_numpy_reference(nist, one_thread):
         np.testing.assert_allclose(a, r, rtol=1e-11)
 
 
+def test_compile_ahead_warms_the_fused_likelihood_for_the_types_a_fit_passes(nist, one_thread):
+    """The report's compile-ahead task ``"likelihood"`` compiles the fused kernel for exactly the
+    argument types a fit's batch passes: the batch, with and without error columns, adds no
+    specialization (a type apart compiled it again on the report's main process, ~2.4 s cold)."""
+    from scatterbench.validation.fitting import mueller_kernel
+    from scatterbench.validation.fitting.mueller_fit import mueller_likelihood
+    from scatterbench.validation.report.build import REPORT_KERNELS, warm_task
+
+    assert ("likelihood", None, None, False) in REPORT_KERNELS
+    assert warm_task(("likelihood", None, None, False)) == "likelihood"
+    assert not mueller_kernel.cold()
+    before = len(mueller_kernel._walkers.signatures)
+    d = nist.subset(np.arange(0, len(nist), 97))
+    sc = scene_mod.load("references/scenes/ptfe_lambertian_per_wavelength.toml")
+    for data in (d, replace(d, err=np.full(d.mueller.shape, 0.004), err_normalized=True)):
+        lik = mueller_likelihood(sc, data)
+        u0 = lik.spec.u_bounds().mean(axis=1)
+        assert np.all(np.isfinite(lik.batch(np.array([u0, u0]))))
+    assert len(mueller_kernel._walkers.signatures) == before, mueller_kernel._walkers.signatures
+
+
 def test_a_scene_with_films_fits_its_own_wavelength_only(nist):
     """Films are built at the scene's wavelength: fitting such a scene to other wavelengths
     would use the wrong film phases, so it is refused, naming the table and the remedy."""

@@ -199,7 +199,8 @@ def _signature(precision):
 
 def _other_entries(name):
     """``(entry, signature)`` of the cached entries of module ``name`` (``"montecarlo"``,
-    ``"aperture"``, ``"disc"``), for the argument types their models pass."""
+    ``"aperture"``, ``"disc"``; ``"angles"``: :func:`~scatterbench.models.kernels.drive.angles_ok`),
+    for the argument types their models pass."""
     from numba import types
 
     f, i, b = types.float64, types.int64, types.boolean
@@ -212,6 +213,8 @@ def _other_entries(name):
             (aperture.nodes, (a1, a1, a1, ro, ro, ro, ro, a2)),
             (aperture._tiles, (a2, a2, i, a2, i, i, i)),
         ]
+    if name == "angles":  # the small-call path's check of the angles (Compiled.fast)
+        return [(drive.angles_ok, (a1, a1, a1))]
     if name == "disc":  # PointSourceBRDF's disc quadrature
         return [(disc.points, (f, f, a1, a1, types.Array(b, 1, "C"), a1, a1) + (a2,) * 6)]
     raise KeyError(name)

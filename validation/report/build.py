@@ -86,8 +86,9 @@ def _run_sections(ctx, specs):
 #: --quick`` by wrapping ``kernels.vector.lanes_of``: all 4 of Cook-Torrance's, 3 of
 #: Maxwell-Beard's 6; None: every one, or a module's entries), whether it calls the scalar loop
 #: (recorded by wrapping ``kernels.Compiled.scalar``: only for the options without lanes, Smith
-#: shadowing and other slopes of the facets and Cook-Torrance, and FacetBTDF), and the Monte
-#: Carlo, aperture and disc entries.  A loop missing here still compiles, on first use.  Largest
+#: shadowing and other slopes of the facets and Cook-Torrance, and FacetBTDF), the Monte
+#: Carlo, aperture and disc entries, the fused Mueller likelihood of the PTFE section and the
+#: small calls' angle check (the main process compiled those two, ~3 s, during the sections).  A loop missing here still compiles, on first use.  Largest
 #: first (``python benchmarks/scaling.py --threads 1 --studies --compile`` times each), so that
 #: the processes of a 2-core machine finish together; Cook-Torrance's loops in two tasks, the
 #: scalar one in one of them
@@ -97,14 +98,32 @@ REPORT_KERNELS = (
     ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)], True), ("single", "float64", [(0, 0, 0), (1, 0, 0)], False),
     ("montecarlo", "float64", None, False), ("facet", "float32", None, True), ("cook", "float64", _COOK[2:], False),
     ("aperture", "float64", None, False), ("diffuse", "float64", [(0, 0, 0)], False), ("disc", "float64", None, False),
-    ("btdf", "float64", [], True),
+    ("btdf", "float64", [], True), ("likelihood", None, None, False), ("angles", "float64", None, False),
 )  # fmt: skip
 
 
-def _warm(task):
+def warm_task(task):
+    """Compile (or load) what compile-ahead task ``task`` of :data:`REPORT_KERNELS` names: a
+    kernel's loops (:func:`scatterbench.models.kernels.warm`) or the fused Mueller likelihood
+    (``"likelihood"``: :func:`scatterbench.validation.fitting.mueller_kernel.warm`)."""
+    if task[0] == "likelihood":  # validation's, not a model kernel
+        from scatterbench.validation.fitting import mueller_kernel  # numba (heavy): on use
+
+        return mueller_kernel.warm()
     from scatterbench.models import kernels
 
     return kernels.warm(*task)
+
+
+def cold_task(task) -> bool:
+    """Whether what ``task`` names (:func:`warm_task`) is not in numba's cache yet."""
+    if task[0] == "likelihood":
+        from scatterbench.validation.fitting import mueller_kernel
+
+        return mueller_kernel.cold()
+    from scatterbench.models import kernels
+
+    return kernels.cold(*task)
 
 
 def compile_ahead(executor):
@@ -116,10 +135,10 @@ def compile_ahead(executor):
         return
     from scatterbench.models import kernels
 
-    todo = [task for task in REPORT_KERNELS if kernels.cold(*task)]
+    todo = [task for task in REPORT_KERNELS if cold_task(task)]
     if todo:
         kernels.announce(list(dict.fromkeys(task[0] for task in todo)), f"on {executor.workers} processes")
-        executor.map(_warm, todo, tasks=len(todo))
+        executor.map(warm_task, todo, tasks=len(todo))
 
 
 def build_report(
