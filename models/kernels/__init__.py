@@ -158,14 +158,21 @@ _READY = set()  # the entries this process has called (loaded from the cache or 
 _SAID = set()  # the kernels this process has said it compiles
 
 
+def uncached(fn) -> bool:
+    """Whether numba's on-disk cache lacks the cached entry ``fn`` (False for a Python function:
+    ``NUMBA_DISABLE_JIT=1``)."""
+    cache = getattr(fn, "_cache", None)
+    return cache is not None and not os.path.exists(cache._cache_file._index_path)
+
+
 def _announced(fn):
     """``fn``, after saying, on the first call in this process of an entry of a kernel that is
     not in the cache yet, that the kernel compiles (once per kernel, not per entry: a first
     report printed 64 lines): the command line shows that the kernels compile once per machine."""
     if fn not in _READY:
         _READY.add(fn)
-        cache = getattr(fn, "_cache", None)  # None: a Python function (NUMBA_DISABLE_JIT=1)
-        if cache is not None and not os.path.exists(cache._cache_file._index_path):
+        if uncached(fn):
+            cache = fn._cache
             kernel = getattr(fn.py_func, "kernel", fn.__name__)  # drive.named's
             if kernel not in _SAID:
                 # the cache folder once per process
@@ -238,11 +245,7 @@ def _warm_entries(kernel, precision, option_sets=None, scalar=True):
 
 def cold(kernel, precision="float64", option_sets=None, scalar=True) -> bool:
     """Whether a loop of :func:`warm`'s is not in the cache yet."""
-    return any(
-        not os.path.exists(fn._cache._cache_file._index_path)
-        for fn, _ in _warm_entries(kernel, precision, option_sets, scalar)
-        if getattr(fn, "_cache", None) is not None
-    )
+    return any(uncached(fn) for fn, _ in _warm_entries(kernel, precision, option_sets, scalar))
 
 
 def warm(kernel, precision="float64", option_sets=None, scalar=True):

@@ -12,11 +12,11 @@ took 28.8 ms (one thread, both timed alternately in one process; the same bits).
 from __future__ import annotations
 
 import math
-import os
 
 import numba
 import numpy as np
 
+from scatterbench.models.kernels import uncached
 from scatterbench.models.kernels.threads import spread
 
 __all__ = ["pack_map", "loglike_rows"]
@@ -112,8 +112,7 @@ def _signature():
 
 def cold() -> bool:
     """Whether the fused likelihood is not in numba's cache yet."""
-    cache = getattr(_walkers, "_cache", None)  # None: a Python function (NUMBA_DISABLE_JIT=1)
-    return cache is not None and not os.path.exists(cache._cache_file._index_path)
+    return uncached(_walkers)
 
 
 def warm():
