@@ -69,7 +69,18 @@ def _breakdown(lik, walkers):
         # as in a chain: every walker's index new at every wavelength, so R-bar's quadrature
         # runs (the batch above repeats positions whose R-bar is cached)
         "batch, new positions": _best(lambda: lik.batch(U + 1e-6 * rng.standard_normal(U.shape))),
+        # the route before the range-by-range one (mueller_kernel.loglike_terms): the model's
+        # (16, walkers, rows) elements first, then the likelihood; the same bits
+        "same, elements first": _best(lambda: _elements_first(lik, U + 1e-6 * rng.standard_normal(U.shape))),
     }
+
+
+def _elements_first(lik, U):
+    lik._unit_terms = lambda U: None
+    try:
+        return lik.batch(U)
+    finally:
+        del lik._unit_terms
 
 
 def main(argv=None):

@@ -140,6 +140,25 @@ class Model(Declared, ModelFacts):
         through it; users call :meth:`mueller`, which validates and broadcasts."""
         return evaluation.flat(self, ti, tr, pr, 16)
 
+    def indexed_kernel(self, index):
+        """``(kernel, index)``: this model set's :class:`~scatterbench.models.kernels.Compiled`
+        kernel over its flat parameters (length ``G``), one column per element, and ``index``
+        checked against them (:meth:`~scatterbench.models.kernels.Compiled.indexed`), for
+        :meth:`flat_mueller16_indexed` and for callers that evaluate ranges of the geometries
+        themselves (a fit's likelihood, range by range through the cache); ``None`` where the
+        set has no kernel (:func:`~scatterbench.models.evaluation.kernel_path`)."""
+        if not evaluation.kernel_path(self):
+            return None
+        from . import kernels  # numba (heavy): compiled kernels load when one first runs
+
+        code, rows, options = self._kernel_spec()
+        g = math.prod(self.param_shape)
+        # the rows once, one column per element (shared values repeated): the loops read column
+        # index[k] in place (drive.column), where a gather per chunk built (11, chunk) arrays
+        flat = [np.broadcast_to(np.asarray(r).reshape(-1) if np.size(r) == g else r, (g,)) for r in rows]
+        kernel = kernels.Compiled(self, code, flat, options)
+        return kernel, kernel.indexed(index)
+
     def flat_mueller16_indexed(self, index, ti, tr, pr, out, add=False):
         """Mueller elements ``(16, n)`` into ``out`` of this model set, whose parameters are flat
         (length ``G``), at flat float64 angles validated already (length 1 or ``n``), geometry
@@ -159,15 +178,7 @@ class Model(Declared, ModelFacts):
             whole = modelset.with_leaves(self, {p: a.reshape(-1)[index] for p, a in leaves.items()})
             out[...] = evaluation.flat(whole, ti, tr, pr)
             return out
-        from . import kernels  # numba (heavy): compiled kernels load when one first runs
-
-        code, rows, options = self._kernel_spec()
-        g = math.prod(self.param_shape)
-        # the rows once, one column per element (shared values repeated): the loops read column
-        # index[k] in place (drive.column), where a gather per chunk built (11, chunk) arrays
-        flat = [np.broadcast_to(np.asarray(r).reshape(-1) if np.size(r) == g else r, (g,)) for r in rows]
-        kernel = kernels.Compiled(self, code, flat, options)
-        index = kernel.indexed(index)
+        kernel, index = self.indexed_kernel(index)
         n = out.shape[1]
         if add:  # through cache-sized buffers (Compiled.accumulate)
             kernel.accumulate(ti, tr, pr, out, index)

@@ -432,14 +432,14 @@ def test_compile_ahead_warms_the_fused_likelihood_for_the_types_a_fit_passes(nis
     assert ("likelihood", None, None, False) in REPORT_KERNELS
     assert warm_task(("likelihood", None, None, False)) == "likelihood"
     assert not mueller_kernel.cold()
-    before = len(mueller_kernel._walkers.signatures)
+    before = len(mueller_kernel._rows.signatures)
     d = nist.subset(np.arange(0, len(nist), 97))
     sc = scene_mod.load("references/scenes/ptfe_lambertian_per_wavelength.toml")
     for data in (d, replace(d, err=np.full(d.mueller.shape, 0.004), err_normalized=True)):
         lik = mueller_likelihood(sc, data)
         u0 = lik.spec.u_bounds().mean(axis=1)
         assert np.all(np.isfinite(lik.batch(np.array([u0, u0]))))
-    assert len(mueller_kernel._walkers.signatures) == before, mueller_kernel._walkers.signatures
+    assert len(mueller_kernel._rows.signatures) == before, mueller_kernel._rows.signatures
 
 
 def test_a_scene_with_films_fits_its_own_wavelength_only(nist):
@@ -507,8 +507,9 @@ def _gathered_indexed(self, index, ti, tr, pr, out, add=False):
 def test_batch_at_new_positions_gives_the_bits_of_the_gathered_route(name, nist, monkeypatch):
     """A/B of the batch's speed-ups (issue 29 part 6): 24 walkers at new positions over all of
     NIST's rows (several kernel chunks) give the same log posteriors, bit for bit, as the route
-    before them: kernel rows gathered per chunk, a sum's terms added whole, and R-bar by
-    ``quad`` with the Python integrand (every position new, so every R-bar computed again)."""
+    before them: the model's elements for all walkers and rows first, kernel rows gathered per
+    chunk, a sum's terms added whole, and R-bar by ``quad`` with the Python integrand (every
+    position new, so every R-bar computed again)."""
     from scatterbench.models import base, smooth_interface
     from scatterbench.validation.fitting.mueller_fit import mueller_likelihood
     from scatterbench.validation.fitting.sampling import _default_start
@@ -517,8 +518,10 @@ def test_batch_at_new_positions_gives_the_bits_of_the_gathered_route(name, nist,
     u0 = _default_start(lik, lik.spec.u_bounds())
     U = u0 + 1e-3 * np.random.default_rng(4).standard_normal((24, len(u0)))
     smooth_interface._rbar.cache_clear()
+    assert lik._unit_terms(U) is not None  # the fast route: range by range through the cache
     fast = lik.batch(U)
     with monkeypatch.context() as mp:
+        mp.setattr(MuellerLikelihood, "_unit_terms", lambda self, U: None)  # the whole (16, W, N) first
         mp.setattr(base.Model, "flat_mueller16_indexed", _gathered_indexed)
         mp.setattr(smooth_interface, "_compiled_integrand", lambda: None)
         smooth_interface._rbar.cache_clear()

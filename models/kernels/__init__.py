@@ -378,18 +378,32 @@ class Compiled:
         rows) went through memory twice and was then added on one core."""
         n = index.shape[0]
         ti, tr, pr = (_mutable(np.ascontiguousarray(x)) for x in (ti, tr, pr))
-        prm, loop = self.params("float64"), _announced(self._loop)
+        write = self.range_writer()
 
         def ranges(lo, hi):
             buf = np.empty((out.shape[0], ADD_CHUNK))
             for a in range(lo, hi, ADD_CHUNK):
                 b = min(a + ADD_CHUNK, hi)
-                # geometry i into buf[:, i - a]: the whole buffer, so the loop's one type
-                loop(ti, tr, pr, prm, index, self.iopt, buf, -a, a, b)
+                write(ti, tr, pr, index, buf, a, b)
                 part = out[:, a:b]
                 np.add(part, buf[:, : b - a], out=part)
 
         spread(ranges, (), n, max(ADD_CHUNK, drive.BLOCK))
+
+    def range_writer(self):
+        """``write(ti, tr, pr, index, buf, lo, hi)``: geometries ``lo .. hi - 1`` of flat float64
+        angles (C-contiguous, writable, length 1 or ``n``) with parameter columns ``index``
+        (:meth:`indexed`) into ``buf[:, :hi - lo]`` (a C-contiguous float64 ``(rows, m)`` ndarray,
+        ``m >= hi - lo``), on the calling thread: for callers that spread ranges over the cores
+        themselves and use each while it is in the cache.  The loop is looked up once (a few us a
+        call otherwise), and given the whole buffer (geometry ``i`` into column ``i - lo``), so
+        that it sees one type."""
+        loop, prm, iopt = _announced(self._loop), self.params("float64"), self.iopt
+
+        def write(ti, tr, pr, index, buf, lo, hi):
+            loop(ti, tr, pr, prm, index, iopt, buf, -lo, lo, hi)
+
+        return write
 
     def run(self, ti, tr, pr, rows):
         """``(rows, n)`` float64 of flat float64 angles (:func:`scatterbench.models.evaluation.flat`'s kernel route)."""

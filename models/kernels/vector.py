@@ -33,7 +33,7 @@ from numba.extending import overload
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME
 from .common import NO_SHADOWING, azimuths
-from .drive import COOK, DIFFUSE, FACET, KERNELS, MAXWELL, PARAM_ROWS, SINGLE, column, named
+from .drive import COOK, DIFFUSE, FACET, KERNELS, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, column, named
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (55 kB), stays
 #: in the L2 cache
@@ -105,10 +105,10 @@ def _loop(kernel, sc, m, o):
 
 
 @njit(error_model="numpy")
-def gather(sc, ti, tr, pr, prm, index, lo, m, turns):
+def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch: angles, the azimuth's
     cosine and sine (:func:`~scatterbench.models.kernels.common.azimuths` over the block), and the
-    parameters (a single model's repeated; the columns :func:`~scatterbench.models.kernels.drive.column`
+    first ``rows`` parameter rows, those the kernel reads (a single model's repeated; the columns :func:`~scatterbench.models.kernels.drive.column`
     reads, without a branch that LLVM would unswitch the block loop on, copying the kernel)."""
     a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
     for k in range(m):
@@ -116,7 +116,7 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns):
         sc[_TI * VBLOCK + k], sc[_TR * VBLOCK + k], sc[_PR * VBLOCK + k] = ti[i * a], tr[i * b], pr[i * c]
     if turns:  # a constant of the kernel: only the diffuse one reads no azimuth
         azimuths(_row(sc, _PR, m), _row(sc, _CP, m), _row(sc, _SP, m))
-    for r in range(PARAM_ROWS):  # a single model's too: the loop then reads them as a set's
+    for r in range(rows):  # a single model's too: the loop then reads them as a set's
         for k in range(m):
             sc[(_PRM + r) * VBLOCK + k] = prm[r, column(index, p, lo + k)]
 
@@ -165,6 +165,7 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, h
     r0, r1, r2 = o0 == RUNTIME, o1 == RUNTIME, o2 == RUNTIME
     # the diffuse kernel reads no azimuth: its blocks skip the cosines and sines (a tenth of its time)
     turns = code.literal_value != DIFFUSE
+    rows = len(ROWS[NAMES[code.literal_value]])
 
     def impl(code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, hi):
         o = (
@@ -173,9 +174,10 @@ def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, h
             iopt[2] if r2 else np.int64(o2),
         )
         sc = np.empty(_ROWS * VBLOCK)
+        sc[(_PRM + rows) * VBLOCK :] = 0.0  # the parameter rows the kernel does not read: never gathered
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
-            gather(sc, ti, tr, pr, prm, index, blo, m, turns)
+            gather(sc, ti, tr, pr, prm, index, blo, m, turns, rows)
             _loop(kernel, sc, m, o)
             for r in range(out.shape[0]):
                 for k in range(m):

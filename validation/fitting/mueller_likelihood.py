@@ -36,7 +36,7 @@ from scatterbench.models.scene import binding
 from .fitspec import FitSpecError
 from .likelihood import BatchPosterior
 from .mueller_data import ELEMENTS, fold_negative_polar, to_basis
-from .mueller_kernel import loglike_rows, pack_map
+from .mueller_kernel import loglike_rows, loglike_terms, pack_map
 from .mueller_spec import dispersion_index
 
 __all__ = ["MuellerLikelihood", "Rows"]
@@ -205,18 +205,25 @@ class MuellerLikelihood(BatchPosterior):
         ``(16, W * rows)``, when given): one model set over walkers x distinct wavelengths,
         validated there and gathered per row (:meth:`~scatterbench.models.base.Model.flat_mueller16_indexed`)."""
         U = np.atleast_2d(np.asarray(U, dtype=float))
-        _, off, _ = self.nuisance(U)
         if self.binding is None:
-            return self._predict_rebuilt(U, self.scene_values(U, rows), off, rows)
+            return self._predict_rebuilt(U, self.scene_values(U, rows), self.nuisance(U)[1], rows)
+        model, index, angles = self._model_set(U, rows)
+        M = np.empty((16, len(U) * len(rows))) if out is None else out
+        _mueller16(model, index, angles, M)
+        return M.reshape((16, len(U), len(rows)))
+
+    def _model_set(self, U, rows):
+        """``(model, index, angles)``: the model set over ``(walkers, wavelengths)`` at positions
+        ``U``, validated, the element each flat ``(walkers, rows)`` geometry takes, and the flat
+        angles (checked); a ``ValueError`` where the scene refuses a position."""
+        _, off, _ = self.nuisance(U)
         W, G = len(U), len(rows.group_wavelength_nm)
         values = {k: np.broadcast_to(v, (W, G)).reshape(-1) for k, v in self._group_values(U, rows).items()}
         model = self.binding.values_model(values, (W * G,))
         self.binding.check(model)
         ti, tr, phi = rows.angles(off)
         evaluation.checked_angles(model, ti, rows.theta_r, rows.phi)  # the others: checked per row
-        M = np.empty((16, W * len(rows))) if out is None else out
-        _mueller16(model, rows.index(W), (ti, tr, phi), M)
-        return M.reshape((16, W, len(rows)))
+        return model, rows.index(W), (ti, tr, phi)
 
     def _predict_rebuilt(self, U, values, off, rows):
         """The scene rebuilt per walker and wavelength (scenes the binding cannot express)."""
@@ -260,7 +267,8 @@ class MuellerLikelihood(BatchPosterior):
         the fused kernel (:mod:`.mueller_kernel`) on the model's psps elements."""
         U = np.atleast_2d(np.asarray(U, dtype=float))
         try:
-            M = self.predict_psps(U, self.rows)
+            terms = self._unit_terms(U)
+            M = None if terms else self.predict_psps(U, self.rows)
         except ValueError:
             return self._pointwise_each(U)
         c, _, noise = self.nuisance(U)
@@ -268,8 +276,25 @@ class MuellerLikelihood(BatchPosterior):
         for k, e in enumerate(self._e):
             s2[k] = np.broadcast_to(self.spec.noise_level(ELEMENTS[e], noise), (len(U), 1))[:, 0] ** 2
         out = np.empty((len(U), len(self.data)))
-        loglike_rows(np.ascontiguousarray(M), *self._packed, c[:, 0].copy(), s2, self._errvar, out)
+        rest = (*self._packed, c[:, 0].copy(), s2, self._errvar, out)
+        if terms:
+            loglike_terms(*terms, *rest)
+        else:
+            loglike_rows(M, *rest)
         return out
+
+    def _unit_terms(self, U):
+        """``([(kernel, index)], angles)`` where the model set is a kernel's or a sum of kernels'
+        with weights 1 (:func:`loglike_terms` then never holds its ``(16, W, N)`` elements), else
+        ``None``; a ``ValueError`` where the scene refuses a position."""
+        if self.binding is None:
+            return None
+        model, index, angles = self._model_set(U, self.rows)
+        parts = model.terms if isinstance(model, Sum) else [(1, model)]
+        if not all(isinstance(w, (int, float)) and w == 1 for w, _ in parts):
+            return None
+        kernels = [m.indexed_kernel(index) for _, m in parts]
+        return (kernels, angles) if all(kernels) else None
 
     def pointwise_reference(self, U) -> np.ndarray:
         """:meth:`pointwise_batch` in numpy, from :meth:`residuals` (the kernel's reference)."""
