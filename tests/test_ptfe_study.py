@@ -134,6 +134,27 @@ def test_study_cli_writes_results_netcdf_and_maps(tmp_path):
     assert all((out / f).stat().st_size > 0 for f in res["figures"].values())
 
 
+def test_joint_study_fits_every_wavelength_with_the_joint_scenes(tmp_path):
+    """``--joint``: the rows of all four wavelengths in one fit per model, through the shipped
+    joint scenes (one albedo per wavelength), and maps of the 532 nm rows only."""
+    from scatterbench.validation.cli import main
+
+    out = tmp_path / "joint"
+    args = ["study", "ptfe", "--out", str(out), "--joint", "--models", "lambertian,maxwell_beard"]
+    assert main(args + ["--row-step", "96", "--steps", "20", "--no-cv"]) == 0
+    res = json.loads((out / "results.json").read_text())
+    nist = load_mueller_data(nist_ptfe_path())
+    rows = np.array(res["data"]["row_indices"])
+    assert np.array_equal(rows, np.arange(0, len(nist), 96))
+    assert set(np.unique(nist.wavelength_nm[rows])) == {351.0, 532.0, 633.0, 1064.0}
+    for m in ("lambertian", "maxwell_beard"):
+        assert res["models"][m]["scene"] == f"ptfe_{m}_joint.toml"
+        names = list(res["models"][m]["parameters"])
+        assert sum(n.endswith(("@351", "@532", "@633", "@1064")) for n in names) >= 4, names
+    at532 = set(np.round(np.degrees(nist.theta_i[rows][nist.wavelength_nm[rows] == 532.0]), 1).tolist())
+    assert sorted(res["figures"], key=float) == [f"{a:g}" for a in sorted(at532)]
+
+
 def test_study_cli_refuses_bad_input(tmp_path, capsys):
     from scatterbench.validation.cli import main
 
@@ -144,6 +165,8 @@ def test_study_cli_refuses_bad_input(tmp_path, capsys):
     assert "nosuch" in capsys.readouterr().err
     assert main(["study", "ptfe", "--out", out, "--walkers", "7"]) == 2
     assert "walkers" in capsys.readouterr().err
+    assert main(["study", "ptfe", "--out", out, "--joint", "--wavelength", "532"]) == 2
+    assert "--wavelength: a joint study fits every wavelength" in capsys.readouterr().err
 
 
 def test_study_settings_pass_the_moves_to_every_chain():

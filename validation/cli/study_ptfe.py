@@ -34,8 +34,15 @@ def settings_from(args) -> ptfe.StudySettings:
         except ValueError:
             raise UsageError(f"--cv-incidences: {args.cv_incidences!r} is not a list of degrees") from None
     try:
+        if args.joint and args.wavelength is not None:
+            raise UsageError("--wavelength: a joint study fits every wavelength (its maps show 532 nm)")
         return ptfe.StudySettings(
-            wavelength_nm=args.wavelength, seed=args.seed, cv=not args.no_cv, moves=args.moves, **kw
+            wavelength_nm=532.0 if args.wavelength is None else args.wavelength,
+            joint=args.joint,
+            seed=args.seed,
+            cv=not args.no_cv,
+            moves=args.moves,
+            **kw,
         )
     except ValueError as exc:
         raise UsageError(f"--{str(exc).split(':')[0].replace('_', '-')}: {exc}") from None
@@ -51,7 +58,7 @@ def _cmd_ptfe(args) -> int:
     settings = settings_from(args)
     data = load_mueller_data(args.data)
     try:
-        ptfe.select_rows(data, settings.wavelength_nm, settings.row_step)
+        ptfe.select_rows(data, settings.wavelength_nm, settings.row_step)  # joint: the maps' wavelength
     except ValueError as exc:
         raise UsageError(f"--wavelength: {exc}") from None
     _check_out(args.out, args.force)
@@ -73,7 +80,8 @@ def _ptfe(args, data, settings) -> int:
             raise UsageError(str(exc)) from None
         win = res["verdict"]["winner"]
         res["figures"] = {}
-        for a, maps in incidence_maps(fits[win], settings.draws, settings.seed).items():
+        shown = settings.wavelength_nm if settings.joint else None
+        for a, maps in incidence_maps(fits[win], settings.draws, settings.seed, shown).items():
             name = f"maps_{a:g}.png"
             fig = incidence_figure(maps, a, win, plt)
             atomic_savefig(fig, os.path.join(out, name), dpi=80)
@@ -131,7 +139,12 @@ def register_ptfe(ss):
     p.add_argument("--out", required=True)
     p.add_argument("--force", action="store_true")
     p.add_argument("--quick", action="store_true", help="three models, every 48th row, 30 steps, 2 CV folds")
-    p.add_argument("--wavelength", type=float, default=532.0, help="the wavelength fitted (nm)")
+    p.add_argument("--wavelength", type=float, default=None, help="the wavelength fitted (nm; default 532)")
+    p.add_argument(
+        "--joint",
+        action="store_true",
+        help="every wavelength at once, with the joint scenes (shape shared, albedo per wavelength, Cauchy index)",
+    )
     p.add_argument("--row-step", type=int_at_least(1), default=None, help="every N-th row (default 24)")
     p.add_argument("--steps", type=int_at_least(10), default=None, help="emcee steps (default 200)")
     p.add_argument("--walkers", type=int_at_least(2), default=None)

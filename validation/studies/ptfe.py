@@ -33,6 +33,7 @@ __all__ = [
     "QUICK",
     "REPORT",
     "StudySettings",
+    "scene_file",
     "select_rows",
     "fit_model",
     "pointwise_loglik",
@@ -52,6 +53,15 @@ MODELS = {
     "maxwell_beard": "ptfe_maxwell_beard_per_wavelength.toml",
     "lambertian": "ptfe_lambertian_per_wavelength.toml",
 }
+
+
+def scene_file(name, joint=False) -> str:
+    """The shipped scene of model ``name``: fitted to one wavelength, or (``joint``) to all of
+    them at once (``ptfe_<name>_joint.toml``: the shape shared, the albedo per wavelength, the
+    index a Cauchy law)."""
+    return MODELS[name].replace("_per_wavelength", "_joint") if joint else MODELS[name]
+
+
 #: seed 003's physical models (its claim: they improve over Maxwell-Beard)
 PHYSICAL = ("smooth_diffuse", "rough_diffuse", "single_hg")
 
@@ -77,9 +87,12 @@ REPORT = {
 @dataclass(frozen=True)
 class StudySettings:
     """What the study fits: one wavelength, every ``row_step``-th of its rows (file order,
-    deterministic), ``walkers`` x ``steps`` emcee chains, seeded."""
+    deterministic), ``walkers`` x ``steps`` emcee chains, seeded; ``joint``: every wavelength
+    at once with the joint scenes (:func:`scene_file`), ``wavelength_nm`` then only the one the
+    maps show."""
 
     wavelength_nm: float = 532.0
+    joint: bool = False
     row_step: int = 24
     walkers: int = 16
     steps: int = 200
@@ -117,8 +130,10 @@ class StudySettings:
 
 
 def select_rows(data, wavelength_nm, row_step):
-    """Indices of ``data``'s rows at ``wavelength_nm``, every ``row_step``-th in file order;
-    ``ValueError`` when the wavelength is absent."""
+    """Indices of ``data``'s rows at ``wavelength_nm`` (``None``: all of them), every
+    ``row_step``-th in file order; ``ValueError`` when the wavelength is absent."""
+    if wavelength_nm is None:
+        return np.arange(len(data))[::row_step]
     at = np.flatnonzero(np.abs(data.wavelength_nm - wavelength_nm) <= 1e-6 * wavelength_nm)
     if not len(at):
         have = ", ".join(f"{w:g}" for w in np.unique(data.wavelength_nm))
@@ -126,9 +141,9 @@ def select_rows(data, wavelength_nm, row_step):
     return at[::row_step]
 
 
-def fit_model(name, data, chain: ChainSettings, scene=None):
-    """:func:`run_fit` of model ``name``'s shipped scene (or ``scene``) on ``data``."""
-    sc = scene if scene is not None else scene_mod.load(scene_path(MODELS[name]))
+def fit_model(name, data, chain: ChainSettings, scene=None, joint=False):
+    """:func:`run_fit` of model ``name``'s shipped scene (:func:`scene_file`; or ``scene``) on ``data``."""
+    sc = scene if scene is not None else scene_mod.load(scene_path(scene_file(name, joint)))
     lik = mueller_likelihood(sc, data)
     need = 2 * len(lik.spec.free)  # emcee's ensemble needs >= 2 walkers per dimension
     if chain.walkers < need:
@@ -219,7 +234,7 @@ def leave_one_incidence_out(name, data, settings: StudySettings, scene=None) -> 
             raise ValueError(
                 f"cv_incidences: {a:g} deg leaves no held-out or no training rows (incidences: {have})"
             )
-        fit = fit_model(name, data.subset(~held), settings.chain(seed_offset=1 + j), scene)
+        fit = fit_model(name, data.subset(~held), settings.chain(seed_offset=1 + j), scene, settings.joint)
         cov = heldout_coverage(fit, data.subset(held), settings.draws, settings.seed + j)
         folds[f"{a:g}"] = {"heldout_rows": int(held.sum()), "coverage": cov}
     pooled = {
@@ -272,19 +287,20 @@ def run_study(data, settings: StudySettings, out_dir=None, progress=print) -> tu
     """Fit every model on the subset, compare, check and cross-validate.  Returns ``(results,
     fits)``; with ``out_dir``, each model's ``posterior.json``, samples and ``posterior.nc``
     are written under ``out_dir/<model>/`` (atomically; the caller swaps the folder in)."""
-    rows = select_rows(data, settings.wavelength_nm, settings.row_step)
+    rows = select_rows(data, None if settings.joint else settings.wavelength_nm, settings.row_step)
     sub = data.subset(rows)
+    where = "all wavelengths (joint)" if settings.joint else f"{settings.wavelength_nm:g} nm"
     fits, idatas, models = {}, {}, {}
     for name in settings.models:
-        progress(f"ptfe: fitting {name} on {len(sub)} rows at {settings.wavelength_nm:g} nm")
-        fit = fit_model(name, sub, settings.chain())
+        progress(f"ptfe: fitting {name} on {len(sub)} rows at {where}")
+        fit = fit_model(name, sub, settings.chain(), joint=settings.joint)
         ll = pointwise_loglik(fit)
         idata = inference_data(fit, ll)
         fits[name], idatas[name] = fit, idata
-        entry = {"scene": MODELS[name], "parameters": fit.summary["parameters"]}
+        entry = {"scene": scene_file(name, settings.joint), "parameters": fit.summary["parameters"]}
         if out_dir is not None:
             folder = os.path.join(out_dir, name)
-            post = write_mueller_fit(fit, folder, data_path=data.path, scene_path=MODELS[name])
+            post = write_mueller_fit(fit, folder, data_path=data.path, scene_path=entry["scene"])
             _write_netcdf(idata, os.path.join(folder, "posterior.nc"))
             entry["posterior_json"] = os.path.join(name, "posterior.json") if post else None
         # in-sample posterior predictive check: the fitted rows inside the 68/95% intervals

@@ -16,9 +16,10 @@ __all__ = ["SHOWN", "incidence_maps", "incidence_figure"]
 SHOWN = ("m11", "m12", "m22", "m33", "m34", "m44")
 
 
-def incidence_maps(fit, draws=100, seed=0) -> dict:
+def incidence_maps(fit, draws=100, seed=0, wavelength_nm=None) -> dict:
     """``{incidence deg: {"phi", "theta", element: (measured, model median, residual/sd)}}``
-    over the fitted rows; the model's median and standard deviation are those of the
+    over the fitted rows (at ``wavelength_nm`` only, when given: a joint fit's wavelengths
+    share their geometries); the model's median and standard deviation are those of the
     posterior predictive (measurement noise included)."""
     lik = fit.lik
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 13]))
@@ -28,9 +29,10 @@ def incidence_maps(fit, draws=100, seed=0) -> dict:
     d = lik.data
     N = d.normalized()
     inc = np.round(np.degrees(d.theta_i), 1)  # NIST's normal incidence is 0.001 deg
+    at = np.ones(len(d), bool) if wavelength_nm is None else np.abs(d.wavelength_nm - wavelength_nm) < 1e-3
     out = {}
-    for a in sorted(set(inc.tolist())):
-        m = inc == a
+    for a in sorted(set(inc[at].tolist())):
+        m = (inc == a) & at
         entry = {"phi": d.phi_r[m], "theta": np.degrees(d.theta_r[m])}
         for name in SHOWN:
             e = ELEMENTS.index(name)
