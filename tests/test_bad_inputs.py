@@ -471,6 +471,7 @@ fit_case("tau factor zero", ["--tau-factor", "0"], "tau_factor")
 fit_case("walkers zero", ["--walkers", "0"], "walkers")
 fit_case("walkers odd", ["--walkers", "3"], "walkers")
 fit_case("walkers negative", ["--walkers", "-2"], "walkers")
+fit_case("burn negative", ["--burn", "-5"], "burn must be an integer >= 0")
 fit_case("walkers a word", ["--walkers", "abc"], "--walkers")
 fit_case(
     "walkers too few for the free parameters",

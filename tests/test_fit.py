@@ -432,6 +432,26 @@ def test_same_seed_same_chain_whatever_the_executor(coated, data):
     assert not np.array_equal(ref.chain.chain, other.chain.chain)
 
 
+def test_a_burned_chain_continues_the_burn_in_bit_for_bit(coated, data):
+    """``ChainSettings.burn``: the kept chain is the tail of the chain the burn-in began (its
+    ensemble and random state continued), for either move; the burned steps and their time
+    are reported, and the setting refuses a negative count, naming itself."""
+    lik = _small(coated, data, 20)
+    for moves in ("stretch", "de"):
+        st = ChainSettings(walkers=8, seed=3, max_steps=20, check_every=10, starts=1, moves=moves)
+        whole = run_fit(lik, st.replace(max_steps=32))
+        burned = run_fit(lik, st.replace(burn=12))
+        assert burned.chain.steps == 20
+        assert np.array_equal(burned.chain.chain, whole.chain.chain[12:])
+        assert np.array_equal(burned.chain.log_prob, whole.chain.log_prob[12:])
+        b = burned.summary["sampling"]["burned_before_chain"]
+        assert b["steps"] == 12 and b["seconds"] > 0
+        assert whole.summary["sampling"]["burned_before_chain"] == {"steps": 0, "seconds": 0.0}
+    assert fingerprint(lik, st) != fingerprint(lik, st.replace(burn=12))
+    with pytest.raises(ValueError, match="burn must be an integer >= 0"):
+        ChainSettings(burn=-1)
+
+
 def test_recovers_the_scatmech_sample_within_95_percent(coated, data):
     """Held-out SCATMECH data: sigma, coating index, n and k inside their 95% intervals.
 

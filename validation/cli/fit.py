@@ -110,6 +110,12 @@ def _mcmc_args(p, walkers=None, max_steps=None):
         default=d.moves,
         help="ensemble proposal: emcee's stretch move, or differential evolution (DE 80%%, snooker 20%%)",
     )
+    p.add_argument(
+        "--burn",
+        type=int,
+        default=d.burn,
+        help="steps run and discarded before the kept chain (its tau then carries no start-up transient)",
+    )
 
 
 def _load(args):
@@ -151,6 +157,7 @@ def _chain_settings(args):
             tau_factor=args.tau_factor,
             starts=args.starts,
             moves=args.moves,
+            burn=args.burn,
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from exc

@@ -22,7 +22,7 @@ from scatterbench.validation.atomic import atomic_savefig, atomic_write_json
 
 from .checkpoint import CheckpointBackend
 from .likelihood import TERMS, Likelihood, replicate, term_variances
-from .sampling import ChainResult, initial_ball, optimize, run_chain, summarize
+from .sampling import ChainResult, burn_in, initial_ball, optimize, run_chain, summarize
 from .settings import ChainSettings
 
 __all__ = [
@@ -95,6 +95,8 @@ def fingerprint(lik, settings: ChainSettings) -> str:
     h.update(json.dumps(lik.spec.as_dict(), sort_keys=True).encode())
     kept = ("walkers", "seed", "check_every", "tau_factor", "tau_rtol", "starts")
     shaping = {k: getattr(settings, k) for k in kept}
+    if settings.burn:  # where the kept chain starts; chains without a burn-in keep their hash
+        shaping["burn"] = settings.burn
     if settings.moves != "stretch":  # the stretch move's checkpoints predate the setting: same hash
         shaping["moves"] = settings.moves
     h.update(json.dumps(shaping, sort_keys=True).encode())
@@ -141,9 +143,12 @@ def run_fit(
         backend = CheckpointBackend(checkpoint, fp)
     u_opt, lp_opt, info = optimize(lik, settings.seed, n_starts=settings.starts)
     _require_finite(lik, u_opt, lp_opt)  # before sampling: a chain from -inf never moves
-    p0 = None
+    p0, burned = None, {"steps": 0, "seconds": 0.0}
     if not resume:
         p0 = initial_ball(u_opt, settings.walkers, settings.seed, lik.spec.u_bounds(), sd=info["sd_u"])
+        if settings.burn:
+            p0, seconds = burn_in(lik, settings, p0, executor)
+            burned = {"steps": settings.burn, "seconds": seconds}
     chain = run_chain(lik, settings, p0=p0, backend=backend, executor=executor, progress=progress)
     optimum = {
         "values": lik.spec.physical(u_opt),
@@ -153,7 +158,11 @@ def run_fit(
         "log_likelihood": lik.loglike(u_opt),
         "starts": info["starts"],
     }
-    return FitResult(lik, optimum, chain, summarize(chain, lik.spec), settings)
+    summary = summarize(chain, lik.spec)
+    # steps run and discarded before the chain (ChainSettings.burn; a resumed chain: 0 here), not
+    # the kept chain's own burn-in ("burn_in": 2 max tau of it, dropped from its samples)
+    summary["sampling"]["burned_before_chain"] = burned
+    return FitResult(lik, optimum, chain, summary, settings)
 
 
 def information_criteria(fit: FitResult) -> dict:

@@ -26,6 +26,7 @@ process from the seed; the executor only maps the log-probability over walkers.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -44,6 +45,7 @@ __all__ = [
     "vectorized",
     "optimize",
     "initial_ball",
+    "burn_in",
     "run_chain",
     "ChainResult",
     "summarize",
@@ -264,6 +266,9 @@ def _first_state(backend, settings, p0):
         return backend.get_last_sample()
     if p0 is None:
         raise ValueError("p0: the walkers' starting positions are needed for a new chain")
+    if isinstance(p0, emcee.State):  # a burn-in's end (burn_in): its ensemble and random state
+        settings.require_walkers(p0.coords.shape[1])
+        return emcee.State(p0.coords, random_state=p0.random_state)
     p0 = np.asarray(p0, float)
     if p0.ndim != 2 or p0.shape[0] != settings.walkers:
         raise ValueError(f"p0: expected shape (walkers = {settings.walkers}, ndim); got {p0.shape}")
@@ -330,8 +335,9 @@ def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, 
     settings : ChainSettings, optional
         Walkers, seed, step budget, check interval and stopping rule (default:
         ``ChainSettings()``).
-    p0 : ndarray, shape (walkers, ndim), optional
-        Starting positions of a new chain (ignored when ``backend`` holds one).
+    p0 : ndarray, shape (walkers, ndim), or emcee.State, optional
+        Starting positions of a new chain (ignored when ``backend`` holds one); a state
+        (:func:`burn_in`'s) gives the random state too.
     backend : CheckpointBackend, optional
         Where the chain is kept (and saved, if it has a path): a new one, or
         :meth:`CheckpointBackend.load` to resume.  Default: memory only.
@@ -366,6 +372,17 @@ def run_chain(log_prob, settings=None, *, p0=None, backend=None, executor=None, 
             backend.end_segment(time.perf_counter() - t0)
             state = backend.get_last_sample()  # the ensemble and random state after the segment
     return _result(backend, settings)
+
+
+def burn_in(log_prob, settings, p0, executor=None):
+    """``settings.burn`` steps from ``p0``, not kept: ``(state, seconds)``, the ensemble and
+    random state they end in (:func:`run_chain`'s ``p0`` for the kept chain, which then
+    continues them bit for bit) and their wall time."""
+    backend = CheckpointBackend()
+    t0 = time.perf_counter()
+    burn = dataclasses.replace(settings, max_steps=settings.burn, check_every=settings.burn, burn=0)
+    run_chain(log_prob, burn, p0=p0, backend=backend, executor=executor)
+    return backend.get_last_sample(), time.perf_counter() - t0
 
 
 def _segment(sampler, state, n, bar, hold_sigint):
