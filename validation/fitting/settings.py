@@ -76,9 +76,9 @@ class ChainSettings:
         Steps run from the starting ball and discarded before the kept chain, >= 0 (emcee's
         burn-in): the kept chain starts from the ensemble and random state they end in, so
         its autocorrelation estimate, and with it the ``N >= tau_factor * tau`` rule, carries
-        no start-up transient (on the joint PTFE fit the whole-chain estimate was 197 steps,
-        156 without its first tenth and 146 without its first half: ad hoc, 2026-11-29).  The
-        kept chain is then the burned one's continuation, bit for bit; their time is the fit's.
+        no start-up transient (``benchmarks/ptfe_joint_fit.py`` prints the estimate without
+        the chain's first tenth and half).  The kept chain is then the burned one's
+        continuation, bit for bit; their time is the fit's.
     moves : "stretch" | "de"
         The ensemble's proposal (:data:`MOVES`).  The stretch move is emcee's default; on
         the model comparison's curved, strongly correlated posteriors (seed 003, six
