@@ -165,6 +165,8 @@ def test_study_cli_refuses_bad_input(tmp_path, capsys):
     assert "nosuch" in capsys.readouterr().err
     assert main(["study", "ptfe", "--out", out, "--walkers", "7"]) == 2
     assert "walkers" in capsys.readouterr().err
+    assert main(["study", "ptfe", "--out", out, "--burn", "-3"]) == 2
+    assert "--burn: burn: -3 is not an integer >= 0" in capsys.readouterr().err
     assert main(["study", "ptfe", "--out", out, "--joint", "--wavelength", "532"]) == 2
     assert "--wavelength: a joint study fits every wavelength" in capsys.readouterr().err
 
@@ -174,6 +176,9 @@ def test_study_settings_pass_the_moves_to_every_chain():
     PTFE joint fit in 9600 steps, the stretch move in 16800); an unknown proposal is refused by
     name."""
     assert ptfe.StudySettings(moves="de").chain(3).moves == "de"
+    assert ptfe.StudySettings(burn=500).chain(2).burn == 500 and ptfe.StudySettings().chain().burn == 0
+    with pytest.raises(ValueError, match="burn: -1 is not an integer >= 0"):
+        ptfe.StudySettings(burn=-1)
     assert ptfe.StudySettings().chain().moves == "stretch"
     with pytest.raises(ValueError, match="moves: 'walk' is not one of stretch, de"):
         ptfe.StudySettings(moves="walk")

@@ -42,6 +42,7 @@ def settings_from(args) -> ptfe.StudySettings:
             seed=args.seed,
             cv=not args.no_cv,
             moves=args.moves,
+            burn=args.burn,
             **kw,
         )
     except ValueError as exc:
@@ -154,6 +155,9 @@ def register_ptfe(ss):
         choices=MOVES,
         default="stretch",
         help="emcee's proposal: stretch, or differential evolution",
+    )
+    p.add_argument(
+        "--burn", type=int, default=0, help="steps run and discarded before each chain (default 0)"
     )
     p.add_argument("--models", default=None, help=f"comma separated, of {', '.join(ptfe.MODELS)}")
     p.add_argument("--cv-incidences", default=None, help="held-out incidences (deg); default: all")

@@ -102,10 +102,13 @@ class StudySettings:
     cv_incidences: tuple | None = None  # None: every incidence of the subset
     draws: int = 200
     moves: str = "stretch"  # emcee's proposal (ChainSettings.moves: "stretch" or "de")
+    burn: int = 0  # steps run and discarded before each chain (ChainSettings.burn)
 
     def __post_init__(self):
         if self.moves not in MOVES:
             raise ValueError(f"moves: {self.moves!r} is not one of {', '.join(MOVES)}")
+        if not (isinstance(self.burn, int) and self.burn >= 0):
+            raise ValueError(f"burn: {self.burn!r} is not an integer >= 0")
         if not (isinstance(self.row_step, int) and self.row_step >= 1):
             raise ValueError(f"row_step: {self.row_step!r} is not an integer >= 1")
         if not (isinstance(self.steps, int) and self.steps >= 10):
@@ -126,6 +129,7 @@ class StudySettings:
             starts=1,
             seed=self.seed + seed_offset,
             moves=self.moves,
+            burn=self.burn,
         )
 
 
