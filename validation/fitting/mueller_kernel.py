@@ -61,7 +61,7 @@ def loglike_rows(M, src, coef, nsrc, obs, is_m11, c, s2, errvar, out):
     cache), each walker's rows in the serial order (:func:`_rows`)."""
     W, N = out.shape
     flat = np.ascontiguousarray(M).reshape(M.shape[0], W * N)
-    args = (src, coef, nsrc, obs, is_m11, c, s2, errvar, bool(np.any(errvar != 0.0)), out)
+    args = _row_args(src, coef, nsrc, obs, is_m11, c, s2, errvar, out)
 
     def walkers(lo, hi):
         for w in range(lo, hi):
@@ -87,7 +87,7 @@ def loglike_terms(terms, angles, src, coef, nsrc, obs, is_m11, c, s2, errvar, ou
     per = -(-N // RANGE_ROWS)  # ranges per walker, of equal size
     step = -(-N // per)
     ti, tr, pr = (a if a.flags.writeable else a.copy() for a in map(np.ascontiguousarray, angles))
-    args = (src, coef, nsrc, obs, is_m11, c, s2, errvar, bool(np.any(errvar != 0.0)), out)
+    args = _row_args(src, coef, nsrc, obs, is_m11, c, s2, errvar, out)
     (first, index0), *later = [(kernel.range_writer(), index) for kernel, index in terms]
 
     def ranges(lo, hi):
@@ -105,6 +105,12 @@ def loglike_terms(terms, angles, src, coef, nsrc, obs, is_m11, c, s2, errvar, ou
             _rows(buf, 0, w, a, b, *args)
 
     spread(ranges, (), W * per, 1)
+
+
+def _row_args(src, coef, nsrc, obs, is_m11, c, s2, errvar, out):
+    """:func:`_rows`' arguments after the range, both routes': whether the data have errors
+    (the row loop's second branch) found once per batch."""
+    return (src, coef, nsrc, obs, is_m11, c, s2, errvar, bool(np.any(errvar != 0.0)), out)
 
 
 @numba.njit(cache=True, nogil=True)

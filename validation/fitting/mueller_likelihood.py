@@ -200,15 +200,14 @@ class MuellerLikelihood(BatchPosterior):
         U = np.atleast_2d(np.asarray(U, dtype=float))
         return _to_data(self.predict_psps(U, rows), rows.map)
 
-    def predict_psps(self, U, rows, out=None):
-        """The model's 16 psps elements ``(16, W, rows)`` at positions ``U`` (into ``out``,
-        ``(16, W * rows)``, when given): one model set over walkers x distinct wavelengths,
+    def predict_psps(self, U, rows):
+        """The model's 16 psps elements ``(16, W, rows)`` at positions ``U``: one model set over walkers x distinct wavelengths,
         validated there and gathered per row (:meth:`~scatterbench.models.base.Model.flat_mueller16_indexed`)."""
         U = np.atleast_2d(np.asarray(U, dtype=float))
         if self.binding is None:
             return self._predict_rebuilt(U, self.scene_values(U, rows), self.nuisance(U)[1], rows)
         model, index, angles = self._model_set(U, rows)
-        M = np.empty((16, len(U) * len(rows))) if out is None else out
+        M = np.empty((16, len(U) * len(rows)))
         _mueller16(model, index, angles, M)
         return M.reshape((16, len(U), len(rows)))
 
@@ -291,7 +290,7 @@ class MuellerLikelihood(BatchPosterior):
             return None
         model, index, angles = self._model_set(U, self.rows)
         parts = model.terms if isinstance(model, Sum) else [(1, model)]
-        if not all(isinstance(w, (int, float)) and w == 1 for w, _ in parts):
+        if not all(_unit(w) for w, _ in parts):
             return None
         kernels = [m.indexed_kernel(index) for _, m in parts]
         return (kernels, angles) if all(kernels) else None
@@ -350,7 +349,7 @@ def _mueller16(model, index, angles, out):
         return model.flat_mueller16_indexed(index, *angles, out)
     scratch = None
     for k, (w, m) in enumerate(model.terms):
-        unit = isinstance(w, (int, float)) and w == 1
+        unit = _unit(w)
         if k and unit and not isinstance(m, Sum):
             m.flat_mueller16_indexed(index, *angles, out, add=True)
             continue
@@ -363,6 +362,11 @@ def _mueller16(model, index, angles, out):
         if k:
             out += term
     return out
+
+
+def _unit(w) -> bool:
+    """Whether a sum's weight ``w`` is the number 1 (a term added as its kernel computes it)."""
+    return isinstance(w, (int, float)) and w == 1
 
 
 def _to_data(M, maps):

@@ -26,7 +26,6 @@ process from the seed; the executor only maps the log-probability over walkers.
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -380,7 +379,7 @@ def burn_in(log_prob, settings, p0, executor=None):
     continues them bit for bit) and their wall time."""
     backend = CheckpointBackend()
     t0 = time.perf_counter()
-    burn = dataclasses.replace(settings, max_steps=settings.burn, check_every=settings.burn, burn=0)
+    burn = settings.replace(max_steps=settings.burn, check_every=settings.burn, burn=0)
     run_chain(log_prob, burn, p0=p0, backend=backend, executor=executor)
     return backend.get_last_sample(), time.perf_counter() - t0
 
