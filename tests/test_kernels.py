@@ -474,3 +474,27 @@ def test_narrow_lobes_agree_within_their_derived_tolerance(model):
     assert err <= tol(model)
     if model.slopes.scale <= 1e-6:
         assert err > 1e-12  # the flat tolerance these models need more than
+
+
+def test_a_long_evaluation_is_one_kernel_call_with_the_chunks_bits(monkeypatch):
+    """Past one chunk, a single model's kernel is called once over every geometry (its threads
+    share the whole range), and each geometry's bits are those of a call on its chunk alone;
+    a single angle value is broadcast, not gathered.  Fails when ``fill`` goes chunk by chunk
+    (three calls) or the one call misplaces a geometry."""
+    from scatterbench.models import evaluation
+    from scatterbench.models.kernels import Compiled
+
+    m = models.FacetBRDF(slopes=models.GaussianSlopes(0.2), substrate=AL)
+    n = 2 * evaluation.KERNEL_CHUNK + 17
+    rng = np.random.default_rng(5)
+    tr, pr = rng.uniform(0.0, 1.5, n), rng.uniform(-math.pi, math.pi, n)
+    writes = []
+    real = Compiled.write
+    monkeypatch.setattr(
+        Compiled, "write", lambda self, out, sl, *a, **k: writes.append(sl) or real(self, out, sl, *a, **k)
+    )
+    _, whole = m.mueller16(0.3, tr, pr)
+    assert writes == [slice(0, n)]
+    for a in range(0, n, evaluation.KERNEL_CHUNK):
+        b = min(a + evaluation.KERNEL_CHUNK, n)
+        np.testing.assert_array_equal(whole[:, a:b], m.mueller16(0.3, tr[a:b], pr[a:b])[1])

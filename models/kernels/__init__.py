@@ -412,6 +412,12 @@ class Compiled:
         self.call(ti, tr, pr, out, 0)
         return out
 
+    @staticmethod
+    def in_place(out, precision) -> bool:
+        """Whether :meth:`write` writes into ``out`` itself (a C-contiguous ndarray of
+        ``precision``'s dtype) rather than through a buffer of the chunk's size."""
+        return type(out) is np.ndarray and out.flags.c_contiguous and out.dtype == np.dtype(precision)
+
     def write(self, out, sl, ti, tr, pr, precision, index=None):
         """One chunk of flat float64 angles (length 1 or the chunk's) into ``out[:, sl]``,
         computed in ``precision`` (the float32 kernels for ``"float32"``): in place in a
@@ -420,7 +426,7 @@ class Compiled:
         columns (:meth:`call`)."""
         dtype = np.dtype(precision)
         a, b, c = ti.astype(dtype, copy=False), tr.astype(dtype, copy=False), azimuth_as(pr, dtype)
-        if type(out) is np.ndarray and out.flags.c_contiguous and out.dtype == dtype:
+        if self.in_place(out, precision):
             self.call(a, b, c, out, sl.start, precision, index)
         else:
             buf = np.empty((out.shape[0], sl.stop - sl.start), dtype=dtype)
