@@ -293,3 +293,18 @@ def test_contributed_models_section(monkeypatch):
     results, page = build_report(quick=True, only=["contributed"], checks=[])
     assert results["sections"]["contributed"]["numbers"] == {"contributed": []}
     assert f"no contributed models installed (entry-point group {group})" in page
+
+
+def test_the_comparison_text_states_the_burn_in_of_its_chains():
+    """The full report's comparison burns 1000 steps in before its kept chains
+    (``comparison_settings``), and its text says so; the quick one burns none and says nothing
+    of it.  Fails when the settings or the text drop the burn-in."""
+    from scatterbench.validation.checks.fitting import comparison_settings
+    from scatterbench.validation.report.sections import model_comparison as mc
+
+    full, quick = comparison_settings(False)["settings"], comparison_settings(True)["settings"]
+    assert (full.burn, quick.burn) == (1000, 0)
+    base = dict(rows=(), speckle=0.05, rows_per_file=200, all_rows=True, walkers=24, max_steps=12000, seed=3,
+                chains=2, data_files=("a.csv",), scene_files=("b.toml",), scans=())  # fmt: skip
+    assert "1000 steps of burn-in (not kept), then at most 12000 steps" in mc._text(mc.ComparisonData(**base, burn=1000))
+    assert "burn-in" not in mc._text(mc.ComparisonData(**base, burn=0))

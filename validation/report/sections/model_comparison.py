@@ -57,6 +57,7 @@ class ComparisonData:
     all_rows: bool
     walkers: int
     max_steps: int
+    burn: int
     seed: int
     chains: int
     data_files: tuple[str, ...]
@@ -139,6 +140,7 @@ def compute(ctx):
         all_rows=st["rows"] is None,
         walkers=st["settings"].walkers,
         max_steps=st["settings"].max_steps,
+        burn=st["settings"].burn,
         seed=st["settings"].seed,
         chains=st.get("chains", 1),
         data_files=tuple(SEED003_PAIRING["data"].values()),
@@ -177,7 +179,8 @@ def _text(d):
         f"{' and references/scenes/'.join(d.scene_files)}. Each pair is fitted with every "
         "likelihood term (BRDF, eta, P, P_C) and with the BRDF alone (eta, P, P_C off). "
         f"{'All ' if d.all_rows else ''}{d.rows_per_file} rows per file"
-        f"{'' if d.all_rows else ' (evenly spread)'}; emcee {d.walkers} walkers, at most "
+        f"{'' if d.all_rows else ' (evenly spread)'}; emcee {d.walkers} walkers, "
+        f"{f'{d.burn} steps of burn-in (not kept), then ' if d.burn else ''}at most "
         f"{d.max_steps} steps, {d.chains} independent chain(s) per fit (the first seeded {d.seed}, the "
         "others from it and their index), pooled for WAIC, predictive coverage and medians, the best "
         "ln L over them all; R-hat is the rank-normalized split R-hat between them (Vehtari et al. 2021; "
