@@ -15,7 +15,7 @@ from scatterbench.validation.fitting.settings import MOVES
 from scatterbench.validation.studies import ptfe
 from scatterbench.validation.studies.ptfe_figures import incidence_figure, incidence_maps
 
-from .args import UsageError, int_at_least
+from .args import UsageError, check_executor, executor_args, int_at_least, open_executor
 from .fit import _check_out, locked_out
 
 __all__ = ["register_ptfe", "format_results"]
@@ -63,11 +63,12 @@ def _cmd_ptfe(args) -> int:
     except ValueError as exc:
         raise UsageError(f"--wavelength: {exc}") from None
     _check_out(args.out, args.force)
-    with locked_out(args):
-        return _ptfe(args, data, settings)
+    check_executor(args)
+    with locked_out(args), open_executor(args) as ex:
+        return _ptfe(args, data, settings, ex)
 
 
-def _ptfe(args, data, settings) -> int:
+def _ptfe(args, data, settings, executor) -> int:
     import matplotlib  # matplotlib (heavy): loaded only where a figure is drawn
 
     matplotlib.use("Agg")
@@ -76,7 +77,7 @@ def _ptfe(args, data, settings) -> int:
     t0 = time.perf_counter()
     with replacing_folder(args.out, _owned, lock=False) as out:
         try:
-            res, fits = ptfe.run_study(data, settings, out_dir=out)
+            res, fits = ptfe.run_study(data, settings, out_dir=out, executor=executor)
         except ValueError as exc:
             raise UsageError(str(exc)) from None
         win = res["verdict"]["winner"]
@@ -150,6 +151,7 @@ def register_ptfe(ss):
     p.add_argument("--steps", type=int_at_least(10), default=None, help="emcee steps (default 200)")
     p.add_argument("--walkers", type=int_at_least(2), default=None)
     p.add_argument("--seed", type=int_at_least(0), default=0)
+    executor_args(p)  # the fits and the folds as tasks; the results do not depend on it
     p.add_argument(
         "--moves",
         choices=MOVES,

@@ -18,6 +18,7 @@ import numpy as np
 
 from scatterbench.models import scene as scene_mod
 from scatterbench.references import scene_path
+from scatterbench.validation.fitting.executors import SerialExecutor
 from scatterbench.validation.fitting.fit import run_fit
 from scatterbench.validation.fitting.mueller_fit import (
     interval_coverage,
@@ -225,12 +226,20 @@ def heldout_coverage(fit, held, draws=200, seed=0) -> dict:
     return interval_coverage(lik, fit.chain.samples(), held, rows, rng, draws)
 
 
-def leave_one_incidence_out(name, data, settings: StudySettings, scene=None) -> dict:
+def leave_one_incidence_out(name, data, settings: StudySettings, scene=None, executor=None) -> dict:
     """For each incidence angle of ``data`` (or ``settings.cv_incidences``): fit on the other
-    incidences, then the 68%/95% coverage of the held-out rows only."""
+    incidences, then the 68%/95% coverage of the held-out rows only; the folds' fits on
+    ``executor`` (default in-process; the same result on any)."""
+    jobs = _fold_jobs(name, data, settings, scene)
+    return _pooled(jobs, (executor or SerialExecutor()).map(_task, jobs, tasks=len(jobs)))
+
+
+def _fold_jobs(name, data, settings: StudySettings, scene=None) -> list:
+    """The tasks (:func:`_task`) of :func:`leave_one_incidence_out`: one ``("fold", ...)`` per
+    held-out incidence, each seeded by its index."""
     inc = np.round(np.degrees(data.theta_i), 1)  # NIST's normal incidence is 0.001 deg
     angles = sorted(set(inc.tolist())) if settings.cv_incidences is None else list(settings.cv_incidences)
-    folds = {}
+    jobs = []
     for j, a in enumerate(angles):
         held = np.abs(inc - a) < 0.05
         if not held.any() or held.all():
@@ -238,9 +247,32 @@ def leave_one_incidence_out(name, data, settings: StudySettings, scene=None) -> 
             raise ValueError(
                 f"cv_incidences: {a:g} deg leaves no held-out or no training rows (incidences: {have})"
             )
-        fit = fit_model(name, data.subset(~held), settings.chain(seed_offset=1 + j), scene, settings.joint)
-        cov = heldout_coverage(fit, data.subset(held), settings.draws, settings.seed + j)
-        folds[f"{a:g}"] = {"heldout_rows": int(held.sum()), "coverage": cov}
+        chain = settings.chain(seed_offset=1 + j)
+        jobs.append(
+            ("fold", name, f"{a:g}", data.subset(~held), data.subset(held), chain, scene, settings, j)
+        )
+    return jobs
+
+
+def _task(job):
+    """One task of the study, run where the executor puts it (its chain is seeded by its
+    settings alone, so it is the same anywhere): ``("fit", name, data, chain, joint)`` gives
+    the fit; ``("fold", name, label, train, held, chain, scene, settings, j)`` the coverage of
+    the held-out rows by the fit to the others (:func:`leave_one_incidence_out`)."""
+    if job[0] == "fit":
+        _, name, data, chain, joint = job
+        return fit_model(name, data, chain, joint=joint)
+    _, name, _, train, held, chain, scene, settings, j = job
+    fit = fit_model(name, train, chain, scene, settings.joint)
+    return {
+        "heldout_rows": len(held),
+        "coverage": heldout_coverage(fit, held, settings.draws, settings.seed + j),
+    }
+
+
+def _pooled(jobs, done) -> dict:
+    """One model's folds (``("fold", ...)`` jobs and their results) and their pooled coverage."""
+    folds = {job[2]: f for job, f in zip(jobs, done, strict=True)}
     pooled = {
         q: float(
             sum(f["coverage"]["all"][q] * f["heldout_rows"] for f in folds.values())
@@ -287,25 +319,34 @@ def verdict(comparison: dict) -> dict:
     return out
 
 
-def run_study(data, settings: StudySettings, out_dir=None, progress=print) -> tuple[dict, dict]:
+def run_study(
+    data, settings: StudySettings, out_dir=None, progress=print, executor=None
+) -> tuple[dict, dict]:
     """Fit every model on the subset, compare, check and cross-validate.  Returns ``(results,
     fits)``; with ``out_dir``, each model's ``posterior.json``, samples and ``posterior.nc``
-    are written under ``out_dir/<model>/`` (atomically; the caller swaps the folder in)."""
+    are written under ``out_dir/<model>/`` (atomically; the caller swaps the folder in).  The
+    fits and the cross-validation's folds are tasks of one map on ``executor`` (default
+    in-process; the results are the same on any)."""
     rows = select_rows(data, None if settings.joint else settings.wavelength_nm, settings.row_step)
     sub = data.subset(rows)
     where = "all wavelengths (joint)" if settings.joint else f"{settings.wavelength_nm:g} nm"
+    jobs = [("fit", name, sub, settings.chain(), settings.joint) for name in settings.models]
+    folds = {name: _fold_jobs(name, sub, settings) if settings.cv else [] for name in settings.models}
+    jobs += [job for name in settings.models for job in folds[name]]
+    progress(
+        f"ptfe: fitting {', '.join(settings.models)} on {len(sub)} rows at {where}"
+        + (", and leaving one incidence out" if settings.cv else "")
+    )
+    done = (executor or SerialExecutor()).map(_task, jobs, tasks=len(jobs))
     fits, idatas, models = {}, {}, {}
-    for name in settings.models:
-        progress(f"ptfe: fitting {name} on {len(sub)} rows at {where}")
-        fit = fit_model(name, sub, settings.chain(), joint=settings.joint)
-        ll = pointwise_loglik(fit)
-        idata = inference_data(fit, ll)
-        fits[name], idatas[name] = fit, idata
+    for name, fit in zip(settings.models, done, strict=False):
+        fits[name] = fit
+        idatas[name] = inference_data(fit, pointwise_loglik(fit))
         entry = {"scene": scene_file(name, settings.joint), "parameters": fit.summary["parameters"]}
         if out_dir is not None:
             folder = os.path.join(out_dir, name)
             post = write_mueller_fit(fit, folder, data_path=data.path, scene_path=entry["scene"])
-            _write_netcdf(idata, os.path.join(folder, "posterior.nc"))
+            _write_netcdf(idatas[name], os.path.join(folder, "posterior.nc"))
             entry["posterior_json"] = os.path.join(name, "posterior.json") if post else None
         # in-sample posterior predictive check: the fitted rows inside the 68/95% intervals
         entry["posterior_predictive"] = heldout_coverage(fit, fit.lik.data, settings.draws, settings.seed)
@@ -319,10 +360,11 @@ def run_study(data, settings: StudySettings, out_dir=None, progress=print) -> tu
         "verdict": verdict(comparison),
     }
     if settings.cv:
+        at = len(settings.models)
         res["cross_validation"] = {}
         for name in settings.models:
-            progress(f"ptfe: leave-one-incidence-out for {name}")
-            res["cross_validation"][name] = leave_one_incidence_out(name, sub, settings)
+            res["cross_validation"][name] = _pooled(folds[name], done[at : at + len(folds[name])])
+            at += len(folds[name])
     return res, fits
 
 

@@ -33,7 +33,7 @@ class PtfeData:
 def compute(ctx):
     data = load_mueller_data(nist_ptfe_path())
     st = ptfe.StudySettings(seed=ctx.seed, **(ptfe.QUICK if ctx.quick else ptfe.REPORT))
-    res, fits = ptfe.run_study(data, st, progress=lambda msg: None)
+    res, fits = ptfe.run_study(data, st, progress=lambda msg: None, executor=ctx.executor)
     cmp_rows, cov_rows = [], []
     for name in res["verdict"]["ranking"]:
         c, ppc = res["comparison"][name], res["models"][name]["posterior_predictive"]["all"]
