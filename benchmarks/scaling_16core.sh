@@ -16,6 +16,9 @@
 #   5. the full `report` restricted to 2 cores (taskset, 2 workers, NUMBA_NUM_THREADS=2: numba
 #      counts the host's cores, not the affinity mask).
 # The reports' digests (results.json without timings) must be equal.
+# At 4235c56 parts 1-3 and the comparison in-process took ~560 s of the device call's 600:
+# the comparison on 16 workers and part 5 were cut (figures in docs/guide/nightly.md, "How it
+# scales"). Part 5 needs a call of its own (~400 s at 4235c56).
 set -u
 OUT=${1:?usage: scaling_16core.sh OUTDIR}
 mkdir -p "$OUT"
