@@ -238,9 +238,10 @@ def comparison_settings(quick):
     # `python benchmarks/fit_moves.py --max-steps 2000` (it prints both).
     # A burn-in of 1000 steps: the walkers' start-up counted in the whole chain's tau, and the
     # Maxwell-Beard hypothesis on the combination's polarized data (a misfit) ran one chain to
-    # the 12000-step limit unconverged (tau 298.9, 59.9 s) where, after the burn-in, it converges
-    # at 3100 kept steps (tau 62.0, 18.5 s with the burn-in): the comparison's longest chain
-    # bounds it on many workers (`python benchmarks/comparison_chains.py`).
+    # the 12000-step limit unconverged (tau 298.9, 69.4 s) where, after the burn-in, it converges
+    # at 3100 kept steps (tau 62.0, 20.5 s with the burn-in): the comparison's longest chain
+    # bounds it on many workers (`python benchmarks/comparison_chains.py`, 2026-11-29: 279.6 s
+    # and 259.3 s for all 16 chains, the longest 69.4 s and 25.4 s).
     return dict(
         rows=None,
         settings=ChainSettings(
