@@ -306,5 +306,7 @@ def test_the_comparison_text_states_the_burn_in_of_its_chains():
     assert (full.burn, quick.burn) == (1000, 0)
     base = dict(rows=(), speckle=0.05, rows_per_file=200, all_rows=True, walkers=24, max_steps=12000, seed=3,
                 chains=2, data_files=("a.csv",), scene_files=("b.toml",), scans=())  # fmt: skip
-    assert "1000 steps of burn-in (not kept), then at most 12000 steps" in mc._text(mc.ComparisonData(**base, burn=1000))
+    assert "1000 steps of burn-in (not kept), then at most 12000 steps" in mc._text(
+        mc.ComparisonData(**base, burn=1000)
+    )
     assert "burn-in" not in mc._text(mc.ComparisonData(**base, burn=0))

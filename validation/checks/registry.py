@@ -28,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import operator
+import threading
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -177,6 +178,30 @@ def select(ids):
     return [specs[i] for i in ids]
 
 
+#: one lock per memo entry being computed: a report computes some sections at once, on
+#: threads (:func:`scatterbench.validation.report.build.build_report`), and two of them asking
+#: for one study must share one run of it, not each start their own
+_COMPUTING: dict = {}
+_COMPUTING_GUARD = threading.Lock()
+
+
+def _once(memo, key, make):
+    """``memo[key]``, made by ``make()`` the first time: by one thread, the others asking for
+    it meanwhile waiting for its value (a failed ``make`` raises in each, and the next asks again)."""
+    if key in memo:
+        return memo[key]
+    with _COMPUTING_GUARD:
+        lock = _COMPUTING.setdefault((id(memo), key), threading.Lock())
+    with lock:
+        try:
+            if key not in memo:
+                memo[key] = make()
+            return memo[key]
+        finally:
+            with _COMPUTING_GUARD:
+                _COMPUTING.pop((id(memo), key), None)
+
+
 @dataclass
 class CheckContext:
     """What a run gives its checks: the quick flag, the seed, a memo and an executor.
@@ -197,18 +222,14 @@ class CheckContext:
         """``fn(*args, **kw)``, computed once per context (arguments must be hashable);
         the result is shared: treat it as read-only."""
         key = (fn.__module__, fn.__qualname__, args, tuple(sorted(kw.items())))
-        if key not in self.memo:
-            self.memo[key] = fn(*args, **kw)
-        return self.memo[key]
+        return _once(self.memo, key, lambda: fn(*args, **kw))
 
     def study(self, fn, *args, **kw):
         """``fn(*args, executor=..., **kw)`` on the run's executor, computed once per context
         like :meth:`compute` and keyed without the executor: a study gives the same results on
         any executor (benchmarks/study_workers.py, tests/test_report_executors.py)."""
         key = (fn.__module__, fn.__qualname__, args, tuple(sorted(kw.items())))
-        if key not in self.memo:
-            self.memo[key] = fn(*args, executor=self.runner(), **kw)
-        return self.memo[key]
+        return _once(self.memo, key, lambda: fn(*args, executor=self.runner(), **kw))
 
     def runner(self):
         """The run's executor (in-process when none was given)."""
@@ -253,10 +274,7 @@ def run_checks(specs=None, ctx=None):
     specs = registered(ctx.quick) if specs is None else specs
     out = []
     for spec in specs:
-        key = ("check", spec.id)
-        if key not in ctx.memo:
-            ctx.memo[key] = _run_one(spec, ctx)
-        out.extend(ctx.memo[key])
+        out.extend(_once(ctx.memo, ("check", spec.id), lambda spec=spec: _run_one(spec, ctx)))
     return out
 
 

@@ -132,12 +132,20 @@ def _worker_init(threads):
     _share_cores(threads)
 
 
+#: the functions a worker keeps unpickled: a report's sections run at once
+#: (:func:`scatterbench.validation.report.build.build_report`), so one worker's tasks
+#: alternate between a few studies' functions
+WORKER_FUNCTIONS = 8
+
+
 def _run_pickled_chunk(key, blob, chunk):
     """Worker side: unpickle the function once per worker process and reuse it."""
-    fn = _WORKER_FNS.get(key)
+    fn = _WORKER_FNS.pop(key, None)
     if fn is None:
-        _WORKER_FNS.clear()
-        fn = _WORKER_FNS[key] = pickle.loads(blob)
+        fn = pickle.loads(blob)
+        while len(_WORKER_FNS) >= WORKER_FUNCTIONS:
+            _WORKER_FNS.pop(next(iter(_WORKER_FNS)))  # the least recently used
+    _WORKER_FNS[key] = fn
     return [fn(x) for x in chunk]
 
 
@@ -166,6 +174,9 @@ def _sigint_between_calls():
 class SerialExecutor:
     workers = 1
     kind = "serial"
+    #: whether each worker process runs one task at a time (what the report needs to compute
+    #: sections at once: :func:`scatterbench.validation.report.build.side_by_side`)
+    one_task_per_process = False
 
     def map(self, fn, items, tasks=None):
         """``[fn(x) for x in items]``; ``tasks`` (how many pieces the work is cut
@@ -193,11 +204,13 @@ class SerialExecutor:
 
 class ProcessExecutor(SerialExecutor):
     kind = "processes"
+    one_task_per_process = True
 
     def __init__(self, workers: int):
         self.workers = _integer("workers", workers, 1)
         # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
         self._fn = self._blob = self._key = None
+        self._lock = threading.Lock()
         self._pool = cf.ProcessPoolExecutor(
             workers,
             mp_context=multiprocessing.get_context("spawn"),
@@ -209,12 +222,14 @@ class ProcessExecutor(SerialExecutor):
         """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker)."""
         # The function (e.g. a likelihood holding the data) is pickled once per
         # distinct function object, not once per call; workers unpickle it once.
-        if self._fn is not fn:
-            blob = pickle.dumps(fn)
-            self._fn, self._blob, self._key = fn, blob, hashlib.sha1(blob).hexdigest()
+        # one lock: sections call map from threads at once (the last function is per executor)
+        with self._lock:
+            if self._fn is not fn:
+                blob = pickle.dumps(fn)
+                self._fn, self._blob, self._key = fn, blob, hashlib.sha1(blob).hexdigest()
+            key, blob = self._key, self._blob
         futs = [
-            self._pool.submit(_run_pickled_chunk, self._key, self._blob, c)
-            for c in _chunks(items, tasks or self.workers)
+            self._pool.submit(_run_pickled_chunk, key, blob, c) for c in _chunks(items, tasks or self.workers)
         ]
         return [y for f in futs for y in f.result()]
 
@@ -237,6 +252,7 @@ class DaskExecutor(SerialExecutor):
             self.client, self._own = _connect(address_or_client, timeout), True
         info = self.client.scheduler_info().get("workers", {})
         self.workers = max(1, len(info))
+        self.one_task_per_process = bool(info) and all(w["nthreads"] == 1 for w in info.values())
         self._threads = _dask_kernel_threads(info, self.client.run(_local_cores) if info else {})
 
     def map(self, fn, items, tasks=None):

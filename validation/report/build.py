@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import contextvars
 import datetime
 import json
 import os
 import sys
 import time
 import traceback
+from concurrent.futures import ThreadPoolExecutor
 
 from tqdm import tqdm
 
@@ -53,30 +55,69 @@ def _context(context, quick, previous, seed, executor):
     return context
 
 
-def _run_one(ctx, spec):
-    """``spec`` computed and rendered; if either raises, the section keeps its error and the
-    failure is recorded in ``ctx.cache["section_failures"]``."""
-    sec = Section(spec.id, spec.title)
+def _computed(ctx, spec):
+    """``(data, error, seconds)`` of ``spec.compute(ctx)``: ``error`` the failure record (and
+    the section's error line) when it raised, else ``None``."""
     t = time.perf_counter()
     try:
-        spec.render(sec, spec.compute(ctx))
+        return spec.compute(ctx), None, time.perf_counter() - t
     except Exception as exc:  # a broken section must not lose the rest of the report
-        sec = Section(spec.id, spec.title, error=f"{type(exc).__name__}: {exc}")
-        ctx.cache["section_failures"].append(_section_failure(spec.id))
-    sec.seconds = time.perf_counter() - t
-    ctx.cache["section_times"][spec.id] = sec.seconds
+        return None, (f"{type(exc).__name__}: {exc}", _section_failure(spec.id)), time.perf_counter() - t
+
+
+def _rendered(ctx, spec, computed):
+    """``spec`` rendered from ``computed`` (:func:`_computed`); a failure of either is kept as
+    the section's error and recorded in ``ctx.cache["section_failures"]``."""
+    data, error, seconds = computed
+    sec = Section(spec.id, spec.title)
+    t = time.perf_counter()
+    if error is None:
+        try:
+            spec.render(sec, data)
+        except Exception as exc:  # noqa: BLE001 - as a failed compute
+            error = (f"{type(exc).__name__}: {exc}", _section_failure(spec.id))
+    if error is not None:
+        sec = Section(spec.id, spec.title, error=error[0])
+        ctx.cache["section_failures"].append(error[1])
+    sec.seconds = seconds + time.perf_counter() - t
     return sec
 
 
+def side_by_side(executor) -> bool:
+    """Whether a report on ``executor`` computes its :attr:`~.core.SectionSpec.beside` sections
+    at once: only when their tasks run on workers that each run one task at a time (local
+    processes, or a cluster of one-thread workers).  In-process there is nothing to overlap;
+    on a worker with several task threads the stability sweep, which records warnings
+    process-wide, would record other sections' warnings."""
+    return getattr(executor, "workers", 1) > 1 and getattr(executor, "one_task_per_process", False)
+
+
+def _beside(ctx, specs):
+    """``{id: computed}`` of the sections of ``specs`` that run beside each other, each
+    computed on a thread of its own (in a copy of this thread's context: the backend and
+    precision settings), their tasks then sharing the executor's workers."""
+    specs = [sp for sp in specs if sp.beside] if side_by_side(ctx.executor) else []
+    if len(specs) < 2:
+        return {}
+    with ThreadPoolExecutor(len(specs), thread_name_prefix="scatterbench-section") as pool:
+        futs = {sp.id: pool.submit(contextvars.copy_context().run, _computed, ctx, sp) for sp in specs}
+        return {sid: f.result() for sid, f in futs.items()}
+
+
 def _run_sections(ctx, specs):
-    """Every section of ``specs`` by stage (page order within one); returns them in page order."""
+    """Every section of ``specs``: first those computed side by side (:func:`_beside`), then
+    the others one at a time by stage (page order within one), each rendered in that order on
+    this thread (matplotlib's figures are not thread-safe); returns them in page order."""
     ctx.cache.setdefault("section_times", {})
     ctx.cache.setdefault("section_failures", [])
     done = {}
     with _progress(len(specs), "report") as bar:
+        early = _beside(ctx, specs)
         for spec in sorted(specs, key=lambda sp: sp.stage):
             bar.set_postfix_str(spec.id)
-            done[spec.id] = _run_one(ctx, spec)
+            computed = early.pop(spec.id, None) or _computed(ctx, spec)
+            done[spec.id] = _rendered(ctx, spec, computed)
+            ctx.cache["section_times"][spec.id] = done[spec.id].seconds
             bar.update(1)
     return [done[spec.id] for spec in specs]
 

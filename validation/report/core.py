@@ -74,6 +74,11 @@ class SectionSpec:
 
     ``stage``: sections run in increasing stage (page order within one); provenance
     (stage 1) shows the others' run times, the summary (stage 2) their failures.
+
+    ``beside``: the section's work is mostly tasks on the run's executor, it records no
+    warnings in this process and times nothing: on worker processes it is computed at once
+    with the other such sections, before the rest (:func:`~.build.side_by_side`), so that
+    the workers always have tasks.
     """
 
     id: str
@@ -81,6 +86,7 @@ class SectionSpec:
     compute: Callable
     render: Callable
     stage: int = 0
+    beside: bool = False
 
 
 def _clean(v):

@@ -33,8 +33,8 @@ from .summary import report_checks
 __all__ = ["SECTIONS", "report_checks"]
 
 
-def _spec(sid, title, module, stage=0):
-    return SectionSpec(sid, title, module.compute, module.render, stage)
+def _spec(sid, title, module, stage=0, beside=False):
+    return SectionSpec(sid, title, module.compute, module.render, stage, beside)
 
 
 #: the page, in order; the summary runs last (it shows every check and every section that
@@ -46,16 +46,28 @@ SECTIONS = (
     _spec("conservation", "Conservation: reciprocity and albedo", conservation),
     _spec("scatmech", "Agreement with SCATMECH", scatmech),
     _spec("seed003_fig1", "Seed 003 Fig. 1 reproduced: Snell shift of facet transmission", seed003_fig1),
-    _spec("seed003_presets", "Seed 003 Fig. 2-3: preset model curves beside Maxwell-Beard", seed003_presets),
+    _spec(
+        "seed003_presets",
+        "Seed 003 Fig. 2-3: preset model curves beside Maxwell-Beard",
+        seed003_presets,
+        beside=True,
+    ),
     _spec("seed001", "Seed 001: published vs energy Cook-Torrance, varnish, point source", seed001),
     _spec("thin_film", "Beyond the seeds: thin-film interference flakes and their colour travel", thin_film),
-    _spec("uncertainty", "Uncertainty: an example posterior and the recovery coverage", uncertainty),
     _spec(
-        "model_comparison", "Model comparison: seed 003's combination against Maxwell-Beard", model_comparison
+        "uncertainty", "Uncertainty: an example posterior and the recovery coverage", uncertainty, beside=True
     ),
-    _spec("ptfe", "Real data: NIST's sintered PTFE, five models compared and cross-validated", ptfe),
+    _spec(
+        "model_comparison",
+        "Model comparison: seed 003's combination against Maxwell-Beard",
+        model_comparison,
+        beside=True,
+    ),
+    _spec(
+        "ptfe", "Real data: NIST's sintered PTFE, five models compared and cross-validated", ptfe, beside=True
+    ),
     _spec("speed", "Speed and accuracy", speed),
-    _spec("stability", "Stability sweep at the extremes", edge_findings),
+    _spec("stability", "Stability sweep at the extremes", edge_findings, beside=True),
     _spec("scenes", "Scenes and the mechanisms they build", scenes),
     _spec("contributed", "Contributed models (scatterbench.models entry points)", contributed),
     _spec("provenance", "Provenance", provenance, stage=1),

@@ -1,0 +1,142 @@
+"""The report computes its ``beside`` sections (the studies on the executor) at once, on
+threads of their own, when its workers run one task at a time; everything else one after
+another, and every section is rendered in page order on the calling thread.
+
+Equal results on every executor are ``tests/test_report_executors.py``'s (its subset, the
+seed 003 presets and the stability sweep, are both ``beside``)."""
+
+import threading
+
+import pytest
+
+from scatterbench.validation.checks.registry import CheckContext
+from scatterbench.validation.fitting import executors
+from scatterbench.validation.report import build, sections
+from scatterbench.validation.report.core import SectionSpec
+
+
+class Workers(executors.SerialExecutor):
+    """In-process, but claiming two one-task workers: what makes a report compute side by side."""
+
+    workers = 2
+    kind = "processes"
+    one_task_per_process = True
+
+
+def _report(monkeypatch, specs, executor):
+    summary, provenance = sections.SECTIONS[0], sections.SECTIONS[-1]
+    monkeypatch.setattr(build, "SECTIONS", [summary, *specs, provenance])
+    return build.build_report(quick=True, checks=[], executor=executor)[0]
+
+
+def _meeting(n, timeout=20.0):
+    """``n`` sections' compute that return only once all ``n`` run at the same time (a barrier
+    that breaks after ``timeout`` s: computed one after another, each raises)."""
+    barrier = threading.Barrier(n, timeout=timeout)
+    seen = []
+
+    def compute(ctx):
+        barrier.wait()
+        seen.append(threading.current_thread().name)
+        return len(seen)
+
+    return compute, seen
+
+
+def _rendering(log):
+    def render(sec, data):
+        log.append((sec.id, threading.current_thread() is threading.main_thread()))
+        sec.numbers["data"] = 1.0
+
+    return render
+
+
+def test_beside_sections_are_computed_at_once_and_rendered_in_page_order(monkeypatch):
+    compute, seen = _meeting(3)
+    log = []
+    specs = [SectionSpec(f"s{i}", f"S{i}", compute, _rendering(log), beside=True) for i in range(3)]
+    results = _report(monkeypatch, specs, Workers())
+    assert [s["error"] for s in results["sections"].values()] == [None] * 5
+    assert len(set(seen)) == 3 and all(name.startswith("scatterbench-section") for name in seen)
+    assert log == [("s0", True), ("s1", True), ("s2", True)]  # page order, on the main thread
+    assert results["summary"]["n_fail"] == 0
+
+
+def test_on_one_process_or_many_task_threads_the_sections_run_one_after_another(monkeypatch):
+    class Threads(Workers):
+        one_task_per_process = False  # a Dask worker with several task threads
+
+    for executor in (executors.SerialExecutor(), Threads()):
+        compute, _ = _meeting(2, timeout=1.0)
+        specs = [SectionSpec(f"s{i}", f"S{i}", compute, _rendering([]), beside=True) for i in range(2)]
+        results = _report(monkeypatch, specs, executor)
+        # one after another, the first waits at the barrier alone until it breaks
+        assert results["sections"]["s0"]["error"] == "BrokenBarrierError: "
+        assert results["summary"]["n_fail"] == 2
+
+
+def test_a_beside_section_that_raises_fails_alone(monkeypatch):
+    def broken(ctx):
+        raise RuntimeError("the study failed")
+
+    log = []
+    specs = [
+        SectionSpec("bad", "Bad", broken, _rendering(log), beside=True),
+        SectionSpec("good", "Good", lambda ctx: 1, _rendering(log), beside=True),
+        SectionSpec("after", "After", lambda ctx: 2, _rendering(log)),
+    ]
+    results = _report(monkeypatch, specs, Workers())
+    assert results["sections"]["bad"]["error"] == "RuntimeError: the study failed"
+    assert results["sections"]["good"]["numbers"] == {"data": 1.0}
+    assert [c["id"] for c in results["checks"]] == ["report.section_bad"]
+    assert log == [("good", True), ("after", True)]
+
+
+def test_the_dask_executor_says_whether_its_workers_run_one_task_at_a_time():
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    ) as lc:
+        with distributed.Client(lc) as client:
+            ex = executors.DaskExecutor(client)
+            assert not ex.one_task_per_process and not build.side_by_side(ex)
+    assert build.side_by_side(Workers()) and not build.side_by_side(executors.SerialExecutor())
+
+
+def test_two_sections_asking_for_one_study_share_one_run_of_it():
+    ctx = CheckContext()
+    calls, started = [], threading.Event()
+
+    def study(x, executor=None):
+        calls.append(x)
+        started.set()
+        threading.Event().wait(0.3)  # long enough that the other thread asks meanwhile
+        return x * 2
+
+    def ask(out):
+        out.append(ctx.study(study, 21))
+
+    got = []
+    first = threading.Thread(target=ask, args=(got,))
+    first.start()
+    started.wait(5)
+    ask(got)
+    first.join()
+    assert got == [42, 42] and calls == [21]
+
+
+def test_a_worker_keeps_the_functions_of_sections_that_alternate(monkeypatch):
+    loads = []
+    real = executors.pickle.loads
+
+    def counting(blob):
+        loads.append(blob)
+        return real(blob)
+
+    monkeypatch.setattr(executors, "_WORKER_FNS", {})
+    monkeypatch.setattr(executors.pickle, "loads", counting)
+    blobs = {k: executors.pickle.dumps(fn) for k, fn in (("a", abs), ("b", round))}
+    for _ in range(3):  # two studies' chunks alternating on one worker
+        assert executors._run_pickled_chunk("a", blobs["a"], [-1]) == [1]
+        assert executors._run_pickled_chunk("b", blobs["b"], [1.4]) == [1]
+    assert len(loads) == 2
