@@ -129,7 +129,32 @@ def checked_angles(model, theta_i, theta_r, phi_r):
     """The three angle inputs as float64 arrays, each validated under ``model``'s names for
     them (two polar angles in [0, pi/2], a finite azimuth)."""
     n1, n2, n3 = model._angle_names
-    return [check_polar_angle(n1, theta_i), check_polar_angle(n2, theta_r), check_finite_array(n3, phi_r)]
+    return [
+        _checked(check_polar_angle, n1, theta_i, 0.0, _HALF_PI),
+        _checked(check_polar_angle, n2, theta_r, 0.0, _HALF_PI),
+        _checked(check_finite_array, n3, phi_r, -_LARGEST, _LARGEST),
+    ]
+
+
+_HALF_PI, _LARGEST = 0.5 * math.pi, float(np.finfo(np.float64).max)
+#: from this many values a C-contiguous float64 angle array is checked by one compiled pass on
+#: the kernels' threads (:func:`scatterbench.models.kernels.within`) instead of numpy's
+#: reductions, which run on one thread
+PARALLEL_CHECK = 1 << 18
+
+
+def _checked(check, name, a, low, high):
+    """``check(name, a)``, or ``a`` itself when it is a large C-contiguous float64 array
+    (:data:`PARALLEL_CHECK`) whose values all lie in ``[low, high]``, which the kernels' threads
+    check in one pass; anything else (a value out of range included) takes ``check``, which
+    raises the error that names the angle."""
+    large = type(a) is np.ndarray and a.dtype == np.float64 and a.size >= PARALLEL_CHECK
+    if large and a.flags.c_contiguous and _BACKEND.get() == "numba":
+        from . import kernels  # numba (heavy): loaded when compiled code first runs
+
+        if kernels.within(a.reshape(-1), low, high):
+            return a
+    return check(name, a)
 
 
 #: one angle value a small call takes without numpy's conversion (a ``bool`` is not one:

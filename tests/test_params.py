@@ -154,3 +154,34 @@ def test_wrappers_require_their_model(cls):
     with pytest.raises(ValueError, match="model is required"):
         cls()
     assert {p.name: p for p in cls.parameters()}["model"].required
+
+
+@pytest.mark.parametrize(
+    "at, value, name",
+    [(0, float("nan"), "theta_i"), (-1, math.pi / 2 + 1e-12, "theta_i"), (12345, -0.0001, "theta_r"),
+     (7, float("inf"), "phi_r"), (-1, float("-inf"), "phi_r")],
+)  # fmt: skip
+def test_large_angle_arrays_are_checked_on_the_kernels_threads_and_name_a_bad_value(
+    at, value, name, monkeypatch
+):
+    """From PARALLEL_CHECK values a float64 angle array is checked by one compiled pass
+    (kernels.within); one bad value anywhere in it still gives numpy's error naming the angle."""
+    from scatterbench.models import evaluation
+
+    n = evaluation.PARALLEL_CHECK
+    good = {
+        "theta_i": np.full(n, 0.3),
+        "theta_r": np.linspace(0.0, math.pi / 2, n),
+        "phi_r": np.linspace(-7, 7, n),
+    }
+    m = models.FacetBRDF()
+    with pytest.MonkeyPatch.context() as mp:  # valid: the numpy checks never run
+        mp.setattr(evaluation, "check_polar_angle", None)
+        mp.setattr(evaluation, "check_finite_array", None)
+        shape, M = m.mueller16(*good.values())
+    assert M.shape == (16, n) and np.isfinite(M).all()
+    bad = dict(good)
+    bad[name] = good[name].copy()
+    bad[name][at] = value
+    with pytest.raises(ValueError, match=name):
+        m.mueller16(*bad.values())

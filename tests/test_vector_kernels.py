@@ -255,7 +255,7 @@ def test_only_the_entry_points_are_cached():
     import scatterbench.models.kernels as kernels
 
     entries = {
-        "drive": {"angles_ok"},  # and the entries per kernel, below
+        "drive": {"angles_ok", "outside_range"},  # and the entries per kernel, below
         "montecarlo": {"_range", "_exit_range"},
         "aperture": {"nodes", "_tiles"},
         "disc": {"points"},

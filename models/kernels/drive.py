@@ -185,6 +185,19 @@ def angles_ok(ti, tr, pr):
     return True
 
 
+@njit(cache=True, error_model="numpy", nogil=True)
+def outside_range(a, low, high, bad, lo, hi):
+    """``bad[0] = 1`` when a value of ``a[lo:hi]`` lies outside ``[low, high]`` (NaN does): the
+    general path's check of a large angle array, a range of it per thread (:func:`~scatterbench.models.kernels.within`)."""
+    n = 0
+    for k in range(lo, hi):
+        x = a[k]
+        if not (low <= x) or not (x <= high):  # no early exit: the loop stays on SIMD lanes
+            n += 1
+    if n:
+        bad[0] = 1
+
+
 #: the index of a call without one (:func:`column`: geometry ``i`` reads column ``i * p``)
 NO_INDEX = np.zeros(1, dtype=np.int64)
 
