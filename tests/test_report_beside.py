@@ -140,3 +140,46 @@ def test_a_worker_keeps_the_functions_of_sections_that_alternate(monkeypatch):
         assert executors._run_pickled_chunk("a", blobs["a"], [-1]) == [1]
         assert executors._run_pickled_chunk("b", blobs["b"], [1.4]) == [1]
     assert len(loads) == 2
+
+
+# ----------------------------------------------------------------------------- the cores a worker's kernels take
+def _kernel_threads_after(seconds):
+    """(A worker's task) the threads a kernel call would start, read after ``seconds``."""
+    import time
+
+    from scatterbench.models.kernels.threads import threads_now
+
+    time.sleep(seconds)
+    return threads_now()
+
+
+def test_a_worker_s_kernels_take_the_cores_the_idle_workers_leave():
+    cores = executors._local_cores()
+    if cores < 2:
+        pytest.skip("one core: nothing to share")
+    with executors.ProcessExecutor(2) as ex:
+        ex.map(_kernel_threads_after, [0.0, 0.0], tasks=2)  # both workers started
+        alone = ex.map(_kernel_threads_after, [0.0])
+        both = ex.map(_kernel_threads_after, [1.0, 1.0], tasks=2)  # running at the same time
+    assert alone == [cores] and both == [cores // 2] * 2
+
+
+def test_spread_starts_the_threads_the_share_gives(monkeypatch):
+    from scatterbench.models.kernels import threads
+
+    names = set()
+
+    def loop(lo, hi):
+        names.add(threading.current_thread().name)
+        threading.Event().wait(0.01)  # long enough that every thread takes a range
+
+    monkeypatch.setattr(threads.numba.config, "NUMBA_NUM_THREADS", 4)
+    monkeypatch.setattr(threads, "_POOL", [])
+    try:
+        for share in (1, 3):
+            names.clear()
+            threads.set_share(lambda share=share: share)
+            threads.spread(loop, (), 64, 1)
+            assert len(names) == share
+    finally:
+        threads.set_share(None)
