@@ -15,7 +15,8 @@
 #      PROBE_ARGS);
 #   3. FacetBRDF's kernel on 10^7 geometries at 1, 2, 4, 8, 16 threads (benchmarks/scaling.py);
 #   4. the full `report` on 16 workers;
-#   5. the full model comparison on 16 workers and in-process, with digests (scaling.py);
+#   5. the full model comparison on 16 workers and in-process, with digests (scaling.py;
+#      COMPARISON_WORKERS, default "16 1", the worker counts);
 #   6. the full `report` restricted to 2 cores (taskset, 2 workers, NUMBA_NUM_THREADS=2: numba
 #      counts the host's cores, not the affinity mask).
 # The reports' digests (results.json without timings) must be equal.
@@ -86,7 +87,7 @@ part4() {
 part5() {
     echo "== 5. the full model comparison on 16 workers and in-process; load $(cut -d' ' -f1-3 /proc/loadavg)"
     timeout 280 python3 benchmarks/scaling.py --geometries 1e3 --threads 1 --repeat 1 \
-        --studies comparison --workers 16 1
+        --studies comparison --workers ${COMPARISON_WORKERS:-16 1}
 }
 part6() {
     echo "== 6. full report on 2 cores; load $(cut -d' ' -f1-3 /proc/loadavg)"
