@@ -11,8 +11,7 @@
 # 1 2 3 4 5 6) choose which run, in the order given (part 1 compiles what the others use):
 #   1. the first `report --quick` with an empty numba cache (16 workers), then again warm;
 #   2. a probe of the kernels' threads when .probe/threads_probe.py is there (ad hoc, not
-#      committed: what each range of a kernel call costs on 1..16 threads; its arguments in
-#      PROBE_ARGS);
+#      committed: what each range of a kernel call costs on 1..16 threads);
 #   3. FacetBRDF's kernel on 10^7 geometries at 1, 2, 4, 8, 16 threads (benchmarks/scaling.py);
 #   4. the full `report` on 16 workers;
 #   5. the full model comparison on 16 workers and in-process, with digests (scaling.py;
@@ -72,7 +71,7 @@ part1() {
 part2() {
     [ -f .probe/threads_probe.py ] || return 0
     echo "== 2. threads probe; load $(cut -d' ' -f1-3 /proc/loadavg)"
-    timeout 150 python3 .probe/threads_probe.py ${PROBE_ARGS:-}
+    timeout 150 python3 .probe/threads_probe.py
 }
 part3() {
     echo "== 3. kernels by threads; load $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -16,7 +16,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numba
 
-__all__ = ["spread", "set_share", "threads_now"]
+__all__ = ["spread"]
 
 _POOL = []  # made on first use; forgotten in a fork's child, which has the object but no threads
 
@@ -33,29 +33,12 @@ os.register_at_fork(after_in_child=_forget)
 PER_THREAD = 4
 
 
-_SHARE = []  # the function giving this process's kernel threads now, when one is set
-
-
-def set_share(fn):
-    """Let ``fn()`` (or, for ``None``, ``numba.get_num_threads()`` again) give the threads a
-    kernel call starts in this process: a local worker process's share of its machine's cores
-    among the tasks running at the time (:mod:`scatterbench.validation.fitting.executors`), so
-    that the last tasks of a study take the cores the finished ones left."""
-    _SHARE[:] = [fn] if fn is not None else []
-
-
-def threads_now() -> int:
-    """The threads a kernel call starts here now (:func:`set_share`)."""
-    return min(_SHARE[0](), numba.config.NUMBA_NUM_THREADS) if _SHARE else numba.get_num_threads()
-
-
 def spread(loop, args, n, grain):
     """``loop(*args, lo, hi)`` over ``0 .. n - 1``: in one call below ``2 * grain``, otherwise
-    on up to :func:`threads_now` threads (``numba.get_num_threads()``, what
-    ``numba.set_num_threads`` sets, as for numba's own parallel loops, unless a share is set),
-    the calling thread one of them, each taking the next of up to
+    on up to ``numba.get_num_threads()`` threads (what ``numba.set_num_threads`` sets, as for
+    numba's own parallel loops), the calling thread one of them, each taking the next of up to
     :data:`PER_THREAD` equal ranges per thread (each at least ``grain``) until none is left."""
-    k = min(threads_now(), n // max(grain, 1))
+    k = min(numba.get_num_threads(), n // max(grain, 1))
     if k <= 1:
         loop(*args, 0, n)
         return

@@ -123,47 +123,13 @@ def _share_cores(threads):
         _LIMITED = threads
 
 
-_RUNNING = None  # in a local worker: its pool's count of the tasks running now (shared memory)
-
-
-def _worker_init(threads, running=None):
+def _worker_init(threads):
     """A local worker's set-up: it leaves Ctrl-C to the parent (which stops the pool and says
     how to resume: the terminal sends it to every process of the group, and each would print
-    a traceback) and runs on its share of the cores (:func:`_share_cores`); with ``running``,
-    the pool's count of running tasks, the kernels take the cores the idle workers leave
-    (:func:`_running_share`)."""
-    global _RUNNING
+    a traceback) and runs on its share of the cores (:func:`_share_cores`)."""
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _share_cores(threads)
-    if running is not None:
-        from scatterbench.models.kernels import threads as kernel_threads_  # numba: loaded already
-
-        _RUNNING = running
-        kernel_threads_.set_share(_running_share(threads, _local_cores(), running))
-
-
-def _running_share(least, cores, running):
-    """The kernel threads of a worker now: the machine's cores shared among the pool's running
-    tasks, at least ``least`` (its share when every worker runs one).  At the end of a study the
-    last tasks then run on the cores the others left: the full model comparison's longest
-    chain took 27.6 s on one thread and 19.0 s on two (ad hoc, 2-core machine).  The thread
-    count changes no result (:func:`scatterbench.models.kernels.threads.spread`)."""
-    return lambda: max(least, cores // max(1, running.value))
-
-
-@contextlib.contextmanager
-def _counted():
-    """The block counted as a running task of this worker's pool (:data:`_RUNNING`)."""
-    if _RUNNING is None:
-        yield
-        return
-    with _RUNNING.get_lock():
-        _RUNNING.value += 1
-    try:
-        yield
-    finally:
-        with _RUNNING.get_lock():
-            _RUNNING.value -= 1
 
 
 #: the functions a worker keeps unpickled: a report's sections run at once
@@ -180,8 +146,7 @@ def _run_pickled_chunk(key, blob, chunk):
         while len(_WORKER_FNS) >= WORKER_FUNCTIONS:
             _WORKER_FNS.pop(next(iter(_WORKER_FNS)))  # the least recently used
     _WORKER_FNS[key] = fn
-    with _counted():
-        return [fn(x) for x in chunk]
+    return [fn(x) for x in chunk]
 
 
 @contextlib.contextmanager
@@ -246,12 +211,11 @@ class ProcessExecutor(SerialExecutor):
         # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
         self._fn = self._blob = self._key = None
         self._lock = threading.Lock()
-        spawn = multiprocessing.get_context("spawn")
         self._pool = cf.ProcessPoolExecutor(
             workers,
-            mp_context=spawn,
+            mp_context=multiprocessing.get_context("spawn"),
             initializer=_worker_init,
-            initargs=(kernel_threads(workers), spawn.Value("i", 0)),
+            initargs=(kernel_threads(workers),),
         )
 
     def map(self, fn, items, tasks=None):
