@@ -141,18 +141,25 @@ _HALF_PI, _LARGEST = 0.5 * math.pi, float(np.finfo(np.float64).max)
 #: the kernels' threads (:func:`scatterbench.models.kernels.within`) instead of numpy's
 #: reductions, which run on one thread
 PARALLEL_CHECK = 1 << 18
+#: the compiled check ``within(a, low, high) -> bool``: registered by
+#: :mod:`scatterbench.models.kernels` when it loads (it sits above this module: the layers)
+_WITHIN = []
+
+
+def register_range_check(fn):
+    """Check large angle arrays with ``fn(a, low, high) -> bool`` (whether every value of the
+    flat float64 ``a`` lies in ``[low, high]``) from now on (:func:`_checked`)."""
+    _WITHIN[:] = [fn]
 
 
 def _checked(check, name, a, low, high):
     """``check(name, a)``, or ``a`` itself when it is a large C-contiguous float64 array
     (:data:`PARALLEL_CHECK`) whose values all lie in ``[low, high]``, which the kernels' threads
-    check in one pass; anything else (a value out of range included) takes ``check``, which
-    raises the error that names the angle."""
+    check in one pass once the kernels have loaded; anything else (a value out of range
+    included) takes ``check``, which raises the error that names the angle."""
     large = type(a) is np.ndarray and a.dtype == np.float64 and a.size >= PARALLEL_CHECK
-    if large and a.flags.c_contiguous and _BACKEND.get() == "numba":
-        from . import kernels  # numba (heavy): loaded when compiled code first runs
-
-        if kernels.within(a.reshape(-1), low, high):
+    if large and _WITHIN and a.flags.c_contiguous and _BACKEND.get() == "numba":
+        if _WITHIN[0](a.reshape(-1), low, high):
             return a
     return check(name, a)
 

@@ -166,8 +166,9 @@ def test_large_angle_arrays_are_checked_on_the_kernels_threads_and_name_a_bad_va
 ):
     """From PARALLEL_CHECK values a float64 angle array is checked by one compiled pass
     (kernels.within); one bad value anywhere in it still gives numpy's error naming the angle."""
-    from scatterbench.models import evaluation
+    from scatterbench.models import evaluation, kernels
 
+    assert evaluation._WITHIN == [kernels.within]  # registered when the kernels load
     n = evaluation.PARALLEL_CHECK
     good = {
         "theta_i": np.full(n, 0.3),

@@ -217,6 +217,7 @@ def within(a, low, high) -> bool:
 
 #: values per range of :func:`within`: a range costs about a microsecond of calls and waits
 WITHIN_GRAIN = 1 << 16
+evaluation.register_range_check(within)
 
 
 def _other_entries(name):
