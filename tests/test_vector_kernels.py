@@ -14,7 +14,16 @@ from test_kernels import CONFIGS, _geometries
 
 from scatterbench import models
 from scatterbench.models.kernels import Compiled, drive, vector
-from scatterbench.models.kernels.vector_math import REDUCED_MAX, atan2, exp_neg, hypot, sincos, sqrt
+from scatterbench.models.kernels.vector_math import (
+    REDUCED_MAX,
+    atan2,
+    erfc,
+    exp_neg,
+    exp_neg_square,
+    hypot,
+    sincos,
+    sqrt,
+)
 
 #: test_kernels' configurations, and Cook-Torrance under strokes (its azimuth's cosine and
 #: sine are parameter rows)
@@ -56,7 +65,10 @@ def test_the_vectorized_models_are_the_ones_meant():
     assert names == closed | cook
     facets = [m for m in VECTORIZED if type(m).__name__.endswith("FacetBRDF")]
     assert {type(m.slopes).__name__ for m in facets} == {"ExponentialSlopes", "GaussianSlopes", "GGXSlopes"}
-    assert all(m.shadowing == "none" for m in facets)
+    # Smith's G only of the isotropic slopes with a closed-form Lambda (Gaussian, GGX)
+    shadowed = {(type(m.slopes).__name__, m.shadowing) for m in facets if m.shadowing != "none"}
+    assert {s for _, s in shadowed} == {"smith", "smith-correlated"}
+    assert {k for k, _ in shadowed} <= {"GaussianSlopes", "GGXSlopes"}
     assert {m.shadowing for m in VECTORIZED if type(m).__name__ in cook} == {"none", "blinn"}
 
 
@@ -132,13 +144,15 @@ import re
 import numpy as np
 from scatterbench import models
 from scatterbench.models.kernels import Compiled, drive
-for m in (models.FacetBRDF(), models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
+smith = models.FacetBRDF(slopes=models.GaussianSlopes(0.2), shadowing="smith")
+for m in (models.FacetBRDF(), smith, models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
     k = Compiled(m, *m._kernel_spec())
+    label = type(m).__name__ + ("-smith" if m is smith else "")
     k.run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
     k.scalar(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], drive.NO_INDEX, k.iopt, np.empty((16, 4)), 0, 0, 4)
     for name, fn in (("lanes", k.lanes), ("scalar", k.scalar)):  # each kernel's one compiled loop
         ir = "".join(fn.inspect_llvm().values())
-        print(type(m).__name__, name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
+        print(label, name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
 """
 
 
@@ -157,14 +171,15 @@ def test_the_lanes_are_vectorized_loops(tmp_path):
     """In a process that compiles the vector loop (its IR is inspected: a function loaded
     from the cache has none), after an earlier process filled the cache with some of the
     kernels' helpers: each model's vector loop (:func:`scatterbench.models.kernels.vector.lane_entries`)
-    holds LLVM's vectorized loops (their ``vector.body`` blocks, on ``<N x double>`` values);
+    holds LLVM's vectorized loops (their ``vector.body`` blocks, on ``<N x double>`` values),
+    the facet kernel's under Smith shadowing too (its ``erfc``);
     its scalar entry (:mod:`~scatterbench.models.kernels.drive`) has none.  Fails when a change puts a call or an exception
     back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     subprocess.run([sys.executable, "-c", _EARLIER], env=env, check=True)
     res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
     counts = {tuple(ln.split()[:2]): tuple(int(x) for x in ln.split()[2:]) for ln in res.stdout.splitlines()}
-    assert len(counts) == 6, res.stdout
+    assert len(counts) == 8, res.stdout
     for (model, loop), (bodies, vectors) in counts.items():
         if loop == "lanes":  # one option set per entry: its loop, and LLVM's remainder copies
             assert bodies >= 1 and vectors > 0, (model, bodies, vectors)
@@ -283,6 +298,46 @@ def test_only_the_entry_points_are_cached():
     assert len(names) == len(per_kernel)  # cache files of their own
 
 
+@njit
+def _erfc_each(x):
+    e, s = np.empty_like(x), np.empty_like(x)
+    for i in range(x.size):
+        e[i], s[i] = erfc(x[i]), exp_neg_square(abs(x[i]))
+    return e, s
+
+
+@pytest.mark.parametrize("span", [(-6.0, 0.0), (0.0, 1.0), (1.0, 6.0), (6.0, 27.0)])
+def test_erfc_within_five_ulp_and_exp_of_the_square_within_two(span):
+    """``erfc`` within 5 ulp of the C library's (which is within 2 of the exact value: ours is
+    within 4, ``scripts/fit_erfc_coefficients.py``'s reference), down to the normal range; exactly
+    zero from ``x^2 = 700`` on; ``exp(-x^2)`` within 2 ulp of ``exp`` of the exact square (the
+    float64 product of ``x`` with itself is rounded: ``math.exp(-x * x)`` is up to ``x^2`` ulp off,
+    so the reference takes the square's rounding error out, to first order)."""
+    rng = np.random.default_rng(13)
+    x = np.concatenate([rng.uniform(*span, 200_000), np.array(span)])
+    got, sq = _erfc_each(x)
+    ref = np.array([math.erfc(v) for v in x])
+    live = ref > 1e-300
+    assert _ulps(got[live], ref[live]) <= 5.0
+    assert np.all(got[np.abs(x) >= math.sqrt(700.0)] == 0.0)
+    p = x * x
+    hi = x * 134217729.0 - (x * 134217729.0 - x)  # the square's rounding error, exactly
+    err = ((hi * hi - p) + 2.0 * hi * (x - hi)) + (x - hi) ** 2
+    ref_sq = np.exp(-p) * (1.0 - err)
+    live = (p < 700.0) & (ref_sq > 1e-300)
+    assert _ulps(sq[live], ref_sq[live]) <= 2.0
+
+
+def test_erfc_at_the_edges():
+    """The values Smith's ``Lambda`` meets: zero, infinity (``mu`` at normal incidence), the
+    underflow, NaN."""
+    got, sq = _erfc_each(np.array([0.0, -0.0, np.inf, -np.inf, 26.4, 26.5, 1e300, np.nan]))
+    assert np.array_equal(got[[0, 1, 2, 3, 5, 6]], [1.0, 1.0, 0.0, 2.0, 0.0, 0.0])
+    assert abs(got[4] - math.erfc(26.4)) <= 5 * math.ulp(math.erfc(26.4))
+    assert np.isnan(got[7])
+    assert np.array_equal(sq[:4], [1.0, 1.0, 0.0, 0.0])
+
+
 def test_option_sets_are_every_set_the_lanes_take():
     """:func:`~scatterbench.models.kernels.vector.option_sets` (what ``kernels.warm`` compiles
     ahead) holds every option set :func:`~scatterbench.models.kernels.vector.lane_options` gives a
@@ -290,9 +345,9 @@ def test_option_sets_are_every_set_the_lanes_take():
     lazily, in each process that reaches it, on a report's first run."""
     seen = {c: set() for c in drive.CODES.values()}
     for code in drive.CODES.values():
-        # o[0]: slope kind or form; o[1]: convention or shadowing; o[2]: Cook-Torrance's
+        # o[0]: slope kind or form; o[1]: convention or shadowing (3 kinds); o[2]: Cook-Torrance's
         # shadowing (3 kinds) or Maxwell-Beard's polarized flag (2)
-        for iopt in np.ndindex(8, 2, 2 if code == drive.MAXWELL else 3):
+        for iopt in np.ndindex(8, 3, 2 if code == drive.MAXWELL else 3):
             iopt = np.array(iopt, dtype=np.int64)
             if vector.vectorized(code, iopt):
                 seen[code].add(vector.lane_options(code, iopt))

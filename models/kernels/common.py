@@ -26,7 +26,7 @@ from ..kernel_specs import (
     SHADOWING_KINDS,
     UNIT,
 )
-from .vector_math import REDUCED_MAX, exp_neg, sincos, sqrt
+from .vector_math import REDUCED_MAX, erfc, exp_neg, exp_neg_square, hypot, sincos, sqrt
 
 NO_SHADOWING, SMITH = SHADOWING_KINDS["none"], SHADOWING_KINDS["smith"]
 
@@ -109,11 +109,12 @@ def csqrt(a, b):
     else:
         a_s, b_s = a / s, b / s
         r = s * sqrt(a_s * a_s + b_s * b_s)
-    if a >= T(0.0):
-        t = sqrt((a + r) * T(0.5))
-        return t, b / (T(2.0) * t)
-    t = sqrt((r - a) * T(0.5))
-    return abs(b) / (T(2.0) * t), math.copysign(t, b)
+    # the branch's operands selected before the root and the division, not its results: a
+    # vector loop computes both sides of a select (here one root and one division, not two)
+    right = a >= T(0.0)
+    t = sqrt((a + r if right else r - a) * T(0.5))
+    q = (b if right else abs(b)) / (T(2.0) * t)
+    return (t, q) if right else (q, math.copysign(t, b))
 
 
 @njit(error_model="numpy", forceinline=True)
@@ -122,12 +123,14 @@ def cdiv(a, b, c, d):
     reciprocal, ``scl = 1 / den``, and two products: bit for bit numpy's result, and one
     division fewer than dividing both parts by ``den``)."""
     T = type(a)
-    if abs(c) >= abs(d):
-        r = d / c
-        scl = T(1.0) / (c + d * r)
+    # the larger part of the denominator selected first (a vector loop computes both sides of
+    # a select: two divisions, not four); the same operations on the same values as the branches
+    big = abs(c) >= abs(d)
+    p, q = (c, d) if big else (d, c)
+    r = q / p
+    scl = T(1.0) / (p + q * r)
+    if big:
         return (a + b * r) * scl, (b - a * r) * scl
-    r = c / d
-    scl = T(1.0) / (d + c * r)
     return (a * r + b) * scl, (b * r - a) * scl
 
 
@@ -256,26 +259,27 @@ def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     return exp_neg(q / hz2) * inv_m2
 
 
-@njit(error_model="numpy")
+@njit(error_model="numpy", forceinline=True)
 def lam_unit(kind, mu):
-    """Smith ``Lambda`` of the unit-width Gaussian or GGX family at ``mu = |cot theta|``."""
+    """Smith ``Lambda`` of the unit-width Gaussian or GGX family at ``mu = |cot theta|``: infinite
+    at ``mu = 0``, zero at infinite ``mu``, without a branch or a call (the Gaussian's tail
+    divides by zero at ``mu = 0``), so that a loop over geometries stays on SIMD lanes."""
     T = type(mu)
     if kind == GAUSSIAN or kind == ANISO_GAUSSIAN:
-        if mu == T(0.0):
-            return T(math.inf)
-        tail = math.exp(-mu * mu) * T(_INV_SQRT_PI) / (T(2.0) * mu)
-        return tail - T(0.5) * math.erfc(mu)
-    if mu == T(0.0):
-        return T(math.inf)
+        tail = exp_neg_square(mu) * T(_INV_SQRT_PI) / (T(2.0) * mu)
+        return tail - T(0.5) * erfc(mu)
     x = T(1.0) / mu
     # as shadowing.lambda_ggx: x^2 would overflow at grazing (float32 already at x ~ 2e19)
-    return T(0.5) * x * (x / (T(1.0) + math.hypot(T(1.0), x)))
+    lam = T(0.5) * x * (x / (T(1.0) + T(hypot(T(1.0), x))))
+    return T(math.inf) if mu == T(0.0) else lam
 
 
-@njit(error_model="numpy")
+@njit(error_model="numpy", forceinline=True)
 def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
     """Smith ``Lambda`` (:func:`scatterbench.models.shadowing.smith_lambda`) of the Gaussian and GGX
-    families, isotropic or elliptical, for a direction (cosine, sine, azimuth)."""
+    families, isotropic or elliptical, for a direction (cosine, sine, azimuth).  The elliptical
+    kinds rotate through the C library's cosine and sine (the SIMD lanes take only the isotropic
+    ones: :mod:`~scatterbench.models.kernels.vector`)."""
     T = type(c)
     mu = abs(c) / s if s > T(0.0) else T(math.inf)
     if kind == GAUSSIAN or kind == GGX:
@@ -288,7 +292,7 @@ def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
     return lam_unit(kind, mu / alpha)
 
 
-@njit(error_model="numpy")
+@njit(error_model="numpy", forceinline=True)
 def smith_g(shadowing, kind, di, dio, sx, sy, rot):
     """Shadowing-masking ``G`` for directions ``di``, ``dio`` = ``(cos, sin, cos phi, sin phi)``
     (no back-facing test: both see the facet from its front)."""

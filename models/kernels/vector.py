@@ -19,9 +19,11 @@ block of :data:`VBLOCK` geometries:
 
 The kernels are the same functions as the scalar loop's, so both give the same bits
 (``tests/test_vector_kernels.py``).  :func:`vectorized` says which models and options take this
-path.  The others keep C library calls that leave any loop scalar (FacetBTDF, Smith
-shadowing, anisotropic slopes, unit slopes); :class:`scatterbench.models.kernels.Compiled` runs them through
-:mod:`~scatterbench.models.kernels.drive`.
+path.  The others keep C library calls that leave any loop scalar (FacetBTDF, anisotropic
+slopes, unit slopes, Cook-Torrance's Smith shadowing, which rotates by the strokes' azimuth);
+:class:`scatterbench.models.kernels.Compiled` runs them through :mod:`~scatterbench.models.kernels.drive`.
+The facet kernel's Smith shadowing of isotropic Gaussian and GGX slopes takes the lanes (its
+``erfc``, ``exp(-mu^2)`` and ``hypot`` are :mod:`~scatterbench.models.kernels.vector_math`'s).
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from numba import errors, njit, types
 from numba.core import config
 from numba.extending import overload
 
-from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME
+from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
 from .common import NO_SHADOWING, azimuths
 from .drive import COOK, DIFFUSE, FACET, KERNELS, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, column, named
 
@@ -45,13 +47,18 @@ _ROWS = _PRM + PARAM_ROWS
 #: through the C library's cosine; the unit one is left to the scalar loop: each kind costs
 #: about 2 s of compilation)
 FACET_KINDS = (EXPONENTIAL, GAUSSIAN, GGX)
+#: the facet kernel's shadowing on the lanes: Smith's separable and height-correlated ``G`` of the
+#: isotropic slope kinds whose ``Lambda`` is in closed form (the exponential's is numpy's table)
+SMITH_KINDS, SMITH_FORMS = (GAUSSIAN, GGX), (SHADOWING_KINDS["smith"], SHADOWING_KINDS["smith-correlated"])
 BLINN, NO_COOK_SHADOWING = COOK_SHADOWING["blinn"], COOK_SHADOWING["none"]
 
 
 def vectorized(code, iopt) -> bool:
     """Whether kernel ``code`` with options ``iopt`` takes the vector path (float64)."""
     if code == FACET:
-        return iopt[1] == NO_SHADOWING and iopt[0] in FACET_KINDS
+        return iopt[0] in FACET_KINDS and (
+            iopt[1] == NO_SHADOWING or (iopt[0] in SMITH_KINDS and iopt[1] in SMITH_FORMS)
+        )
     if code == COOK:
         return iopt[2] != COOK_SHADOWING["smith"]
     if code == MAXWELL:
@@ -130,7 +137,7 @@ def lane_options(code, iopt) -> tuple:
     o0, o1, o2 = (int(x) for x in iopt[:3])
     kind = o0 if o0 in (EXPONENTIAL, GAUSSIAN) else GGX
     if code == FACET:
-        return (kind, NO_SHADOWING, 0)
+        return (kind, o1, 0)
     if code == SINGLE:
         return (int(o0 != 0), 0, 0)
     if code == DIFFUSE:
@@ -213,10 +220,12 @@ _ENTRIES = {}
 
 
 def option_sets(code) -> list:
-    """Every option set :func:`lane_options` gives kernel ``code`` (16 in all): what
+    """Every option set :func:`lane_options` gives kernel ``code`` (20 in all): what
     :func:`scatterbench.models.kernels.warm` compiles."""
     if code == FACET:
-        return [(k, NO_SHADOWING, 0) for k in FACET_KINDS]
+        return [(k, NO_SHADOWING, 0) for k in FACET_KINDS] + [
+            (k, f, 0) for k in SMITH_KINDS for f in SMITH_FORMS
+        ]
     if code == SINGLE:
         return [(0, 0, 0), (1, 0, 0)]
     if code == DIFFUSE:
@@ -230,7 +239,7 @@ def option_sets(code) -> list:
 
 def lane_entries(code, iopt):
     """The vector loop of kernel ``code`` with options ``iopt`` (:func:`entry`): made on first
-    use, once per process (there are 16 variants; a run uses a few)."""
+    use, once per process (there are 20 variants; a run uses a few)."""
     return lanes_of(code, lane_options(code, iopt))
 
 
