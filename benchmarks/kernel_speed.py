@@ -45,6 +45,12 @@ except ImportError:  # benchmarks/kernel_ab.py runs this file in a checkout from
 AL = 1.37 + 7.62j
 MODELS = {
     "FacetBRDF": lambda: models.FacetBRDF(slopes=models.ExponentialSlopes(0.1), substrate=AL),
+    "FacetBRDF GGX smith": lambda: models.FacetBRDF(
+        slopes=models.GGXSlopes(0.2), substrate=AL, shadowing="smith"
+    ),
+    "FacetBRDF Gaussian smith": lambda: models.FacetBRDF(
+        slopes=models.GaussianSlopes(0.2), substrate=AL, shadowing="smith"
+    ),
     "SubsurfaceFacetBRDF": lambda: models.SubsurfaceFacetBRDF(),
     "FacetBTDF": lambda: models.FacetBTDF(slopes=models.GaussianSlopes(0.2), substrate=1.5),
     "SingleScatterBRDF": lambda: models.SingleScatterBRDF(phase=models.HenyeyGreenstein(0.3, True)),

@@ -14,7 +14,9 @@ Pairs (DESIGN.md's mapping):
   ``scalar_spectral_polarized`` against ``mueller``), and the LLVM JIT variants on
   arrays (``llvm_ad_rgb``, ``llvm_ad_mono_polarized``) on one thread, when Dr.Jit finds
   an LLVM it can use (``DRJIT_LIBLLVM_PATH``; set here to Debian's ``libLLVM-19.so``
-  when that exists and the variable is unset).
+  when that exists and the variable is unset).  Beside each, ours per geometry without the
+  Smith term (``shadowing="none"``): issue 30 asks float64 within 2x of Mitsuba's float32
+  per geometry with and without it; the last lines print both ratios.
 
 Every side runs on one thread: Dr.Jit is set to one (``dr.set_thread_count(1)``),
 scatterbench's compiled kernels (which run on threads over every core from 1024
@@ -97,6 +99,10 @@ class Row:
     max_rel_diff: float
     compared: str
     notes: list = field(default_factory=list)
+    #: Mitsuba's pairs: ours per geometry without the Smith term (``shadowing="none"``, the rest
+    #: the same), CPU and wall; Mitsuba's ``roughconductor`` always applies its ``G``
+    ours_unshadowed_geometry_us: float | None = None
+    ours_unshadowed_geometry_wall_us: float | None = None
 
 
 def geometries(n, seed=2024):
@@ -280,6 +286,7 @@ def mitsuba_rows(g, loop):
     except ImportError as exc:
         return [], [f"Mitsuba 3 not installed ({exc}): pip install mitsuba"]
     ours = models.FacetBRDF(slopes=models.GGXSlopes(alpha=0.2), substrate=AL, shadowing="smith")
+    bare = models.FacetBRDF(slopes=models.GGXSlopes(alpha=0.2), substrate=AL)
     rows, notes = [], []
     for variant in ("scalar_rgb", "scalar_spectral_polarized", "llvm_ad_rgb", "llvm_ad_mono_polarized"):
         polarized = variant.endswith("polarized")
@@ -301,13 +308,15 @@ def mitsuba_rows(g, loop):
         except Exception as exc:  # noqa: BLE001 - a JIT variant without a usable LLVM says why
             notes.append(f"Mitsuba {variant} skipped: {type(exc).__name__}: {exc}")
             continue
-        evaluate = ours.mueller if polarized else ours.brdf
-        mine, me = time_ours(evaluate, g, loop)
+        what = "mueller" if polarized else "brdf"
+        mine, me = time_ours(getattr(ours, what), g, loop)
+        _, unshadowed = time_ours(getattr(bare, what), g, loop)
         m00 = mine[:, 0, 0] if polarized else mine
         rows.append(
             Row("FacetBRDF(GGX 0.2, smith)", "Mitsuba 3", f"roughconductor ggx, {variant}", "float64", "float32",
                 *me, *peer, _rel_diff(m00, theirs, floor=1e-20), "BRDF (M00), relative; float32 on Mitsuba's side",
-                [] if variant.startswith("scalar") else [f"Dr.Jit on {THREADS} thread, from direction arrays"])
+                [] if variant.startswith("scalar") else [f"Dr.Jit on {THREADS} thread, from direction arrays"],
+                *unshadowed[2:])
         )  # fmt: skip
     return rows, notes
 
@@ -353,6 +362,13 @@ def print_table(rows):
     print(
         f"ratio = peer / scatterbench (> 1: scatterbench is faster); CPU time, best of batches, {THREADS} thread"
     )
+    for r in (r for r in rows if r.ours_unshadowed_geometry_us is not None and "llvm" in r.variant):
+        print(
+            f"{r.variant}: ours per geometry {r.ours_geometry_us:.4f} us with Smith's G, "
+            f"{r.ours_unshadowed_geometry_us:.4f} without; Mitsuba (always with its G) {r.peer_geometry_us:.4f}: "
+            f"ours / Mitsuba {r.ours_geometry_us / r.peer_geometry_us:.2f}x, "
+            f"{r.ours_unshadowed_geometry_us / r.peer_geometry_us:.2f}x"
+        )
 
 
 def main(argv=None):

@@ -126,8 +126,9 @@ def _run_sections(ctx, specs):
 #: sets, scalar)``, the option sets of the vector loops its models take (recorded from a ``report
 #: --quick`` by wrapping ``kernels.vector.lanes_of``: all 4 of Cook-Torrance's, 3 of
 #: Maxwell-Beard's 6; None: every one, or a module's entries), whether it calls the scalar loop
-#: (recorded by wrapping ``kernels.Compiled.scalar``: only for the options without lanes, Smith
-#: shadowing and other slopes of the facets and Cook-Torrance, and FacetBTDF), the Monte
+#: (recorded by wrapping ``kernels.Compiled.scalar``: only for the options without lanes, the
+#: facets' other slopes, Cook-Torrance's Smith shadowing, float32, and FacetBTDF; the facets'
+#: Smith lanes of Gaussian and GGX slopes a task of their own), the Monte
 #: Carlo, aperture and disc entries, the fused Mueller likelihood of the PTFE section and the
 #: small calls' angle check (the main process compiled those two, ~3 s, during the sections).  A loop missing here still compiles, on first use.  Largest
 #: first (``python benchmarks/scaling.py --threads 1 --studies --compile`` times each), so that
@@ -138,6 +139,7 @@ REPORT_KERNELS = (
     ("cook", "float64", _COOK[:2], True), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)], False),
     ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)], True), ("single", "float64", [(0, 0, 0), (1, 0, 0)], False),
     ("montecarlo", "float64", None, False), ("facet", "float32", None, True), ("cook", "float64", _COOK[2:], False),
+    ("facet", "float64", [(1, 1, 0), (2, 1, 0)], False),
     ("aperture", "float64", None, False), ("diffuse", "float64", [(0, 0, 0)], False), ("disc", "float64", None, False),
     ("btdf", "float64", [], True), ("likelihood", None, None, False), ("angles", "float64", None, False),
 )  # fmt: skip
