@@ -9,7 +9,10 @@
 range) by a Chebyshev series in 40-digit arithmetic (``mpmath.chebyfit``), prints the fit's
 largest error for 20 to 26 coefficients and the largest error of the kept polynomial evaluated
 by Horner's rule in float64 (in units of the float64 epsilon), then the kept coefficients,
-constant term first, as ``vector_math`` writes them.
+constant term first, as ``vector_math`` writes them.  Then, with scatterbench installed, the
+largest error of :func:`scatterbench.models.kernels.vector_math.erfc` itself in ulp of the exact
+value, on 2000 points of ``[-6, 27]`` and 500 from ``4e-18`` to 1 (seed 1), where ``erfc`` is
+above 1e-300.
 """
 
 import mpmath as mp
@@ -40,3 +43,26 @@ print(
     f"{KEPT} kept, Horner in float64: largest error {np.max(np.abs(horner - exact) / exact) / 2.0**-52:.2f} eps"
 )
 print(", ".join(repr(c) for c in reversed(coeffs)))
+
+try:
+    from numba import njit
+
+    from scatterbench.models.kernels.vector_math import erfc
+except ImportError as exc:
+    raise SystemExit(f"the kernel's error not measured: {exc}") from None
+
+
+@njit
+def _each(x):
+    out = np.empty_like(x)
+    for i in range(x.size):
+        out[i] = erfc(x[i])
+    return out
+
+
+rng = np.random.default_rng(1)
+x = np.concatenate([rng.uniform(-6.0, 27.0, 2000), np.exp(rng.uniform(-40.0, 0.0, 500))])
+exact = np.array([float(mp.erfc(mp.mpf(float(v)))) for v in x])
+live = exact > 1e-300
+ulps = np.abs(_each(x) - exact)[live] / np.spacing(exact[live])
+print(f"vector_math.erfc against the exact value: largest error {ulps.max():.0f} ulp ({live.sum()} points)")
