@@ -33,8 +33,10 @@ entry compiles on its first call.
 
 Only the loops that Python calls are cached: per kernel and precision the scalar
 ``run_range`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel and option set
-the vector ``run_range`` of :func:`~scatterbench.models.kernels.vector.lane_entries` (closures
-over the kernel's code, so that a run compiles only the kernels its models use), ``angles_ok``
+the vector ``run_range`` of :func:`~scatterbench.models.kernels.vector.lane_entries` (each with
+its kernel of its own, :func:`~scatterbench.models.kernels.drive.own_kernel`, so that a run
+compiles only the kernels its models use, and the loop written in the entry: each compiled
+level between an entry and its kernel cost another optimization of the inlined kernel), ``angles_ok``
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
 ``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.aperture`'s
 ``nodes`` and ``_tiles``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry

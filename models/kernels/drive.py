@@ -15,10 +15,10 @@ geometry: one compiled loop per kernel (:func:`entry`) takes a range of geometri
 from __future__ import annotations
 
 import math
+from types import FunctionType
 
 import numpy as np
-from numba import errors, njit, types
-from numba.extending import overload
+from numba import njit
 
 from ..kernel_specs import KERNEL_ROWS
 from .common import azimuth
@@ -92,41 +92,9 @@ def column(index, p, i):
 BLOCK = 1024
 
 
-@njit(error_model="numpy", forceinline=True)
-def _serial(kernel, ti, tr, pr, prm, index, o, out, start, lo, hi):
-    """:func:`entry`'s loop for one kernel (compiled once per kernel: a loop that
-    dispatches on the model per geometry holds every kernel's code and runs slower)."""
-    a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
-    for i in range(lo, hi):
-        g = geometry(ti[i * a], tr[i * b], pr[i * c])
-        store(out, start + i, kernel(g, params(prm, column(index, p, i)), o))
-
-
 #: the one-geometry functions by code
 KERNELS = (facet, btdf, single, diffuse, cook, maxwell)
 assert [KERNELS[c] for c in CODES.values()] == [facet, btdf, single, diffuse, cook, maxwell]
-
-
-def serial(code, ti, tr, pr, prm, index, o, out, start, lo, hi):
-    """:func:`_serial` for kernel ``code``; compiled code picks the kernel while typing
-    (:func:`_serial_of`), Python (``NUMBA_DISABLE_JIT=1``) here."""
-    _serial(KERNELS[code], ti, tr, pr, prm, index, o, out, start, lo, hi)
-
-
-@overload(serial, prefer_literal=True)
-def _serial_of(code, ti, tr, pr, prm, index, o, out, start, lo, hi):
-    """``serial`` with ``code`` a constant (an entry's closure cell, typed as a literal): the
-    loop over that one kernel, picked while typing, so that numba types and compiles it alone
-    (a branch on the code compiles every kernel; a tuple of them indexed in compiled code
-    becomes a tuple of function pointers, called without inlining)."""
-    if not isinstance(code, types.IntegerLiteral):
-        raise errors.RequireLiteralValue("serial's kernel code must be a constant")
-    kernel = KERNELS[code.literal_value]
-
-    def impl(code, ti, tr, pr, prm, index, o, out, start, lo, hi):
-        _serial(kernel, ti, tr, pr, prm, index, o, out, start, lo, hi)
-
-    return impl
 
 
 def named(code, tag=""):
@@ -143,6 +111,21 @@ def named(code, tag=""):
     return rename
 
 
+def own_kernel(fn, code, tag=""):
+    """``fn`` (a loop that calls the global ``_KERNEL``) compiled and cached as an entry of
+    kernel ``code`` (:func:`named` after it and ``tag``), with ``_KERNEL`` that kernel: a global
+    of ``fn``'s own (a copy of its module's globals).  numba calls a global dispatcher directly,
+    and LLVM inlines it into the loop; a dispatcher held in a closure cell is pickled into the
+    cache's key, differently in every process (no cache hit, ever), one passed as an argument is
+    a Python object, and one picked from a tuple in compiled code is called through a pointer.
+    The loop is written in the entry itself, not in a function it calls: numba optimizes and
+    emits every compiled function's code, its callees' linked in, so that each level between
+    the entry and the kernel cost a cold cache another pass over the inlined kernel (about 2 s a
+    Maxwell-Beard option set on SIMD lanes)."""
+    own = FunctionType(fn.__code__, dict(fn.__globals__, _KERNEL=KERNELS[code]), None, None, fn.__closure__)
+    return njit(cache=True, error_model="numpy", nogil=True)(named(code, tag)(own))
+
+
 def entry(code):
     """The one compiled entry of kernel ``code``'s scalar loop (built once, at import:
     :data:`ENTRIES`): ``run_range(ti, tr, pr, prm, index, iopt, out, start, lo, hi)``, geometries
@@ -152,20 +135,19 @@ def entry(code):
     (:func:`scatterbench.models.kernels.threads.spread`): one entry per kernel compiles the kernel once,
     where four (a serial, a ``prange``, a checked and a scalar one) each had LLVM optimize the
     inlined kernel again (10 s of a cold first call for Cook-Torrance, a third of it in the
-    three extra copies).
+    three extra copies).  It calls its kernel alone (:func:`own_kernel`): one entry over every
+    kernel compiled all six on a first call (23 s of CPU for one geometry of FacetBRDF on a
+    cold cache).  The loop compiles once per kernel: a loop that dispatches on the model per
+    geometry holds every kernel's code and runs slower."""
 
-    A closure over ``code``, an int: numba folds it as a constant, so the entry compiles only
-    its own kernel (one entry over every kernel compiled all six on a first call: 23 s of CPU
-    for one geometry of FacetBRDF on a cold cache), and its cache key (the closure's pickled
-    cells) is the same in every process."""
-
-    @njit(cache=True, error_model="numpy", nogil=True)
-    @named(code)
     def run_range(ti, tr, pr, prm, index, iopt, out, start, lo, hi):
-        """Geometries ``lo .. hi - 1`` of the inputs into ``out[:, start + i]``."""
-        serial(code, ti, tr, pr, prm, index, options(iopt), out, start, lo, hi)
+        o = options(iopt)
+        a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
+        for i in range(lo, hi):
+            g = geometry(ti[i * a], tr[i * b], pr[i * c])
+            store(out, start + i, _KERNEL(g, params(prm, column(index, p, i)), o))  # noqa: F821
 
-    return run_range
+    return own_kernel(run_range, code)
 
 
 @njit(cache=True, error_model="numpy")

@@ -10,7 +10,7 @@ block of :data:`VBLOCK` geometries:
    array and takes the azimuths' cosines and sines there with the polynomial
    :func:`~scatterbench.models.kernels.vector_math.sincos` (the C library beyond its range:
    :func:`~scatterbench.models.kernels.common.azimuths`);
-2. :func:`blocks` runs the kernel over the scratch: one loop per model and option set (:func:`lane_options`), with
+2. :func:`entry`'s loop runs the kernel over the scratch: one loop per model and option set (:func:`lane_options`), with
    the code and options constants, so that the branches left are selects; no call remains
    (the kernels use :mod:`~scatterbench.models.kernels.vector_math`, and ``error_model="numpy"`` lets a
    division by zero give inf, as numpy's, instead of raising); all reads and writes are in
@@ -29,13 +29,12 @@ The facet kernel's Smith shadowing of isotropic Gaussian and GGX slopes takes th
 from __future__ import annotations
 
 import numpy as np
-from numba import errors, njit, types
+from numba import njit
 from numba.core import config
-from numba.extending import overload
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
 from .common import NO_SHADOWING, azimuths
-from .drive import COOK, DIFFUSE, FACET, KERNELS, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, column, named
+from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, column, own_kernel
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (55 kB), stays
 #: in the L2 cache
@@ -102,15 +101,6 @@ def _store(sc, k, m):
     sc[o + 12 * B], sc[o + 13 * B], sc[o + 14 * B], sc[o + 15 * B] = m[12], m[13], m[14], m[15]
 
 
-@njit(error_model="numpy", forceinline=True)
-def _loop(kernel, sc, m, o):
-    """The loop over a block for one kernel: compiled once per kernel, inlined by LLVM into
-    :func:`blocks`, where the options are constants and fold (numba's own inlining would
-    type the kernel once per call: minutes of compilation)."""
-    for k in range(m):
-        _store(sc, k, kernel(_geometry(sc, k), _scratch_params(sc, k), o))
-
-
 @njit(error_model="numpy")
 def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch: angles, the azimuth's
@@ -147,70 +137,46 @@ def lane_options(code, iopt) -> tuple:
     return (kind, NO_SHADOWING, o2)  # MAXWELL
 
 
-def blocks(code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, hi):
-    """Geometries ``lo .. hi - 1`` into ``out[:, start + i]``, a block at a time, through
-    kernel ``code`` with options ``(k0, k1, k2)`` (:func:`lane_options`), all constants (those
-    :data:`RUNTIME` read from ``iopt``); compiled code builds the loop while typing
-    (:func:`_blocks_of`), Python (``NUMBA_DISABLE_JIT=1``) runs the same here."""
-    _blocks_of(types.literal(code), types.literal(k0), types.literal(k1), types.literal(k2), *[None] * 10)(
-        code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, hi
-    )
+def entry(code, opts):
+    """The one compiled entry of kernel ``code``'s loop on SIMD lanes with options ``opts``
+    (:func:`lane_options`), a closure over those ints: ``run_range(ti, tr, pr, prm, index, iopt,
+    out, start, lo, hi)``, the arguments of the scalar loop's
+    (:func:`scatterbench.models.kernels.drive.entry`; ``iopt`` read only for the options
+    :data:`RUNTIME`), without the GIL: geometries ``lo .. hi - 1`` into ``out[:, start + i]``, a
+    block at a time.  Serial, parallel and checked calls are this loop called from Python
+    (:func:`scatterbench.models.kernels.threads.spread`): a compiled caller links the loop's code
+    into its own and LLVM optimizes it again (a ``prange`` entry and a checked one took 7.8 s
+    and 3.0 s per option set beside the loop's own 6.2 s, Cook-Torrance on a cold cache).
 
-
-@overload(blocks, prefer_literal=True)
-def _blocks_of(code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, hi):
-    if not all(isinstance(x, types.IntegerLiteral) for x in (code, k0, k1, k2)):
-        raise errors.RequireLiteralValue("blocks' kernel code and options must be constants")
-    kernel = KERNELS[code.literal_value]
-    o0, o1, o2 = k0.literal_value, k1.literal_value, k2.literal_value
-
-    # the loop written here, with the kernel and its options constants of it (a dispatcher
-    # passed as an argument to a compiled function is a Python object: no caching).  The
-    # options reach _loop typed int64, not as literals: numba then types _loop and the kernel
-    # once per kernel, not once per option set (17 sets in a report: 35 s of a cold run),
-    # and LLVM, inlining _loop here, still folds them as constants
-    r0, r1, r2 = o0 == RUNTIME, o1 == RUNTIME, o2 == RUNTIME
+    The kernel is the loop's own (:func:`~scatterbench.models.kernels.drive.own_kernel`), and so
+    are the options, closure cells (ints: numba folds them, and they key the cache), those
+    :data:`RUNTIME` read from ``iopt``; they reach the kernel typed int64, not as literals, so
+    that numba types the kernel once per kernel, not once per option set (17 sets in a report:
+    35 s of a cold run), and LLVM, inlining it, still folds them."""
+    k0, k1, k2 = opts
+    r0, r1, r2 = (k == RUNTIME for k in opts)
     # the diffuse kernel reads no azimuth: its blocks skip the cosines and sines (a tenth of its time)
-    turns = code.literal_value != DIFFUSE
-    rows = len(ROWS[NAMES[code.literal_value]])
+    turns = code != DIFFUSE
+    rows = len(ROWS[NAMES[code]])
 
-    def impl(code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, hi):
+    def run_range(ti, tr, pr, prm, index, iopt, out, start, lo, hi):
         o = (
-            iopt[0] if r0 else np.int64(o0),
-            iopt[1] if r1 else np.int64(o1),
-            iopt[2] if r2 else np.int64(o2),
+            iopt[0] if r0 else np.int64(k0),
+            iopt[1] if r1 else np.int64(k1),
+            iopt[2] if r2 else np.int64(k2),
         )
         sc = np.empty(_ROWS * VBLOCK)
         sc[(_PRM + rows) * VBLOCK :] = 0.0  # the parameter rows the kernel does not read: never gathered
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
             gather(sc, ti, tr, pr, prm, index, blo, m, turns, rows)
-            _loop(kernel, sc, m, o)
+            for k in range(m):
+                _store(sc, k, _KERNEL(_geometry(sc, k), _scratch_params(sc, k), o))  # noqa: F821
             for r in range(out.shape[0]):
                 for k in range(m):
                     out[r, start + blo + k] = sc[(_OUT + r) * VBLOCK + k]
 
-    return impl
-
-
-def entry(code, opts):
-    """The one compiled entry of kernel ``code``'s loop on SIMD lanes with options ``opts``
-    (:func:`lane_options`), a closure over those ints: ``run_range(ti, tr, pr, prm, index, iopt,
-    out, start, lo, hi)``, the arguments of the scalar loop's
-    (:func:`scatterbench.models.kernels.drive.entry`; ``iopt`` read only for the options
-    :data:`RUNTIME`), without the GIL.  Serial, parallel and checked calls are this loop called from
-    Python (:func:`scatterbench.models.kernels.threads.spread`): a compiled caller links the loop's code
-    into its own and LLVM optimizes it again (a ``prange`` entry and a checked one took 7.8 s
-    and 3.0 s per option set beside the loop's own 6.2 s, Cook-Torrance on a cold cache)."""
-    k0, k1, k2 = opts
-
-    @njit(cache=True, error_model="numpy", nogil=True)
-    @named(code, "_".join("r" if k == RUNTIME else str(k) for k in opts))
-    def run_range(ti, tr, pr, prm, index, iopt, out, start, lo, hi):
-        """Geometries ``lo .. hi - 1`` into ``out[:, start + i]`` (:func:`blocks`)."""
-        blocks(code, k0, k1, k2, ti, tr, pr, prm, index, iopt, out, start, lo, hi)
-
-    return run_range
+    return own_kernel(run_range, code, "_".join("r" if k == RUNTIME else str(k) for k in opts))
 
 
 #: numba's cache directory when this module was imported (:mod:`scatterbench.models.kernels`
