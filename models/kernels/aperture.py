@@ -61,7 +61,7 @@ def nodes(ti, tr, pr, a, b, cos_u, w, out):
         _node(ti, pr, frame, a[k], b[k], cos_u[k], w[k], out, k * n)
 
 
-@njit(error_model="numpy", forceinline=True)
+@njit(error_model="numpy", inline="always")
 def _node(ti, pr, frame, a, b, cos_u, w, out, o):
     """One node of every geometry into ``out[:, o:o + n]`` (a loop on SIMD lanes)."""
     for g in range(pr.shape[0]):
@@ -97,7 +97,7 @@ def _tiles(m, nodes_out, n, out, start, t0, t1):
         _tile(m, nodes_out, n, out, start, g0, min(TILE, n - g0))
 
 
-@njit(error_model="numpy", forceinline=True)
+@njit(error_model="numpy", inline="always")
 def _tile(m, nodes_out, n, out, start, g0, size):
     """:func:`rotate_sum` for geometries ``g0 .. g0 + size - 1``."""
     acc = np.zeros((17, TILE))  # the 16 rows and the weights' sum

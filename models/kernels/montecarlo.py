@@ -134,7 +134,7 @@ def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
             x[e] += m[e]
 
 
-@njit
+@njit(inline="always")
 def _walk(geo, z, m, prm, inv_scale, x, mean, m2, peak):
     """Welford's running mean and sum of squared deviations (``mean``, ``m2``) of the live
     pairs' estimates times ``inv_scale``, and their largest magnitudes (``peak``); returns
@@ -166,7 +166,7 @@ def _walk(geo, z, m, prm, inv_scale, x, mean, m2, peak):
     return live
 
 
-@njit
+@njit(inline="always")
 def _geometry(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, col):
     """Mean and standard error of one geometry into ``mean[:, col]``, ``err[:, col]``."""
     mean[:, col] = 0.0
