@@ -17,10 +17,11 @@ count, and the first ``report --quick`` cold and warm.
 * **First run** (``--first-run``): ``scatterbench report --quick`` with an empty numba cache
   (``NUMBA_CACHE_DIR`` a fresh folder: every kernel compiles) and then again with that cache
   (warm), with the default ``--workers``.
-* **Compilation** (``--compile``): each compile-ahead task of a report
-  (``validation.report.build.REPORT_KERNELS``: a kernel's loops, or the Monte Carlo, aperture or
-  disc entries) in turn, in one fresh process with an empty numba cache: wall and CPU seconds
-  per task and their sum (what the report's worker processes share on a first run).
+* **Compilation** (``--compile``): each compile-ahead group of a report
+  (``validation.report.build.COMPILE_GROUPS``: a kernel's loops, or the Monte Carlo, aperture or
+  disc entries, grouped by the helpers they share) in a fresh process, as a report's worker
+  takes it, its tasks in turn, with one empty numba cache: wall and CPU seconds per task, per
+  group, and their sum (what the report's worker processes share on a first run).
 
 The machine's load average is printed before and after each part: figures from a shared
 machine are noisy.
@@ -120,10 +121,10 @@ def first_run():
 
 
 _COMPILE = """
-import time
-from scatterbench.validation.report.build import REPORT_KERNELS, warm_task
+import sys, time
+from scatterbench.validation.report.build import COMPILE_GROUPS, warm_task
 total = 0.0
-for task in REPORT_KERNELS:
+for task in COMPILE_GROUPS[int(sys.argv[1])]:
     t, c = time.perf_counter(), time.process_time()
     warm_task(task)
     cpu = time.process_time() - c
@@ -131,16 +132,28 @@ for task in REPORT_KERNELS:
     sets = "all" if task[2] is None else len(task[2])
     loops = f"option sets {sets!s:>3}" + (" + scalar" if task[3] else "         ")
     print(f"  {task[0]:<10} {task[1] or '':<8} {loops}  {time.perf_counter() - t:6.1f} s  cpu {cpu:6.1f} s")
-print(f"  all tasks: cpu {total:.1f} s")
+print(f"  group {sys.argv[1]}: cpu {total:.1f} s")
 """
 
 
 def compile_tasks():
-    """The report's compile-ahead tasks one after another in a fresh process, empty cache."""
-    print(f"\ncompilation: the report's compile-ahead tasks, one process, empty numba cache; {_load()}")
+    """The report's compile-ahead groups, each in a fresh process as the report's workers take
+    them (its tasks one after another), all with one empty cache."""
+    print(
+        f"\ncompilation: the report's compile-ahead groups, a fresh process each, empty numba cache; {_load()}"
+    )
+    from scatterbench.validation.report.build import COMPILE_GROUPS
+
+    total = 0.0
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        subprocess.run([sys.executable, "-c", _COMPILE], env=env, check=True)
+        for g in range(len(COMPILE_GROUPS)):
+            r = subprocess.run(
+                [sys.executable, "-c", _COMPILE, str(g)], env=env, check=True, capture_output=True, text=True
+            )
+            print(r.stdout, end="")
+            total += float(r.stdout.rsplit("cpu", 1)[1].split()[0])
+    print(f"  all groups: cpu {total:.1f} s (half of it on each of two cores at best)")
 
 
 def _powers(top):

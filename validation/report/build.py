@@ -127,24 +127,32 @@ def _run_sections(ctx, specs):
 #: --quick`` by wrapping ``kernels.vector.lanes_of``: all 4 of Cook-Torrance's, 3 of
 #: Maxwell-Beard's 6; None: every one, or a module's entries), whether it calls the scalar loop
 #: (recorded by wrapping ``kernels.Compiled.scalar``: only for the options without lanes, the
-#: facets' other slopes, Cook-Torrance's Smith shadowing, float32, and FacetBTDF; the facets'
-#: Smith lanes of Gaussian and GGX slopes a task of their own), the Monte
+#: facets' other slopes, Cook-Torrance's Smith shadowing, float32, and FacetBTDF), the Monte
 #: Carlo, aperture and disc entries, the fused Mueller likelihood of the PTFE section and the
-#: small calls' angle check (the main process compiled those two, ~3 s, during the sections).  A loop missing here still compiles, on first use.  Largest
-#: first (``python benchmarks/scaling.py --threads 1 --studies --compile`` times each: 14.5, 13.3,
-#: 10.9, 6.2, 5.3, 5.0, 4.9, 4.9, 4.4, 3.3, 2.0, 1.8, 1.2, 0.3 s at 4f12edf), so that
-#: the processes of a 2-core machine finish together; Cook-Torrance's loops in two tasks, the
-#: scalar one in one of them
+#: small calls' angle check (the main process compiled those two, ~3 s, during the sections).
+#: A loop missing here still compiles, on first use.
+#:
+#: Grouped by process: a process compiles the helpers its loops inline (the kernel's function
+#: and everything it calls: numba does not cache them, :mod:`scatterbench.models.kernels`) once
+#: for all its loops, so that the loops of one kernel, and the kernels that share helpers
+#: (Maxwell-Beard's and FacetBTDF's facets are the facet kernel's), go to one process.  Each
+#: alone, one fresh process each (``python benchmarks/scaling.py --threads 1 --studies
+#: --compile``): Cook-Torrance's loops in two processes took 10.6 + 10.1 s of CPU and 13.3 s in
+#: one, the facet's 11.1 + 9.3 s and 15.0 s, Maxwell-Beard's 13.3 s alone and 9.6 s after the
+#: facet's (ad hoc, 2026-11-30, at 8806382).  Largest first, so that the processes of a 2-core
+#: machine finish together.
 _COOK = [(a, RUNTIME, c) for a in (0, 1) for c in (0, 1)]
-REPORT_KERNELS = (
-    ("cook", "float64", _COOK[:2], True), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)], False),
-    ("facet", "float64", [(0, 0, 0), (1, 0, 0), (2, 0, 0)], True), ("facet", "float32", None, True),
-    ("aperture", "float64", None, False), ("montecarlo", "float64", None, False),
-    ("single", "float64", [(0, 0, 0), (1, 0, 0)], False), ("facet", "float64", [(1, 1, 0), (2, 1, 0)], False),
-    ("cook", "float64", _COOK[2:], False), ("diffuse", "float64", [(0, 0, 0)], False),
-    ("btdf", "float64", [], True), ("likelihood", None, None, False), ("disc", "float64", None, False),
-    ("angles", "float64", None, False),
+_FACET = [(0, 0, 0), (1, 0, 0), (2, 0, 0), (1, 1, 0), (2, 1, 0)]  # three slopes; Smith's lanes of two
+COMPILE_GROUPS = (
+    (("cook", "float64", _COOK, True), ("montecarlo", "float64", None, False),
+     ("single", "float64", [(0, 0, 0), (1, 0, 0)], False), ("diffuse", "float64", [(0, 0, 0)], False)),
+    (("facet", "float64", _FACET, True), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)], False),
+     ("btdf", "float64", [], True)),
+    (("facet", "float32", None, True),), (("aperture", "float64", None, False),),
+    (("likelihood", None, None, False),), (("disc", "float64", None, False),),
+    (("angles", "float64", None, False),),
 )  # fmt: skip
+REPORT_KERNELS = tuple(task for group in COMPILE_GROUPS for task in group)
 
 
 def warm_task(task):
@@ -171,19 +179,26 @@ def cold_task(task) -> bool:
     return kernels.cold(*task)
 
 
+def warm_group(group):
+    """Compile (or load) the tasks of ``group`` (one of :data:`COMPILE_GROUPS`) in turn, in this
+    process; returns their kernels' names."""
+    return [warm_task(task) for task in group]
+
+
 def compile_ahead(executor):
     """Compile the loops a report runs that numba's cache lacks on ``executor``'s local
-    worker processes, a different task on each at once (:func:`scatterbench.models.kernels.warm`),
-    before the sections need them: otherwise every process compiled each loop it reached,
-    the workers the same ones at the same time.  Nothing for one process or a Dask cluster."""
+    worker processes, a different group of them (:data:`COMPILE_GROUPS`) on each at once, before
+    the sections need them: otherwise every process compiled each loop it reached, the workers
+    the same ones at the same time.  Nothing for one process or a Dask cluster."""
     if getattr(executor, "kind", None) != "processes":
         return
     from scatterbench.models import kernels
 
-    todo = [task for task in REPORT_KERNELS if cold_task(task)]
+    todo = [group for group in COMPILE_GROUPS if any(cold_task(task) for task in group)]
     if todo:
-        kernels.announce(list(dict.fromkeys(task[0] for task in todo)), f"on {executor.workers} processes")
-        executor.map(warm_task, todo, tasks=len(todo))
+        names = [task[0] for group in todo for task in group]
+        kernels.announce(list(dict.fromkeys(names)), f"on {executor.workers} processes")
+        executor.map(warm_group, todo, tasks=len(todo))
 
 
 def build_report(
