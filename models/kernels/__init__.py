@@ -27,9 +27,9 @@ to an installed, read-only package.  ``<hash>`` covers every kernel source file,
 edit to a shared helper recompiles the kernels that inline it (numba alone only notices
 changes to the file of the function itself).
 
-A first ``scatterbench report`` on worker processes compiles the kernels ahead, a kernel per
-process at once (:func:`warm`, ``validation.report.build.compile_ahead``); elsewhere each
-entry compiles on its first call.
+A first ``scatterbench report`` on worker processes compiles the kernels ahead, a group of
+kernels that share helpers per process at once (:func:`warm`,
+``validation.report.build.compile_ahead``); elsewhere each entry compiles on its first call.
 
 Only the loops that Python calls are cached: per kernel and precision the scalar
 ``run_range`` of :data:`~scatterbench.models.kernels.drive.ENTRIES`, and per kernel and option set
@@ -58,7 +58,7 @@ helpers that take an array keep numba's inlining (:mod:`~scatterbench.models.ker
 scratch accessors, :func:`~scatterbench.models.kernels.drive.column`): a call that passes an
 array counts references; and so do the loops called at one place only, between an entry and
 its helpers (:mod:`~scatterbench.models.kernels.aperture`'s node and tile loops,
-:mod:`~scatterbench.models.kernels.montecarlo`'s geometry and walk): numba compiles a function
+:mod:`~scatterbench.models.kernels.montecarlo`'s geometry and entry loops): numba compiles a function
 that is not inlined into a module of its own, optimizes it and emits its machine code, then
 optimizes it again in each caller, while one typed once at its one call site costs nothing
 more (the aperture's entries 4.0-4.35 s of CPU instead of 4.9-6.7 s, a fresh cache, ad hoc,
@@ -282,8 +282,9 @@ def warm(kernel, precision="float64", option_sets=None, scalar=True):
     ``precision`` (the vector ones of ``option_sets`` only, when given; the scalar one unless
     ``scalar`` is false), for the argument types
     it passes, without running them: a first run compiles the kernels on its worker processes
-    at once, each a different kernel, before it needs them (``scatterbench report``).  One
-    process per kernel: its loops share the kernel's typing.  Returns ``kernel``."""
+    at once, each a different group of kernels, before it needs them (``scatterbench
+    report``).  One process per kernel: its loops share the kernel's helpers, which each process
+    compiles for itself.  Returns ``kernel``."""
     for fn, sig in _warm_entries(kernel, precision, option_sets, scalar):
         if hasattr(fn, "compile"):  # not a Python function (NUMBA_DISABLE_JIT=1)
             fn.compile(sig)

@@ -163,7 +163,7 @@ def _entries(ti, n_i, z, m, n, ent):
         ent[14, j] = f_in
 
 
-@njit(inline="always")
+@njit
 def _walk(geo, ent, z, m, prm, inv_scale, x, mean, m2, peak):
     """Welford's running mean and sum of squared deviations (``mean``, ``m2``) of the live
     pairs' estimates times ``inv_scale``, and their largest magnitudes (``peak``); returns
