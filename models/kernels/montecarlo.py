@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from .common import hg_density, mueller16
-from .facet import btdf_jones, cross3, dot3
+from .facet import btdf_jones, cross3, dot3, transmission_factors
 from .threads import spread
 
 __all__ = ["estimate", "exit_transmittance"]
@@ -72,20 +72,28 @@ def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     return w, k1, e1, (ss, ps, sp, pp), n * c_out / (c_in if c_in > 0.0 else 1.0)
 
 
-@njit(forceinline=True)
-def _exit(k_r, e_r, cr, srcp, srsp, n_r, zx, zy, m, n):
-    """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
-    ``(weight, k2, basis of k2, Jones, flux factor)``, weight 0 where no such ray exists."""
-    w = max(cr + srcp * zx + srsp * zy, 0.0) / n_r
+@njit(error_model="numpy", forceinline=True)
+def _leaving(k_r, n_r, zx, zy, m, n):
+    """The internal ray ``k2`` that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
+    ``(weight, cos(k_r, m), k2, whether it exists)``."""
+    w = max(k_r[2] + k_r[0] * zx + k_r[1] * zy, 0.0) / n_r
     eta = 1.0 / n
     c = dot3(k_r, m)
     ct = math.sqrt(max(1.0 - eta * eta * (1.0 - c * c), 0.0))
     f = eta * c - ct
     k2 = (eta * k_r[0] - f * m[0], eta * k_r[1] - f * m[1], eta * k_r[2] - f * m[2])
-    if not (w > 0.0 and c > 0.0 and k2[2] > 0.0):
+    return w, c, k2, w > 0.0 and c > 0.0 and k2[2] > 0.0
+
+
+@njit(forceinline=True)
+def _exit(k_r, e_r, n_r, zx, zy, m, n):
+    """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
+    ``(weight, k2, basis of k2, Jones, flux factor)``, weight 0 where no such ray exists."""
+    w, _, k2, live = _leaving(k_r, n_r, zx, zy, m, n)
+    if not live:
         return 0.0, k2, _NO_BASIS, (0.0, 0.0, 0.0, 0.0), 0.0
     e2 = _ray_basis(k2)
-    ss, ps, sp, pp, c_in, c_out = btdf_jones(k2, k_r, (-m[0], -m[1], -m[2]), eta, e2, e_r)
+    ss, ps, sp, pp, c_in, c_out = btdf_jones(k2, k_r, (-m[0], -m[1], -m[2]), 1.0 / n, e2, e_r)
     return w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
 
 
@@ -168,7 +176,7 @@ def _walk(geo, ent, z, m, prm, inv_scale, x, mean, m2, peak):
     """Welford's running mean and sum of squared deviations (``mean``, ``m2``) of the live
     pairs' estimates times ``inv_scale``, and their largest magnitudes (``peak``); returns
     the number of live pairs.  The entry facets are the table ``ent`` (:func:`_entries`)."""
-    k_r, e_r, cr, srcp, srsp, n_r = geo
+    k_r, e_r, n_r = geo
     n = prm[0]
     live = 0
     mean[:] = 0.0
@@ -179,7 +187,7 @@ def _walk(geo, ent, z, m, prm, inv_scale, x, mean, m2, peak):
         if w1 == 0.0:
             continue
         mj = (m[3, j], m[4, j], m[5, j])
-        w2, k2, e2, jo, f_out = _exit(k_r, e_r, cr, srcp, srsp, n_r, z[2, j], z[3, j], mj, n)
+        w2, k2, e2, jo, f_out = _exit(k_r, e_r, n_r, z[2, j], z[3, j], mj, n)
         if w2 == 0.0:
             continue
         k1 = (ent[1, j], ent[2, j], ent[3, j])
@@ -205,7 +213,7 @@ def _geometry(tr, pr, n_r, ent, z, m, prm, safe, mean, err, col):
     cr, sr, cp, sp = math.cos(tr), math.sin(tr), math.cos(pr), math.sin(pr)
     k_r = (sr * cp, sr * sp, cr)
     s_r = (-sp, cp, 0.0)
-    geo = (k_r, (s_r, cross3(k_r, s_r)), cr, sr * cp, sr * sp, n_r)
+    geo = (k_r, (s_r, cross3(k_r, s_r)), n_r)
     x, mu, m2, peak, scale = np.empty(16), np.empty(16), np.empty(16), np.empty(16), np.ones(16)
     live = _walk(geo, ent, z, m, prm, scale, x, mu, m2, peak)
     if peak.max() >= safe:
@@ -293,30 +301,20 @@ EXIT_GRAIN = 32
 
 
 @njit(error_model="numpy", forceinline=True)
-def _exit_t00(cr, ax, ay, inv_nr, zx, zy, mx, my, mz, eta, n):
+def _exit_t00(k_r, n_r, zx, zy, m, n):
     """``w_r M_out[0, 0]`` of one exit facet (slopes ``zx, zy``, unit normal ``m``) for the
-    direction ``k_r = (ax, ay, cr)``, without a branch (selects: the direction loop around it
+    direction ``k_r``, without a branch the compiler keeps (the direction loop around it
     vectorizes).  ``M_out[0, 0]`` is half the squared Frobenius norm of the facet's Jones
-    matrix, which no orthonormal choice of the rays' bases changes: ``(t_s^2 + t_p^2) / 2`` with
-    :func:`~scatterbench.models.kernels.facet.btdf_jones`'s ``t_s`` and ``t_p = t_s + delta
-    sin^2`` (its dyadic maps the p vector of the entering ray to that of the leaving one, scaled
-    by ``t_p``, and s to s by ``t_s``), so neither basis is built."""
-    w = max(cr + ax * zx + ay * zy, 0.0) * inv_nr
-    c = ax * mx + ay * my + cr * mz
-    ct = math.sqrt(max(1.0 - eta * eta * (1.0 - c * c), 0.0))
-    f = eta * c - ct
-    k2x, k2y, k2z = eta * ax - f * mx, eta * ay - f * my, eta * cr - f * mz
-    c_in = min(max(k2x * mx + k2y * my + k2z * mz, 0.0), 1.0)
-    arg = eta * eta - 1.0 + c_in * c_in
-    root = math.sqrt(max(arg, 0.0))
-    inv_s = 1.0 / (c_in + root)
-    inv_p = 1.0 / (eta * eta * c_in + root)
-    ts = 2.0 * c_in * inv_s
-    delta = 2.0 * c_in * ((eta - 1.0) * inv_s) * ((eta * eta - 1.0) * inv_p) * (1.0 / (root + eta * c_in))
+    matrix (:func:`_exit`), which no orthonormal choice of the rays' bases changes:
+    ``(t_s^2 + t_p^2) / 2`` with :func:`~scatterbench.models.kernels.facet.btdf_jones`'s
+    ``t_s`` and ``t_p = t_s + delta sin^2`` (its dyadic maps the p vector of the entering ray to
+    that of the leaving one, scaled by ``t_p``, and s to s by ``t_s``), so neither basis is
+    built.  Zero beyond the critical angle, as there ``t_s = delta = 0``."""
+    w, c, k2, live = _leaving(k_r, n_r, zx, zy, m, n)
+    c_in = min(max(dot3(k2, m), 0.0), 1.0)
+    ts, delta = transmission_factors(c_in, 1.0 / n)
     tp = ts + delta * (1.0 - c_in * c_in)
-    c_out = min(max(c, 0.0), 1.0)
-    flux = c_out / (n * (c_in if c_in > 0.0 else 1.0))
-    live = w > 0.0 and c > 0.0 and k2z > 0.0 and arg > 0.0 and c_in + root > 0.0
+    flux = min(max(c, 0.0), 1.0) / (n * (c_in if c_in > 0.0 else 1.0))
     return 0.5 * (ts * ts + tp * tp) * flux * w if live else 0.0
 
 
@@ -326,15 +324,14 @@ def _exit_range(tr, pr, n_r, z, m, n, out, lo, hi):
     outer, the directions inner (a loop of selects over contiguous arrays that the compiler
     vectorizes), each direction's sum taken in the facets' order."""
     g = hi - lo
-    cr, ax, ay, inv_nr, acc = np.empty(g), np.empty(g), np.empty(g), np.empty(g), np.zeros(g)
+    cr, ax, ay, acc = np.empty(g), np.empty(g), np.empty(g), np.zeros(g)
     for i in range(g):
         s = math.sin(tr[lo + i])
         cr[i], ax[i], ay[i] = math.cos(tr[lo + i]), s * math.cos(pr[lo + i]), s * math.sin(pr[lo + i])
-        inv_nr[i] = 1.0 / n_r[lo + i]
-    eta = 1.0 / n
+    nr = n_r[lo:hi]
     for j in range(z.shape[1]):
-        zx, zy, mx, my, mz = z[2, j], z[3, j], m[3, j], m[4, j], m[5, j]
+        zx, zy, mj = z[2, j], z[3, j], (m[3, j], m[4, j], m[5, j])
         for i in range(g):
-            acc[i] += _exit_t00(cr[i], ax[i], ay[i], inv_nr[i], zx, zy, mx, my, mz, eta, n)
+            acc[i] += _exit_t00((ax[i], ay[i], cr[i]), nr[i], zx, zy, mj, n)
     for i in range(g):
         out[lo + i] = acc[i] / z.shape[1]
