@@ -136,11 +136,11 @@ def _run_sections(ctx, specs):
 #: and everything it calls: numba does not cache them, :mod:`scatterbench.models.kernels`) once
 #: for all its loops, so that the loops of one kernel, and the kernels that share helpers
 #: (Maxwell-Beard's and FacetBTDF's facets are the facet kernel's), go to one process.  Each
-#: alone, one fresh process each (``python benchmarks/scaling.py --threads 1 --studies
-#: --compile``): Cook-Torrance's loops in two processes took 10.6 + 10.1 s of CPU and 13.3 s in
-#: one, the facet's 11.1 + 9.3 s and 15.0 s, Maxwell-Beard's 13.3 s alone and 9.6 s after the
-#: facet's (ad hoc, 2026-11-30, at 8806382).  Largest first, so that the processes of a 2-core
-#: machine finish together.
+#: in a fresh process with an empty cache (an ad hoc script calling :func:`warm_task`,
+#: 2026-11-30, at 8806382): Cook-Torrance's loops as two tasks took 10.6 + 10.1 s of CPU and as
+#: one 13.3 s, the facet's 11.1 + 9.3 s and 15.0 s, Maxwell-Beard's 13.3 s alone and 9.6 s after
+#: the facet's.  Largest first (``python benchmarks/scaling.py --threads 1 --studies --compile``
+#: times each group), so that the processes of a 2-core machine finish together.
 _COOK = [(a, RUNTIME, c) for a in (0, 1) for c in (0, 1)]
 _FACET = [(0, 0, 0), (1, 0, 0), (2, 0, 0), (1, 1, 0), (2, 1, 0)]  # three slopes; Smith's lanes of two
 COMPILE_GROUPS = (
@@ -152,11 +152,10 @@ COMPILE_GROUPS = (
     (("likelihood", None, None, False),), (("disc", "float64", None, False),),
     (("angles", "float64", None, False),),
 )  # fmt: skip
-REPORT_KERNELS = tuple(task for group in COMPILE_GROUPS for task in group)
 
 
 def warm_task(task):
-    """Compile (or load) what compile-ahead task ``task`` of :data:`REPORT_KERNELS` names: a
+    """Compile (or load) what compile-ahead task ``task`` (of a group of :data:`COMPILE_GROUPS`) names: a
     kernel's loops (:func:`scatterbench.models.kernels.warm`) or the fused Mueller likelihood
     (``"likelihood"``: :func:`scatterbench.validation.fitting.mueller_kernel.warm`)."""
     if task[0] == "likelihood":  # validation's, not a model kernel
