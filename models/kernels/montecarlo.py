@@ -2,13 +2,19 @@
 
 The numpy implementation (:meth:`scatterbench.models.RoughDiffuseBRDF._block`) evaluates every
 (geometry, facet pair) entry of a block as arrays and reduces them with ``mean`` and
-``std``; here one loop per geometry walks the same facet pairs (the model's, drawn once
-from its seed: the random numbers are identical) and accumulates the mean and the spread
-as it goes (Welford's update), with no temporaries.  Pairs that cannot connect the two
-directions contribute exact zeros in both implementations, so they are counted, not
-evaluated.  Where a geometry's estimates are so large that squares would overflow
-(``|x| >= safe``), the geometry is walked again with each element scaled by its largest
-magnitude, as the numpy path rescales its block.
+``std``; here each geometry walks the same facet pairs (the model's, drawn once from its
+seed: the random numbers are identical) and accumulates the mean and the spread as it goes
+(Welford's update), with no temporaries.  Pairs that cannot connect the two directions
+contribute exact zeros in both implementations, so they are counted, not evaluated.  Where a
+geometry's estimates are so large that squares would overflow (``|x| >= safe``), the geometry
+is walked again with each element scaled by its largest magnitude, as the numpy path
+rescales its block.
+
+The geometries of one incidence walk together, :data:`_LANES` at a time (:func:`_walk`): the
+pairs outer, the geometries inner on SIMD lanes, each geometry's updates in the pairs' order,
+so that every geometry gets the bits it gets alone.  NIST's 1824 PTFE rows at 532 nm, 2000
+pairs, one thread: 440.9 -> 148.3 ms (an ad hoc script timing ``_estimate`` of both trees in
+turn, the same bits); its compilation 7.0 -> 8.1 s of CPU.
 
 The facet refraction is :func:`scatterbench.models.kernels.facet.btdf_jones` (the FacetBTDF kernel's);
 the tests hold this module to the numpy path within 1e-12 relative to ``M00``.
@@ -42,15 +48,14 @@ _REACHED = np.array([0, 1, 2, 4, 5, 6, 8, 9, 10, 15])
 _NO_BASIS = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
-@njit(forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def _ray_basis(k):
     """``(s, p)`` of ray ``k``: ``s = unit(z x k)``, ``+y`` along the z axis
-    (:func:`scatterbench.models.facet_btdf.ray_basis`)."""
+    (:func:`scatterbench.models.facet_btdf.ray_basis`); selects, not a branch, so that a loop
+    over rays (:func:`_walk`) stays on SIMD lanes."""
     norm = math.sqrt(k[1] * k[1] + k[0] * k[0])
-    if norm <= 1e-15:
-        s = (0.0, 1.0, 0.0)
-    else:
-        s = (-k[1] / norm, k[0] / norm, 0.0)
+    far = norm > 1e-15
+    s = ((-k[1] / norm) if far else 0.0, (k[0] / norm) if far else 1.0, 0.0)
     return s, cross3(k, s)
 
 
@@ -85,68 +90,64 @@ def _leaving(k_r, n_r, zx, zy, m, n):
     return w, c, k2, w > 0.0 and c > 0.0 and k2[2] > 0.0
 
 
-@njit(forceinline=True)
+@njit(error_model="numpy", forceinline=True)
 def _exit(k_r, e_r, n_r, zx, zy, m, n):
     """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
-    ``(weight, k2, basis of k2, Jones, flux factor)``, weight 0 where no such ray exists."""
+    ``(whether it exists, weight, k2, basis of k2, Jones, flux factor)``, computed either way
+    (the loop over directions around it stays on SIMD lanes; the caller selects)."""
     w, _, k2, live = _leaving(k_r, n_r, zx, zy, m, n)
-    if not live:
-        return 0.0, k2, _NO_BASIS, (0.0, 0.0, 0.0, 0.0), 0.0
     e2 = _ray_basis(k2)
     ss, ps, sp, pp, c_in, c_out = btdf_jones(k2, k_r, (-m[0], -m[1], -m[2]), 1.0 / n, e2, e_r)
-    return w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
+    return live, w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
 
 
-@njit(forceinline=True)
-def _volume(x, k1, e1, ji, k2, e2, jo, base, depth, prm):
-    """One live pair's Mueller estimate into ``x``: the totally diffuse term and the single
-    scattering (depolarizing: a scalar; polarized: the Jones chain of Eq. 4-5)."""
+@njit(error_model="numpy", forceinline=True)
+def _volume(k1, e1, ji, k2, e2, jo, base, depth, prm):
+    """One live pair's Mueller estimate: its :data:`_REACHED` elements, in that order (the
+    others are zero), the totally diffuse term and the single scattering (depolarizing: a
+    scalar; polarized: the Jones chain of Eq. 4-5)."""
     diffuse, single, g, polarized = prm[1], prm[2], prm[3], prm[4] != 0.0
     cos_scat = dot3(k1, k2)
     dens = hg_density(g, cos_scat)
-    rows = (
-        0.5 * (ji[0] * ji[0] + ji[1] * ji[1] + ji[2] * ji[2] + ji[3] * ji[3]),
-        0.5 * (ji[0] * ji[0] - ji[1] * ji[1] + ji[2] * ji[2] - ji[3] * ji[3]),
-        ji[0] * ji[1] + ji[2] * ji[3],
-    )
-    cols = (
-        0.5 * (jo[0] * jo[0] + jo[1] * jo[1] + jo[2] * jo[2] + jo[3] * jo[3]),
-        0.5 * (jo[0] * jo[0] + jo[1] * jo[1] - jo[2] * jo[2] - jo[3] * jo[3]),
-        jo[0] * jo[2] + jo[3] * jo[1],
-    )
+    r0 = 0.5 * (ji[0] * ji[0] + ji[1] * ji[1] + ji[2] * ji[2] + ji[3] * ji[3])
+    r1 = 0.5 * (ji[0] * ji[0] - ji[1] * ji[1] + ji[2] * ji[2] - ji[3] * ji[3])
+    r2 = ji[0] * ji[1] + ji[2] * ji[3]
     scal = diffuse * base
     if not polarized:
         scal = scal + single * base * dens * depth
-    x[:] = 0.0
-    for a in range(3):
-        ca = cols[a] * scal
-        for q in range(3):
-            x[4 * a + q] = ca * rows[q]
-    if polarized and single > 0.0:
-        (s1, p1), (s2, p2) = e1, e2
-        ph = ((dot3(s2, s1), dot3(s2, p1)), (dot3(p2, s1), dot3(p2, p1)))
-        t = (
-            (ph[0][0] * ji[0] + ph[0][1] * ji[2], ph[0][0] * ji[1] + ph[0][1] * ji[3]),
-            (ph[1][0] * ji[0] + ph[1][1] * ji[2], ph[1][0] * ji[1] + ph[1][1] * ji[3]),
-        )
-        root = math.sqrt(single * base * dens * depth * 2.0 / (1.0 + cos_scat * cos_scat))
-        z = 0.0  # a real Jones matrix: its Mueller elements outside _REACHED are zero
-        m = mueller16(
-            (jo[0] * t[0][0] + jo[1] * t[1][0]) * root,
-            z,
-            (jo[0] * t[0][1] + jo[1] * t[1][1]) * root,
-            z,
-            (jo[2] * t[0][0] + jo[3] * t[1][0]) * root,
-            z,
-            (jo[2] * t[0][1] + jo[3] * t[1][1]) * root,
-            z,
-        )
-        for e in _REACHED:
-            x[e] += m[e]
+    c0 = 0.5 * (jo[0] * jo[0] + jo[1] * jo[1] + jo[2] * jo[2] + jo[3] * jo[3]) * scal
+    c1 = 0.5 * (jo[0] * jo[0] + jo[1] * jo[1] - jo[2] * jo[2] - jo[3] * jo[3]) * scal
+    c2 = (jo[0] * jo[2] + jo[3] * jo[1]) * scal
+    x = (c0 * r0, c0 * r1, c0 * r2, c1 * r0, c1 * r1, c1 * r2, c2 * r0, c2 * r1, c2 * r2, 0.0)
+    if not (polarized and single > 0.0):
+        return x
+    (s1, p1), (s2, p2) = e1, e2
+    ph = ((dot3(s2, s1), dot3(s2, p1)), (dot3(p2, s1), dot3(p2, p1)))
+    t = (
+        (ph[0][0] * ji[0] + ph[0][1] * ji[2], ph[0][0] * ji[1] + ph[0][1] * ji[3]),
+        (ph[1][0] * ji[0] + ph[1][1] * ji[2], ph[1][0] * ji[1] + ph[1][1] * ji[3]),
+    )
+    root = math.sqrt(single * base * dens * depth * 2.0 / (1.0 + cos_scat * cos_scat))
+    z = 0.0  # a real Jones matrix: its Mueller elements outside _REACHED are zero
+    p = mueller16(
+        (jo[0] * t[0][0] + jo[1] * t[1][0]) * root,
+        z,
+        (jo[0] * t[0][1] + jo[1] * t[1][1]) * root,
+        z,
+        (jo[2] * t[0][0] + jo[3] * t[1][0]) * root,
+        z,
+        (jo[2] * t[0][1] + jo[3] * t[1][1]) * root,
+        z,
+    )
+    return (x[0] + p[0], x[1] + p[1], x[2] + p[2], x[3] + p[4], x[4] + p[5], x[5] + p[6],
+            x[6] + p[8], x[7] + p[9], x[8] + p[10], x[9] + p[15])  # fmt: skip
 
 
 #: rows of the entry table (:func:`_entries`): weight, k1 (3), k1's s and p (3 each), Jones (4), flux
 _ENTRY_ROWS = 15
+#: geometries the walk takes at once on SIMD lanes (:func:`_walk`): its accumulators, 31 rows of
+#: this many doubles, stay in the L1 cache
+_LANES = 64
 
 
 @njit(inline="always")
@@ -171,85 +172,165 @@ def _entries(ti, n_i, z, m, n, ent):
         ent[14, j] = f_in
 
 
-@njit
-def _walk(geo, ent, z, m, prm, inv_scale, x, mean, m2, peak):
-    """Welford's running mean and sum of squared deviations (``mean``, ``m2``) of the live
-    pairs' estimates times ``inv_scale``, and their largest magnitudes (``peak``); returns
-    the number of live pairs.  The entry facets are the table ``ent`` (:func:`_entries`)."""
-    k_r, e_r, n_r = geo
-    n = prm[0]
-    live = 0
-    mean[:] = 0.0
-    m2[:] = 0.0
-    peak[:] = 0.0
+@njit(error_model="numpy", forceinline=True)
+def _welford(acc, q, g, v, inv, live):
+    """Welford's update of element ``q`` of geometry ``g`` (rows ``q``, ``10 + q``, ``20 + q`` of
+    ``acc``: mean, sum of squared deviations, largest magnitude) by ``v`` where ``live``, as
+    selects: the loop over geometries stays on SIMD lanes."""
+    a, b, c = q * _LANES + g, (10 + q) * _LANES + g, (20 + q) * _LANES + g
+    mu, m2, peak = acc[a], acc[b], acc[c]
+    d = v - mu
+    mu_new = mu + d * inv
+    acc[a] = mu_new if live else mu
+    acc[b] = (m2 + d * (v - mu_new)) if live else m2
+    acc[c] = max(peak, abs(v)) if live else peak
+
+
+@njit(error_model="numpy")
+def _walk(dirs, count, ent, z, m, prm, inv_scale, acc):
+    """Welford's running mean and sum of squared deviations of the live pairs' estimates times
+    ``inv_scale`` (row ``q``: element ``q`` of :data:`_REACHED`), their largest magnitudes, and
+    the number of live pairs, into ``acc`` (rows 0-9, 10-19, 20-29, 30) for the ``count``
+    directions ``dirs`` (:func:`_block`).  The pairs outer, the geometries inner: each
+    geometry's updates come in the pairs' order, as one geometry's walk would make them, and
+    the inner loop runs on SIMD lanes (selects for the dead pairs' skips).  Every table is flat,
+    row ``r`` of geometry ``g`` at ``r * _LANES + g``: with a stride the compiler knows, it
+    proves the rows apart (with numpy's 2-D indexing it did not, and kept the loop scalar).
+    The entry facets are the table ``ent`` (:func:`_entries`)."""
+    n, L = prm[0], _LANES
+    for k in range(31 * L):
+        acc[k] = 0.0
     for j in range(z.shape[1]):
         w1 = ent[0, j]
         if w1 == 0.0:
             continue
-        mj = (m[3, j], m[4, j], m[5, j])
-        w2, k2, e2, jo, f_out = _exit(k_r, e_r, n_r, z[2, j], z[3, j], mj, n)
-        if w2 == 0.0:
-            continue
+        zx, zy, mj = z[2, j], z[3, j], (m[3, j], m[4, j], m[5, j])
         k1 = (ent[1, j], ent[2, j], ent[3, j])
         e1 = ((ent[4, j], ent[5, j], ent[6, j]), (ent[7, j], ent[8, j], ent[9, j]))
         ji = (ent[10, j], ent[11, j], ent[12, j], ent[13, j])
-        base = w1 * w2 * ent[14, j] * f_out / (n * n)
-        _volume(x, k1, e1, ji, k2, e2, jo, base, 1.0 / (-k1[2] + k2[2]), prm)
-        live += 1
-        inv = 1.0 / live
-        for e in _REACHED:
-            v = x[e] * inv_scale[e]
-            d = v - mean[e]
-            mean[e] += d * inv
-            m2[e] += d * (v - mean[e])
-            peak[e] = max(peak[e], abs(v))
-    return live
+        f_in = ent[14, j]
+        for g in range(count):
+            k_r = (dirs[g], dirs[L + g], dirs[2 * L + g])
+            e_r = (
+                (dirs[3 * L + g], dirs[4 * L + g], 0.0),
+                (dirs[5 * L + g], dirs[6 * L + g], dirs[7 * L + g]),
+            )
+            ok, w2, k2, e2, jo, f_out = _exit(k_r, e_r, dirs[8 * L + g], zx, zy, mj, n)
+            ok = ok and w2 != 0.0
+            base = w1 * w2 * f_in * f_out / (n * n)
+            x = _volume(k1, e1, ji, k2, e2, jo, base, 1.0 / (-k1[2] + k2[2]), prm)
+            live = acc[30 * L + g] + 1.0 if ok else acc[30 * L + g]
+            acc[30 * L + g] = live
+            inv = 1.0 / live
+            # written out: a loop over the tuple's elements kept the geometries' loop off the lanes
+            _welford(acc, 0, g, x[0] * inv_scale[g], inv, ok)
+            _welford(acc, 1, g, x[1] * inv_scale[L + g], inv, ok)
+            _welford(acc, 2, g, x[2] * inv_scale[2 * L + g], inv, ok)
+            _welford(acc, 3, g, x[3] * inv_scale[3 * L + g], inv, ok)
+            _welford(acc, 4, g, x[4] * inv_scale[4 * L + g], inv, ok)
+            _welford(acc, 5, g, x[5] * inv_scale[5 * L + g], inv, ok)
+            _welford(acc, 6, g, x[6] * inv_scale[6 * L + g], inv, ok)
+            _welford(acc, 7, g, x[7] * inv_scale[7 * L + g], inv, ok)
+            _welford(acc, 8, g, x[8] * inv_scale[8 * L + g], inv, ok)
+            _welford(acc, 9, g, x[9] * inv_scale[9 * L + g], inv, ok)
 
 
 @njit(inline="always")
-def _geometry(tr, pr, n_r, ent, z, m, prm, safe, mean, err, col):
-    """Mean and standard error of one geometry into ``mean[:, col]``, ``err[:, col]``, its
-    incidence's entry facets the table ``ent``."""
-    cr, sr, cp, sp = math.cos(tr), math.sin(tr), math.cos(pr), math.sin(pr)
-    k_r = (sr * cp, sr * sp, cr)
-    s_r = (-sp, cp, 0.0)
-    geo = (k_r, (s_r, cross3(k_r, s_r)), n_r)
-    x, mu, m2, peak, scale = np.empty(16), np.empty(16), np.empty(16), np.empty(16), np.ones(16)
-    live = _walk(geo, ent, z, m, prm, scale, x, mu, m2, peak)
-    if peak.max() >= safe:
-        # squares of such values overflow: walk again with each element over its largest
-        for e in range(16):
-            scale[e] = peak[e] if peak[e] > 0.0 else 1.0
-        live = _walk(geo, ent, z, m, prm, 1.0 / scale, x, mu, m2, peak)
-    pairs = z.shape[1]
+def _finish(acc, g, scale, pairs, mean, err, col):
+    """Mean and standard error of geometry ``g`` of ``acc`` (:func:`_walk`) into ``mean[:, col]``,
+    ``err[:, col]``, scaled back by ``scale`` (row ``q``, as ``acc``): the dead pairs' exact
+    zeros joined to the live ones (Chan et al.'s pairwise update)."""
+    L = _LANES
+    live = acc[30 * L + g]
     dead = pairs - live
-    for e in _REACHED:
-        # the dead pairs' exact zeros joined to the live ones (Chan et al.'s pairwise update)
-        total = mu[e] * live / pairs
-        ss = m2[e] + mu[e] * mu[e] * live * dead / pairs
-        mean[e, col] = total * scale[e]
-        err[e, col] = math.sqrt(ss / (pairs - 1)) / math.sqrt(pairs) * scale[e]
+    for q in range(10):
+        e, mu, s = _REACHED[q], acc[q * L + g], scale[q * L + g]
+        total = mu * live / pairs
+        ss = acc[(10 + q) * L + g] + mu * mu * live * dead / pairs
+        mean[e, col] = total * s
+        err[e, col] = math.sqrt(ss / (pairs - 1)) / math.sqrt(pairs) * s
 
 
-@njit(cache=True, nogil=True)
+@njit(inline="always")
+def _block(cols, count, tr, pr, n_r, ent, z, m, prm, safe, mean, err, work):
+    """Geometries ``cols[:count]`` (at most :data:`_LANES`, one incidence: the entry table
+    ``ent``) walked together (:func:`_walk`); those whose estimates are so large that squares
+    would overflow walked again with each element over its largest magnitude.  ``work``: the
+    tables (:func:`_tables`).  Loops, not numpy's slice assignments, fill and copy the tables:
+    those took the kernel's compilation from 8 to 14.6 s of CPU (ad hoc, an empty cache)."""
+    dirs, acc, scale, inv = work
+    L = _LANES
+    for g in range(count):
+        i = cols[g]
+        cr, sr, cp, sp = math.cos(tr[i]), math.sin(tr[i]), math.cos(pr[i]), math.sin(pr[i])
+        k_r = (sr * cp, sr * sp, cr)
+        p_r = cross3(k_r, (-sp, cp, 0.0))
+        dirs[g], dirs[L + g], dirs[2 * L + g] = k_r
+        dirs[3 * L + g], dirs[4 * L + g] = -sp, cp
+        dirs[5 * L + g], dirs[6 * L + g], dirs[7 * L + g] = p_r
+        dirs[8 * L + g] = n_r[i]
+    for k in range(10 * L):
+        scale[k] = 1.0
+    for rescaled in range(2):
+        _walk(dirs, count, ent, z, m, prm, inv if rescaled else scale, acc)
+        big = 0
+        for g in range(count):
+            large = False
+            for q in range(10):
+                large = large or acc[(20 + q) * L + g] >= safe
+            if rescaled or not large:
+                _finish(acc, g, scale, z.shape[1], mean, err, cols[g])
+                continue
+            # squares of such values overflow: lane ``big`` takes it, each element over its largest
+            for r in range(9):
+                dirs[r * L + big] = dirs[r * L + g]
+            cols[big] = cols[g]
+            for q in range(10):
+                peak = acc[(20 + q) * L + g]
+                scale[q * L + big] = peak if peak > 0.0 else 1.0
+                inv[q * L + big] = 1.0 / scale[q * L + big]
+            big += 1
+        if not big:
+            return
+        count = big
+
+
+@njit(inline="always")
+def _tables():
+    """A block's flat tables (:func:`_block`): its directions (k_r, its s (x, y) and p, N_r),
+    the accumulators (:func:`_walk`), the scales and their reciprocals."""
+    L = _LANES
+    return np.empty(9 * L), np.empty(31 * L), np.empty(10 * L), np.empty(10 * L)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def _range(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, lo, hi):
     """Geometries ``lo .. hi - 1`` (a range of :func:`~scatterbench.models.kernels.threads.spread`),
     the entry facets computed once per run of geometries with the same incidence (and
     normalization): the same numbers as for each geometry, in a fraction of the time where the
-    geometries come by incidence, as a measurement's do."""
+    geometries come by incidence, as a measurement's do; such a run's geometries walked
+    :data:`_LANES` at a time (:func:`_block`)."""
     ent = np.empty((_ENTRY_ROWS, z.shape[1]))
-    have, last_t, last_n = False, 0.0, 0.0
-    for i in range(lo, hi):
-        mean[:, i] = 0.0
-        err[:, i] = 0.0
-        if not (ti[i] < 0.5 * math.pi and tr[i] < 0.5 * math.pi):
-            continue
-        # the same bits (a -0.0 incidence gives -0.0 sines: the same values, other zeros)
-        same = ti[i] == last_t and math.copysign(1.0, ti[i]) == math.copysign(1.0, last_t)
-        if not (have and same and n_i[i] == last_n):
-            _entries(ti[i], n_i[i], z, m, prm[0], ent)
-            have, last_t, last_n = True, ti[i], n_i[i]
-        _geometry(tr[i], pr[i], n_r[i], ent, z, m, prm, safe, mean, err, i)
+    work, cols = _tables(), np.empty(_LANES, dtype=np.int64)
+    have, last_t, last_n, i = False, 0.0, 0.0, lo
+    while i < hi:  # a block of one incidence's geometries at a time (one call: numba inlines it)
+        count = 0
+        while i < hi and count < _LANES:
+            mean[:, i] = 0.0
+            err[:, i] = 0.0
+            if ti[i] < 0.5 * math.pi and tr[i] < 0.5 * math.pi:
+                # the same bits (a -0.0 incidence gives -0.0 sines: the same values, other zeros)
+                same = ti[i] == last_t and math.copysign(1.0, ti[i]) == math.copysign(1.0, last_t)
+                if not (have and same and n_i[i] == last_n):
+                    if count:
+                        break  # walk the block first: geometry i starts the next
+                    _entries(ti[i], n_i[i], z, m, prm[0], ent)
+                    have, last_t, last_n = True, ti[i], n_i[i]
+                cols[count] = i
+                count += 1
+            i += 1
+        if count:
+            _block(cols, count, tr, pr, n_r, ent, z, m, prm, safe, mean, err, work)
 
 
 def estimate(ti, tr, pr, n_i, n_r, z, m, prm, safe, parallel):
