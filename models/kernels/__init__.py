@@ -58,7 +58,7 @@ helpers that take an array keep numba's inlining (:mod:`~scatterbench.models.ker
 scratch accessors, :func:`~scatterbench.models.kernels.drive.column`): a call that passes an
 array counts references; and so do the loops called at one place only, between an entry and
 its helpers (:mod:`~scatterbench.models.kernels.aperture`'s node and tile loops,
-:mod:`~scatterbench.models.kernels.montecarlo`'s geometry and entry loops): numba compiles a function
+:mod:`~scatterbench.models.kernels.montecarlo`'s entry table and blocks): numba compiles a function
 that is not inlined into a module of its own, optimizes it and emits its machine code, then
 optimizes it again in each caller, while one typed once at its one call site costs nothing
 more (the aperture's entries 4.0-4.35 s of CPU instead of 4.9-6.7 s, a fresh cache, ad hoc,
@@ -283,7 +283,7 @@ def warm(kernel, precision="float64", option_sets=None, scalar=True):
     ``scalar`` is false), for the argument types
     it passes, without running them: a first run compiles the kernels on its worker processes
     at once, each a different group of kernels, before it needs them (``scatterbench
-    report``).  One process per kernel: its loops share the kernel's helpers, which each process
+    report``).  One process per group: its kernels' loops share helpers, which each process
     compiles for itself.  Returns ``kernel``."""
     for fn, sig in _warm_entries(kernel, precision, option_sets, scalar):
         if hasattr(fn, "compile"):  # not a Python function (NUMBA_DISABLE_JIT=1)

@@ -59,17 +59,25 @@ def _ray_basis(k):
     return s, cross3(k, s)
 
 
+@njit(error_model="numpy", forceinline=True)
+def _refracted(k, m, eta):
+    """``(cos, k_t)``: the cosine ``-k . m`` of ray ``k`` striking the facet of unit normal ``m``
+    (from the side ``m`` points to) and the ray refracted through it at relative index ``eta``
+    (``n_incident / n_transmitted``; its length below 1 beyond the critical angle, whose rays
+    the callers drop)."""
+    c = -dot3(k, m)
+    ct = math.sqrt(max(1.0 - eta * eta * (1.0 - c * c), 0.0))
+    f = eta * c - ct
+    return c, (eta * k[0] + f * m[0], eta * k[1] + f * m[1], eta * k[2] + f * m[2])
+
+
 @njit(forceinline=True)
 def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     """The incident ray through facet ``m`` (slope x ``zx``): ``(weight, k1, basis of k1,
     Jones, flux factor)``; weight 0 where the facet is not struck or the ray does not go
     down."""
     w = max(ci - si * zx, 0.0) / n_i
-    eta = 1.0 / n
-    c = -dot3(k_i, m)
-    ct = math.sqrt(max(1.0 - eta * eta * (1.0 - c * c), 0.0))
-    f = eta * c - ct
-    k1 = (eta * k_i[0] + f * m[0], eta * k_i[1] + f * m[1], eta * k_i[2] + f * m[2])
+    c, k1 = _refracted(k_i, m, 1.0 / n)
     if not (w > 0.0 and c > 0.0 and -k1[2] > 0.0):
         return 0.0, k1, _NO_BASIS, (0.0, 0.0, 0.0, 0.0), 0.0
     e1 = _ray_basis(k1)
@@ -82,11 +90,9 @@ def _leaving(k_r, n_r, zx, zy, m, n):
     """The internal ray ``k2`` that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
     ``(weight, cos(k_r, m), k2, whether it exists)``."""
     w = max(k_r[2] + k_r[0] * zx + k_r[1] * zy, 0.0) / n_r
-    eta = 1.0 / n
-    c = dot3(k_r, m)
-    ct = math.sqrt(max(1.0 - eta * eta * (1.0 - c * c), 0.0))
-    f = eta * c - ct
-    k2 = (eta * k_r[0] - f * m[0], eta * k_r[1] - f * m[1], eta * k_r[2] - f * m[2])
+    # the reversed ray: the one that arrives along -k_r, refracted, reversed (negations are exact)
+    c, back = _refracted((-k_r[0], -k_r[1], -k_r[2]), m, 1.0 / n)
+    k2 = (-back[0], -back[1], -back[2])
     return w, c, k2, w > 0.0 and c > 0.0 and k2[2] > 0.0
 
 
@@ -216,7 +222,6 @@ def _walk(dirs, count, ent, z, m, prm, inv_scale, acc):
                 (dirs[5 * L + g], dirs[6 * L + g], dirs[7 * L + g]),
             )
             ok, w2, k2, e2, jo, f_out = _exit(k_r, e_r, dirs[8 * L + g], zx, zy, mj, n)
-            ok = ok and w2 != 0.0
             base = w1 * w2 * f_in * f_out / (n * n)
             x = _volume(k1, e1, ji, k2, e2, jo, base, 1.0 / (-k1[2] + k2[2]), prm)
             live = acc[30 * L + g] + 1.0 if ok else acc[30 * L + g]

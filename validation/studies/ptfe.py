@@ -77,8 +77,8 @@ QUICK = {
 }
 #: the report's full run: the four models whose likelihood is closed-form (rough_diffuse's
 #: Monte Carlo costs 0.33 s a 14-walker batch on these 76 rows, one thread, at 07139c4
-#: (``benchmarks/ptfe_batch_cost.py``): its chain and three folds would add ~2 min of a worker's
-#: time to the report; run it with the CLI, docs/guide/ptfe.md)
+#: (``benchmarks/ptfe_batch_cost.py``): its chain and three folds, 4 x 100 such batches, would
+#: add about 130 s of a worker's time to the report; run it with the CLI, docs/guide/ptfe.md)
 REPORT = {
     "row_step": 24,
     "steps": 100,
