@@ -17,9 +17,10 @@ count, and the first ``report --quick`` cold and warm.
 * **First run** (``--first-run``): ``scatterbench report --quick`` with an empty numba cache
   (``NUMBA_CACHE_DIR`` a fresh folder: every kernel compiles) and then again with that cache
   (warm), with the default ``--workers``.
-* **Compilation** (``--compile``): each compile-ahead group of a report
-  (``validation.report.build.COMPILE_GROUPS``: a kernel's loops, or the Monte Carlo, aperture or
-  disc entries, grouped by the helpers they share) in a fresh process, as a report's worker
+* **Compilation** (``--compile``): each compile group of a report
+  (``validation.report.build.every_compile_group``: a kernel's loops, or the Monte Carlo, aperture or
+  disc entries, grouped by the helpers they share; the last ones compiled beside the sections
+  after the others) in a fresh process, as a report's worker
   takes it, its tasks in turn, with one empty numba cache: wall and CPU seconds per task, per
   group, and their sum (what the report's worker processes share on a first run).
 
@@ -122,9 +123,9 @@ def first_run():
 
 _COMPILE = """
 import sys, time
-from scatterbench.validation.report.build import COMPILE_GROUPS, warm_task
+from scatterbench.validation.report.build import every_compile_group, warm_task
 total = 0.0
-for task in COMPILE_GROUPS[int(sys.argv[1])]:
+for task in every_compile_group()[int(sys.argv[1])]:
     t, c = time.perf_counter(), time.process_time()
     warm_task(task)
     cpu = time.process_time() - c
@@ -142,12 +143,12 @@ def compile_tasks():
     print(
         f"\ncompilation: the report's compile-ahead groups, a fresh process each, empty numba cache; {_load()}"
     )
-    from scatterbench.validation.report.build import COMPILE_GROUPS
+    from scatterbench.validation.report.build import every_compile_group
 
     total = 0.0
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        for g in range(len(COMPILE_GROUPS)):
+        for g in range(len(every_compile_group())):
             r = subprocess.run(
                 [sys.executable, "-c", _COMPILE, str(g)], env=env, check=True, capture_output=True, text=True
             )

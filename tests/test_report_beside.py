@@ -6,6 +6,7 @@ Equal results on every executor are ``tests/test_report_executors.py``'s (its su
 seed 003 presets and the stability sweep, are both ``beside``)."""
 
 import threading
+import time
 
 import pytest
 
@@ -140,3 +141,58 @@ def test_a_worker_keeps_the_functions_of_sections_that_alternate(monkeypatch):
         assert executors._run_pickled_chunk("a", blobs["a"], [-1]) == [1]
         assert executors._run_pickled_chunk("b", blobs["b"], [1.4]) == [1]
     assert len(loads) == 2
+
+
+def _late_compile(monkeypatch, fail=False):
+    """A first run's compile of loop ``("facet", "float32")`` that only a later section uses:
+    ``warm_group`` logs, waits until the section before that one has started (so it fails,
+    after 20 s, unless the two overlap) and then raises if ``fail``."""
+    task = ("facet", "float32", None, True)
+    log, started = [], threading.Event()
+
+    def warm_group(group):
+        log.append(("compile", tuple(group)))
+        assert started.wait(20.0), "the sections before did not run during the compile"
+        time.sleep(0.2)  # a section that did not wait would log first
+        log.append("compiled")
+        if fail:
+            raise RuntimeError("LLVM ran out of memory")
+        return [t[0] for t in group]
+
+    def before(ctx):
+        log.append("before")
+        started.set()
+        return 1
+
+    def needs(ctx):
+        log.append("needs")
+        return 2
+
+    monkeypatch.setattr(build, "warm_group", warm_group)
+    monkeypatch.setattr(build, "cold_task", lambda t: t == task)
+    specs = [
+        *(
+            SectionSpec(f"b{i}", "B", lambda ctx: log.append("beside") or 0, _rendering([]), beside=True)
+            for i in range(2)
+        ),
+        SectionSpec("before", "Before", before, _rendering([])),
+        SectionSpec("needs", "Needs", needs, _rendering([]), compiles=(task,)),
+    ]
+    return log, task, _report(monkeypatch, specs, Workers())
+
+
+def test_a_sections_own_loops_compile_after_the_beside_sections_and_beside_those_before_it(monkeypatch):
+    """A section's own loops (``SectionSpec.compiles``) compile on the workers once the beside
+    sections are done, while this process computes the sections before it, and that section
+    starts only when they are compiled (it loads them rather than compiling them again).
+    Fails when they compile ahead of every section, or the section does not wait."""
+    log, task, results = _late_compile(monkeypatch)
+    assert log[:2] == ["beside", "beside"] and log[-2:] == ["compiled", "needs"]
+    assert sorted(log[2:4], key=str) == [("compile", (task,)), "before"]  # at once: either first
+    assert results["summary"]["n_fail"] == 0
+
+
+def test_a_failed_late_compile_leaves_the_section_to_compile_its_own(monkeypatch):
+    log, _, results = _late_compile(monkeypatch, fail=True)
+    assert log[-2:] == ["compiled", "needs"]
+    assert results["sections"]["needs"]["error"] is None and results["summary"]["n_fail"] == 0

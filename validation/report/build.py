@@ -10,6 +10,7 @@ import sys
 import time
 import traceback
 from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import wait as wait_for
 
 from tqdm import tqdm
 
@@ -113,8 +114,11 @@ def _run_sections(ctx, specs):
     done = {}
     with _progress(len(specs), "report") as bar:
         early = _beside(ctx, specs)
+        late = compile_later(ctx.executor, specs)
         for spec in sorted(specs, key=lambda sp: sp.stage):
             bar.set_postfix_str(spec.id)
+            if spec.compiles and late is not None:
+                wait_for([late])  # its loops from the cache; a failed compile fails the section's own
             computed = early.pop(spec.id, None) or _computed(ctx, spec)
             done[spec.id] = _rendered(ctx, spec, computed)
             ctx.cache["section_times"][spec.id] = done[spec.id].seconds
@@ -127,10 +131,12 @@ def _run_sections(ctx, specs):
 #: --quick`` by wrapping ``kernels.vector.lanes_of``: all 4 of Cook-Torrance's, 3 of
 #: Maxwell-Beard's 6; None: every one, or a module's entries), whether it calls the scalar loop
 #: (recorded by wrapping ``kernels.Compiled.scalar``: only for the options without lanes, the
-#: facets' other slopes, Cook-Torrance's Smith shadowing, float32, and FacetBTDF), the Monte
-#: Carlo, aperture and disc entries, the fused Mueller likelihood of the PTFE section and the
-#: small calls' angle check (the main process compiled those two, ~3 s, during the sections).
-#: A loop missing here still compiles, on first use.
+#: facets' other slopes, Cook-Torrance's Smith shadowing and FacetBTDF), the Monte Carlo,
+#: aperture and disc entries, the fused Mueller likelihood of the PTFE section and the small
+#: calls' angle check (the main process compiled those two, ~3 s, during the sections).  The
+#: loops only a later section runs are that section's (:attr:`~.core.SectionSpec.compiles`: the
+#: float32 facet, the speed section's), compiled while the sections before it run
+#: (:func:`compile_later`).  A loop missing from both still compiles, on first use.
 #:
 #: Grouped by process: a process compiles the helpers its loops inline (the kernel's function
 #: and everything it calls: numba does not cache them, :mod:`scatterbench.models.kernels`) once
@@ -148,7 +154,7 @@ COMPILE_GROUPS = (
      ("single", "float64", [(0, 0, 0), (1, 0, 0)], False), ("diffuse", "float64", [(0, 0, 0)], False)),
     (("facet", "float64", _FACET, True), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)], False),
      ("btdf", "float64", [], True)),
-    (("facet", "float32", None, True),), (("aperture", "float64", None, False),),
+    (("aperture", "float64", None, False),),
     (("likelihood", None, None, False),), (("disc", "float64", None, False),),
     (("angles", "float64", None, False),),
 )  # fmt: skip
@@ -189,15 +195,48 @@ def compile_ahead(executor):
     worker processes, a different group of them (:data:`COMPILE_GROUPS`) on each at once, before
     the sections need them: otherwise every process compiled each loop it reached, the workers
     the same ones at the same time.  Nothing for one process or a Dask cluster."""
-    if getattr(executor, "kind", None) != "processes":
-        return
-    from scatterbench.models import kernels
-
-    todo = [group for group in COMPILE_GROUPS if any(cold_task(task) for task in group)]
+    todo = _cold_groups(executor, COMPILE_GROUPS)
     if todo:
+        executor.map(warm_group, todo, tasks=len(todo))
+
+
+def compile_later(executor, specs):
+    """Start compiling, on ``executor``'s local worker processes, the loops that only sections
+    computed in this process after the beside ones use (their
+    :attr:`~.core.SectionSpec.compiles`); returns the future of that, or ``None`` when nothing
+    is to compile.  While this process computes the sections before those, one core at a time,
+    the workers are idle; ahead of all sections those loops took every core's time (the float32
+    facet: 3.6 s of CPU, ``benchmarks/scaling.py --compile``).  A section with such loops waits
+    for the future, so that it loads them rather than compiling them again."""
+    todo = _cold_groups(executor, [spec.compiles for spec in specs if spec.compiles])
+    if not todo:
+        return None
+    pool = ThreadPoolExecutor(1, thread_name_prefix="scatterbench-compile")
+    try:
+        return pool.submit(executor.map, warm_group, todo, tasks=len(todo))
+    finally:
+        pool.shutdown(wait=False)  # the thread ends with its one task
+
+
+def every_compile_group() -> tuple:
+    """The groups a report compiles: :data:`COMPILE_GROUPS` ahead of its sections, then the
+    sections' own (:func:`compile_later`)."""
+    return COMPILE_GROUPS + tuple(spec.compiles for spec in SECTIONS if spec.compiles)
+
+
+def _cold_groups(executor, groups) -> list:
+    """The groups of ``groups`` with a task not in numba's cache (said on the progress line),
+    on local worker processes; none elsewhere (one process, a Dask cluster: each loop
+    compiles on first use)."""
+    if getattr(executor, "kind", None) != "processes":
+        return []
+    todo = [group for group in groups if any(cold_task(task) for task in group)]
+    if todo:
+        from scatterbench.models import kernels
+
         names = [task[0] for group in todo for task in group]
         kernels.announce(list(dict.fromkeys(names)), f"on {executor.workers} processes")
-        executor.map(warm_group, todo, tasks=len(todo))
+    return todo
 
 
 def build_report(

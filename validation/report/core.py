@@ -79,6 +79,11 @@ class SectionSpec:
     warnings in this process and times nothing: on worker processes it is computed at once
     with the other such sections, before the rest (:func:`~.build.side_by_side`), so that
     the workers always have tasks.
+
+    ``compiles``: compile tasks (:data:`~.build.COMPILE_GROUPS`' form) of loops that only this
+    section uses, one that is not ``beside``: a first run compiles them on a worker while this
+    process computes the sections before it (:func:`~.build.compile_later`), not ahead of all
+    sections, when every core is compiling.
     """
 
     id: str
@@ -87,6 +92,7 @@ class SectionSpec:
     render: Callable
     stage: int = 0
     beside: bool = False
+    compiles: tuple = ()
 
 
 def _clean(v):
