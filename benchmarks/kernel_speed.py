@@ -56,6 +56,10 @@ MODELS = {
     "SingleScatterBRDF": lambda: models.SingleScatterBRDF(phase=models.HenyeyGreenstein(0.3, True)),
     "DiffuseSubsurfaceBRDF": lambda: models.DiffuseSubsurfaceBRDF(),
     "CookTorranceBRDF": lambda: models.CookTorranceBRDF(),
+    "CookTorranceBRDF smith": lambda: models.CookTorranceBRDF(shadowing="smith"),
+    "CookTorranceBRDF strokes smith": lambda: models.CookTorranceBRDF(
+        slopes=models.StrokeSlopes(0.05, 0.2, 0.7), shadowing="smith"
+    ),
     "VarnishedCookTorranceBRDF": lambda: models.VarnishedCookTorranceBRDF(),
     "MaxwellBeardBRDF": lambda: models.MaxwellBeardBRDF(polarized=True),
 }

@@ -30,8 +30,13 @@ from scatterbench.models.kernels.vector_math import (
 #: sine are parameter rows)
 STROKES = [
     models.CookTorranceBRDF(slopes=models.StrokeSlopes(0.05, 0.2, 0.7), substrate=1.37 + 7.62j, shadowing=sh)
-    for sh in ("none", "blinn")
-] + [models.VarnishedCookTorranceBRDF(slopes=models.StrokeSlopes(0.3, 0.1, -2.0), convention="corrected")]
+    for sh in ("none", "blinn", "smith")
+] + [
+    models.VarnishedCookTorranceBRDF(
+        slopes=models.StrokeSlopes(0.3, 0.1, -2.0), convention="corrected", shadowing=sh
+    )
+    for sh in ("none", "smith")
+]
 VECTORIZED = [m for m in CONFIGS + STROKES if Compiled(m, *m._kernel_spec()).vectorized]
 #: azimuths beyond the polynomial's range (the C library's there), and at its edge
 FAR = np.array([REDUCED_MAX, -REDUCED_MAX, 3.0e6, -1.0e7, 1.0e300])
@@ -70,7 +75,9 @@ def test_the_vectorized_models_are_the_ones_meant():
     shadowed = {(type(m.slopes).__name__, m.shadowing) for m in facets if m.shadowing != "none"}
     assert {s for _, s in shadowed} == {"smith", "smith-correlated"}
     assert {k for k, _ in shadowed} <= {"GaussianSlopes", "GGXSlopes"}
-    assert {m.shadowing for m in VECTORIZED if type(m).__name__ in cook} == {"none", "blinn"}
+    # Cook-Torrance's Smith G too, isotropic or under strokes (the rotation's cosine and sine
+    # are parameter rows: no call left in the loop)
+    assert {m.shadowing for m in VECTORIZED if type(m).__name__ in cook} == {"none", "blinn", "smith"}
 
 
 @pytest.mark.parametrize("model", VECTORIZED, ids=lambda m: type(m).__name__)
@@ -146,9 +153,10 @@ import numpy as np
 from scatterbench import models
 from scatterbench.models.kernels import Compiled, drive
 smith = models.FacetBRDF(slopes=models.GaussianSlopes(0.2), shadowing="smith")
-for m in (models.FacetBRDF(), smith, models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF()):
+ct_smith = models.CookTorranceBRDF(slopes=models.StrokeSlopes(0.05, 0.2, 0.7), shadowing="smith")
+for m in (models.FacetBRDF(), smith, models.CookTorranceBRDF(), models.VarnishedCookTorranceBRDF(), ct_smith):
     k = Compiled(m, *m._kernel_spec())
-    label = type(m).__name__ + ("-smith" if m is smith else "")
+    label = type(m).__name__ + ("-smith" if m is smith or m is ct_smith else "")
     k.run(np.linspace(0.0, 1.0, 64), np.full(1, 0.3), np.full(1, 0.2), 16)
     k.scalar(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], drive.NO_INDEX, k.iopt, np.empty((16, 4)), 0, 0, 4)
     for name, fn in (("lanes", k.lanes), ("scalar", k.scalar)):  # each kernel's one compiled loop
@@ -173,14 +181,15 @@ def test_the_lanes_are_vectorized_loops(tmp_path):
     from the cache has none), after an earlier process filled the cache with some of the
     kernels' helpers: each model's vector loop (:func:`scatterbench.models.kernels.vector.lane_entries`)
     holds LLVM's vectorized loops (their ``vector.body`` blocks, on ``<N x double>`` values),
-    the facet kernel's under Smith shadowing too (its ``erfc``);
+    the facet kernel's and Cook-Torrance's (under strokes) under Smith shadowing too (``erfc``,
+    the ellipse's rotation from parameter rows);
     its scalar entry (:mod:`~scatterbench.models.kernels.drive`) has none.  Fails when a change puts a call or an exception
     back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     subprocess.run([sys.executable, "-c", _EARLIER], env=env, check=True)
     res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
     counts = {tuple(ln.split()[:2]): tuple(int(x) for x in ln.split()[2:]) for ln in res.stdout.splitlines()}
-    assert len(counts) == 8, res.stdout
+    assert len(counts) == 10, res.stdout
     for (model, loop), (bodies, vectors) in counts.items():
         if loop == "lanes":  # one option set per entry: its loop, and LLVM's remainder copies
             assert bodies >= 1 and vectors > 0, (model, bodies, vectors)

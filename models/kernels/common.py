@@ -275,17 +275,28 @@ def lam_unit(kind, mu):
 
 
 @njit(error_model="numpy", forceinline=True)
-def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
+def rotation(kind, rot):
+    """Cosine and sine of slope kind ``kind``'s rotation ``rot`` (the elliptical kinds'; 1 and 0
+    for the others, without a call): through the C library, so that a loop whose kind is a
+    constant of an isotropic kind keeps no call (:mod:`~scatterbench.models.kernels.vector`)."""
+    T = type(rot)
+    if kind == GAUSSIAN or kind == GGX:
+        return T(1.0), T(0.0)
+    return math.cos(rot), math.sin(rot)
+
+
+@njit(error_model="numpy", forceinline=True)
+def smith_lambda(kind, c, s, cphi, sphi, sx, sy, cr, sr):
     """Smith ``Lambda`` (:func:`scatterbench.models.shadowing.smith_lambda`) of the Gaussian and GGX
-    families, isotropic or elliptical, for a direction (cosine, sine, azimuth).  The elliptical
-    kinds rotate through the C library's cosine and sine (the SIMD lanes take only the isotropic
-    ones: :mod:`~scatterbench.models.kernels.vector`)."""
+    families, isotropic or elliptical, for a direction (cosine, sine, azimuth); ``cr``, ``sr``:
+    the cosine and sine of the ellipse's rotation (:func:`rotation`, or parameter rows), so that
+    no call is left here and a loop with a run-time kind stays on SIMD lanes (Cook-Torrance's
+    Smith ``G``: isotropic or elliptical by its parameters)."""
     T = type(c)
     mu = abs(c) / s if s > T(0.0) else T(math.inf)
     if kind == GAUSSIAN or kind == GGX:
         alpha = sx
     else:
-        cr, sr = math.cos(rot), math.sin(rot)
         cl = cphi * cr + sphi * sr
         sl = sphi * cr - cphi * sr
         alpha = sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
@@ -293,12 +304,13 @@ def smith_lambda(kind, c, s, cphi, sphi, sx, sy, rot):
 
 
 @njit(error_model="numpy", forceinline=True)
-def smith_g(shadowing, kind, di, dio, sx, sy, rot):
+def smith_g(shadowing, kind, di, dio, sx, sy, cr, sr):
     """Shadowing-masking ``G`` for directions ``di``, ``dio`` = ``(cos, sin, cos phi, sin phi)``
-    (no back-facing test: both see the facet from its front)."""
+    (no back-facing test: both see the facet from its front); ``cr``, ``sr`` as
+    :func:`smith_lambda`'s."""
     T = type(sx)
-    li = smith_lambda(kind, di[0], di[1], di[2], di[3], sx, sy, rot)
-    lo = smith_lambda(kind, dio[0], dio[1], dio[2], dio[3], sx, sy, rot)
+    li = smith_lambda(kind, di[0], di[1], di[2], di[3], sx, sy, cr, sr)
+    lo = smith_lambda(kind, dio[0], dio[1], dio[2], dio[3], sx, sy, cr, sr)
     if shadowing == SMITH:
         return (T(1.0) / (T(1.0) + li)) * (T(1.0) / (T(1.0) + lo))
     return T(1.0) / (T(1.0) + (li + lo))

@@ -80,7 +80,8 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
         val *= min(T(1.0), t * min(ci, cr))
     elif shadowing == 2:
         kind = GAUSSIAN if p[3] == p[4] else ANISO_GAUSSIAN
-        val *= smith_g(SMITH, kind, (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], p[5])
+        # the strokes' azimuth's cosine and sine (ca, sa) are its rotation's: no call on the lanes
+        val *= smith_g(SMITH, kind, (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], ca, sa)
     return val
 
 

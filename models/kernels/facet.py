@@ -9,7 +9,7 @@ import math
 
 from numba import njit
 
-from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, rs_k, smith_g
+from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, rotation, rs_k, smith_g
 from .vector_math import sqrt
 
 
@@ -47,7 +47,8 @@ def facet_jones_at(g, pol_i, pol_r, p, o):
     if ti >= half_pi or tr >= half_pi:
         S = T(0.0)
     if o[1] != NO_SHADOWING:
-        S = S * smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], p[5])
+        rc, rs = rotation(o[0], p[5])
+        S = S * smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], rc, rs)
     c = T(0.5) * sqrt(g)
     rsr, rsi, kr, ki = rs_k(c, sub_r / n, sub_i / n, sub_r == T(math.inf))
     inv_g = T(1.0) / g
@@ -174,7 +175,8 @@ def btdf(g, p, o):
     mz2 = mz * mz
     S = dens * n * c_out * (T(1.0) / (ci * ct)) / (mz2 * mz2) * (n * n * c_out / D2)
     if o[1] != NO_SHADOWING:
-        g = smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (-ct, st, cp, sp), p[1], p[2], p[3])
+        rc, rs = rotation(o[0], p[3])
+        g = smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (-ct, st, cp, sp), p[1], p[2], rc, rs)
         # back-facing (chi+) tests of Walter et al. Eq. 21-23: both local cosines positive here
         S = S * (g if (c_in * ci > T(0.0) and c_out * ct > T(0.0)) else T(0.0))
     root = sqrt(S)

@@ -20,10 +20,12 @@ block of :data:`VBLOCK` geometries:
 The kernels are the same functions as the scalar loop's, so both give the same bits
 (``tests/test_vector_kernels.py``).  :func:`vectorized` says which models and options take this
 path.  The others keep C library calls that leave any loop scalar (FacetBTDF, anisotropic
-slopes, unit slopes, Cook-Torrance's Smith shadowing, which rotates by the strokes' azimuth);
-:class:`scatterbench.models.kernels.Compiled` runs them through :mod:`~scatterbench.models.kernels.drive`.
-The facet kernel's Smith shadowing of isotropic Gaussian and GGX slopes takes the lanes (its
-``erfc``, ``exp(-mu^2)`` and ``hypot`` are :mod:`~scatterbench.models.kernels.vector_math`'s).
+slopes, unit slopes); :class:`scatterbench.models.kernels.Compiled` runs them through
+:mod:`~scatterbench.models.kernels.drive`.  Smith shadowing takes the lanes (its ``erfc``,
+``exp(-mu^2)`` and ``hypot`` are :mod:`~scatterbench.models.kernels.vector_math`'s): the facet
+kernel's of isotropic Gaussian and GGX slopes, and Cook-Torrance's, isotropic or elliptical by
+its parameters, the ellipse's rotation given as the strokes' azimuth's cosine and sine
+(parameter rows) rather than through the C library.
 """
 
 from __future__ import annotations
@@ -49,7 +51,11 @@ FACET_KINDS = (EXPONENTIAL, GAUSSIAN, GGX)
 #: the facet kernel's shadowing on the lanes: Smith's separable and height-correlated ``G`` of the
 #: isotropic slope kinds whose ``Lambda`` is in closed form (the exponential's is numpy's table)
 SMITH_KINDS, SMITH_FORMS = (GAUSSIAN, GGX), (SHADOWING_KINDS["smith"], SHADOWING_KINDS["smith-correlated"])
-BLINN, NO_COOK_SHADOWING = COOK_SHADOWING["blinn"], COOK_SHADOWING["none"]
+BLINN, NO_COOK_SHADOWING, COOK_SMITH = (
+    COOK_SHADOWING["blinn"],
+    COOK_SHADOWING["none"],
+    COOK_SHADOWING["smith"],
+)
 
 
 def vectorized(code, iopt) -> bool:
@@ -59,7 +65,7 @@ def vectorized(code, iopt) -> bool:
             iopt[1] == NO_SHADOWING or (iopt[0] in SMITH_KINDS and iopt[1] in SMITH_FORMS)
         )
     if code == COOK:
-        return iopt[2] != COOK_SHADOWING["smith"]
+        return True
     if code == MAXWELL:
         return iopt[0] in FACET_KINDS
     return code in (SINGLE, DIFFUSE)
@@ -133,7 +139,7 @@ def lane_options(code, iopt) -> tuple:
     if code == DIFFUSE:
         return (0, 0, 0)
     if code == COOK:  # the convention is one scale or another: read at run time
-        return (int(o0 == 1), RUNTIME, BLINN if o2 == BLINN else NO_COOK_SHADOWING)
+        return (int(o0 == 1), RUNTIME, o2)
     return (kind, NO_SHADOWING, o2)  # MAXWELL
 
 
@@ -197,7 +203,7 @@ def option_sets(code) -> list:
     if code == DIFFUSE:
         return [(0, 0, 0)]
     if code == COOK:
-        return [(a, RUNTIME, c) for a in (0, 1) for c in (NO_COOK_SHADOWING, BLINN)]
+        return [(a, RUNTIME, c) for a in (0, 1) for c in (NO_COOK_SHADOWING, BLINN, COOK_SMITH)]
     if code == MAXWELL:
         return [(k, NO_SHADOWING, c) for k in FACET_KINDS for c in (0, 1)]
     return []  # no lanes (FacetBTDF)
