@@ -322,6 +322,28 @@ def test_a_first_call_compiles_its_own_kernel_alone_and_says_so(tmp_path):
     assert cached == {"vector.run_range_diffuse_0_0_0"}, cached
 
 
+_COLD_BY_TYPE = """
+from scatterbench.models import kernels
+print(kernels.cold("diffuse", "float32", [], True))
+kernels.warm("diffuse", "float64", [], True)  # the scalar loop, float64
+print(kernels.cold("diffuse", "float64", [], True), kernels.cold("diffuse", "float32", [], True))
+kernels.warm("diffuse", "float32", [], True)
+print(kernels.cold("diffuse", "float32", [], True))
+"""
+
+
+def test_a_loop_cached_in_one_precision_is_cold_in_the_other(tmp_path):
+    """``kernels.cold`` asks the cache for the loop's signature, not only for its entry's index
+    file, which the float64 and float32 scalar loops share: a first report compiles the
+    float32 facet later, on a worker (``validation.report.build.compile_later``), which found it
+    "cached" after the float64 loop and left the speed section to compile it (3.5 s)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run(
+        [sys.executable, "-c", _COLD_BY_TYPE], env=env, capture_output=True, text=True, check=True
+    )
+    assert out.stdout.split() == ["True", "False", "True", "False"], out.stdout
+
+
 def test_warm_compiles_the_types_the_calls_use():
     """:func:`scatterbench.models.kernels.warm` compiles each entry for the argument types that
     :class:`~scatterbench.models.kernels.Compiled` passes it: after it, one geometry, 100, 5000

@@ -166,11 +166,18 @@ _READY = set()  # the entries this process has called (loaded from the cache or 
 _SAID = set()  # the kernels this process has said it compiles
 
 
-def uncached(fn) -> bool:
+def uncached(fn, sig=None) -> bool:
     """Whether numba's on-disk cache lacks the cached entry ``fn`` (False for a Python function:
-    ``NUMBA_DISABLE_JIT=1``)."""
+    ``NUMBA_DISABLE_JIT=1``); with ``sig`` (argument types), its compilation for those: an
+    entry's index holds each signature compiled (the scalar loops' float64 and float32), so
+    that its file alone said a float32 loop was cached once the float64 one was."""
     cache = getattr(fn, "_cache", None)
-    return cache is not None and not os.path.exists(cache._cache_file._index_path)
+    if cache is None or not os.path.exists(cache._cache_file._index_path):
+        return cache is not None
+    if sig is None:
+        return False
+    # numba's own key of an overload in the index (the index is {} when the source changed)
+    return cache._index_key(sig, fn.targetctx.codegen()) not in cache._cache_file._load_index()
 
 
 def _announced(fn):
@@ -272,7 +279,7 @@ def _warm_entries(kernel, precision, option_sets=None, scalar=True):
 
 def cold(kernel, precision="float64", option_sets=None, scalar=True) -> bool:
     """Whether a loop of :func:`warm`'s is not in the cache yet."""
-    return any(uncached(fn) for fn, _ in _warm_entries(kernel, precision, option_sets, scalar))
+    return any(uncached(fn, sig) for fn, sig in _warm_entries(kernel, precision, option_sets, scalar))
 
 
 def warm(kernel, precision="float64", option_sets=None, scalar=True):
