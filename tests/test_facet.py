@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from scatterbench import models, references
+from scatterbench.models.kernel_tolerance import kernel_tolerance
 from scatterbench.validation.numerics.flat import flat_coated_reflectance
 from scatterbench.validation.numerics.integrate import integrated_reflectance
 
@@ -62,7 +63,13 @@ def test_brdf_is_m00_and_jones_gives_mueller(rng):
     pr = rng.uniform(-4, 4, 300)
     M = m.mueller(ti, tr, pr)
     np.testing.assert_allclose(m.brdf(ti, tr, pr), M[:, 0, 0], rtol=1e-13, atol=0)
-    np.testing.assert_allclose(models.jones_to_mueller(m.jones(ti, tr, pr)), M, rtol=1e-12, atol=1e-300)
+    # the Jones matrices are numpy's, M the kernel's: within the kernel's tolerance of each
+    # geometry's M00 (models/kernel_tolerance.py), not of each element: an element far below
+    # M00 carries M00's roundings (relative to itself up to 2.9e-12 before the kernel's
+    # one-division Fresnel coefficients, 1.1e-10 after, 3e-15 of M00 both; ad hoc, seeds 0-2)
+    ref = models.jones_to_mueller(m.jones(ti, tr, pr))
+    err = np.max(np.abs(M - ref), axis=(1, 2)) / np.abs(ref[:, 0, 0])
+    assert np.max(err) <= kernel_tolerance(m), np.max(err)
 
 
 def test_broadcasting_and_chunks():

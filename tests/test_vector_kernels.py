@@ -101,6 +101,33 @@ def test_vector_loop_model_sets_and_broadcast_angles(model):
     assert np.array_equal(a, b)
 
 
+@pytest.mark.parametrize("shadowing", ["none", "smith"])
+def test_facet_lanes_coating_per_block_and_per_lane(shadowing):
+    """The facet loop on SIMD lanes takes its coating from a pass per block
+    (:func:`~scatterbench.models.kernels.vector.facet_prepass`): computed where a column of the
+    block is coated, ones and the outer angles where none is.  A model set whose coating is 1
+    in some columns and not in others, in blocks that hold both, blocks of only uncoated
+    columns and blocks of only coated ones (the first 300 columns 1, then alternating): the
+    scalar loop's bits, which read the coating per geometry."""
+    ti, tr, pr = _inputs()
+    n = ti.size
+    coat = np.where((np.arange(n) < 300) | (np.arange(n) % 2 == 0), 1.0, 1.5)
+    coat[-vector.VBLOCK // 2 :] = 1.5  # the last block: coated columns only
+
+    def facets(coating):
+        return models.SubsurfaceFacetBRDF(
+            slopes=models.GGXSlopes(0.2), coating=coating, substrate=1.37 + 7.62j, shadowing=shadowing
+        )
+
+    kernel = Compiled(facets(coat), *facets(coat)._kernel_spec())
+    assert kernel.vectorized
+    a, b = _both(kernel, ti, tr, pr)
+    assert np.array_equal(a, b)
+    _, c = _both(Compiled(facets(1.0), *facets(1.0)._kernel_spec()), ti, tr, pr)
+    assert np.array_equal(b[:, :300], c[:, :300])  # the uncoated blocks: the plain model's
+    assert not np.array_equal(b[:, 301], c[:, 301])  # a coated column is not
+
+
 @pytest.mark.parametrize("model", VECTORIZED[::3], ids=lambda m: type(m).__name__)
 def test_loops_read_parameter_columns_through_an_index(model):
     """An index (``drive.column``): geometry ``k`` reads parameter column ``index[k]`` of ``G``

@@ -111,7 +111,7 @@ def named(code, tag=""):
     return rename
 
 
-def own_kernel(fn, code, tag=""):
+def own_kernel(fn, code, tag="", **own):
     """``fn`` (a loop that calls the global ``_KERNEL``) compiled and cached as an entry of
     kernel ``code`` (:func:`named` after it and ``tag``), with ``_KERNEL`` that kernel: a global
     of ``fn``'s own (a copy of its module's globals).  numba calls a global dispatcher directly,
@@ -121,9 +121,12 @@ def own_kernel(fn, code, tag=""):
     The loop is written in the entry itself, not in a function it calls: numba optimizes and
     emits every compiled function's code, its callees' linked in, so that each level between
     the entry and the kernel cost a cold cache another pass over the inlined kernel (about 2 s a
-    Maxwell-Beard option set on SIMD lanes)."""
-    own = FunctionType(fn.__code__, dict(fn.__globals__, _KERNEL=KERNELS[code]), None, None, fn.__closure__)
-    return njit(cache=True, error_model="numpy", nogil=True)(named(code, tag)(own))
+    Maxwell-Beard option set on SIMD lanes).  ``own``: more globals of ``fn``'s (or another
+    ``_KERNEL``), set the same way."""
+    fresh = FunctionType(
+        fn.__code__, {**fn.__globals__, "_KERNEL": KERNELS[code], **own}, None, None, fn.__closure__
+    )
+    return njit(cache=True, error_model="numpy", nogil=True)(named(code, tag)(fresh))
 
 
 def entry(code):

@@ -24,22 +24,45 @@ def facet_jones(g, p, o):
 @njit(error_model="numpy", forceinline=True)
 def facet_jones_at(g, pol_i, pol_r, p, o):
     """:func:`facet_jones` given the polar angles' ``(cos, sin)`` (:func:`~scatterbench.models.kernels.common.polar`)."""
-    ti, tr, _, cp, sp = g
-    T = type(ti)
-    n, sub_r, sub_i = p[0], p[1], p[2]
+    return facet_jones_through(g, pol_i, pol_r, coating(pol_i, pol_r, p[0]), p, o)
+
+
+@njit(error_model="numpy", forceinline=True)
+def coating(pol_i, pol_r, n):
+    """The directions of polar ``(cos, sin)`` ``pol_i``, ``pol_r`` inside a smooth non-absorbing
+    coating ``n``: their sines and cosines ``(si, sr, ci, cr)``, the transmission coefficients
+    ``(tsi, tpi, tsr, tpr)`` into it and ``1 / n``; for ``n = 1`` the outer ones and ones.  Apart
+    from :func:`facet_jones_through`, so that the facet loop on SIMD lanes computes it only for
+    a block with a coating (:func:`scatterbench.models.kernels.vector.facet_prepass`: a vector
+    loop computes both sides of a branch)."""
     ci_e, si_e = pol_i
     cr_e, sr_e = pol_r
-    if n == T(1.0):
-        si, sr, ci, cr = si_e, sr_e, ci_e, cr_e
-    else:
-        inv_n = T(1.0) / n
-        si, sr = si_e * inv_n, sr_e * inv_n
-        ci, cr = coating_cos(ci_e, n), coating_cos(cr_e, n)
+    T = type(ci_e)
+    one = T(1.0)
+    if n == one:
+        return si_e, sr_e, ci_e, cr_e, one, one, one, one, one
+    inv_n = one / n
+    tsi, tpi = coating_t(ci_e, n)
+    tsr, tpr = coating_t(cr_e, n)
+    return si_e * inv_n, sr_e * inv_n, coating_cos(ci_e, n), coating_cos(cr_e, n), tsi, tpi, tsr, tpr, inv_n
+
+
+@njit(error_model="numpy", forceinline=True)
+def facet_jones_through(g, pol_i, pol_r, coat, p, o):
+    """:func:`facet_jones_at` given the :func:`coating`'s values ``coat`` (its transmission
+    coefficients applied as they are: ones leave the bits alone)."""
+    ti, tr, _, cp, sp = g
+    T = type(ti)
+    sub_r, sub_i = p[1], p[2]
+    ci_e, cr_e = pol_i[0], pol_r[0]
+    si, sr, ci, cr, tsi, tpi, tsr, tpr, inv_n = coat
     hx = sr * cp - si
     hy = sr * sp
     hz = cr + ci
     g = hx * hx + hy * hy + hz * hz
-    inv_hz = T(1.0) / hz
+    # 1 / hz and 1 / g by one division (hz >= cos of the larger polar angle, g >= hz^2: in range)
+    inv_hzg = T(1.0) / (hz * g)
+    inv_hz, inv_g = g * inv_hzg, hz * inv_hzg
     dens = p3(o[0], hx * inv_hz, hy * inv_hz, p[3], p[4], p[5], p[6])
     q = g * inv_hz * inv_hz
     S = dens * q * q / (T(4.0) * ci_e * cr_e)
@@ -50,17 +73,13 @@ def facet_jones_at(g, pol_i, pol_r, p, o):
         rc, rs = rotation(o[0], p[5])
         S = S * smith_g(o[1], o[0], (ci, si, -T(1.0), T(0.0)), (cr, sr, cp, sp), p[3], p[4], rc, rs)
     c = T(0.5) * sqrt(g)
-    rsr, rsi, kr, ki = rs_k(c, sub_r / n, sub_i / n, sub_r == T(math.inf))
-    inv_g = T(1.0) / g
+    rsr, rsi, kr, ki = rs_k(c, sub_r * inv_n, sub_i * inv_n, sub_r == T(math.inf))
     ho_s, ho_p = si * sp, cr * cp * si + sr * ci
     hi_s, hi_p = sr * sp * inv_g, (ci * sr * cp + si * cr) * inv_g
     d_ss, d_ps, d_sp, d_pp = cp, -sp * ci, -cr * sp, sr * si - cr * cp * ci
-    if n != T(1.0):
-        tsi, tpi = coating_t(ci_e, n)
-        tsr, tpr = coating_t(cr_e, n)
-        ho_s, ho_p, hi_s, hi_p = ho_s * tsr, ho_p * tpr, hi_s * tsi, hi_p * tpi
-        d_ss, d_ps = d_ss * (tsr * tsi), d_ps * (tsr * tpi)
-        d_sp, d_pp = d_sp * (tpr * tsi), d_pp * (tpr * tpi)
+    ho_s, ho_p, hi_s, hi_p = ho_s * tsr, ho_p * tpr, hi_s * tsi, hi_p * tpi
+    d_ss, d_ps = d_ss * (tsr * tsi), d_ps * (tsr * tpi)
+    d_sp, d_pp = d_sp * (tpr * tsi), d_pp * (tpr * tpi)
     root = sqrt(S)
     r_re, r_im = rsr * root, rsi * root
     k_re = kr * root - T(2.0) * r_re
@@ -82,6 +101,19 @@ def facet_jones_at(g, pol_i, pol_r, p, o):
 def facet(geo, p, o):
     """:class:`scatterbench.models.FacetBRDF` and :class:`scatterbench.models.SubsurfaceFacetBRDF` at one geometry."""
     a, b, c, d, e, f, g, h = facet_jones(geo, p, o)
+    return mueller16(a, b, c, d, e, f, g, h)
+
+
+@njit(error_model="numpy", forceinline=True)
+def facet_lanes(ge, p, o):
+    """:func:`facet` on SIMD lanes: ``ge`` the geometry followed by its polar angles' cosines and
+    sines and its :func:`coating`'s values, which
+    :func:`scatterbench.models.kernels.vector.facet_prepass` computed for the block."""
+    pol_i, pol_r = (ge[5], ge[6]), (ge[7], ge[8])
+    coat = (ge[9], ge[10], ge[11], ge[12], ge[13], ge[14], ge[15], ge[16], ge[17])
+    a, b, c, d, e, f, g, h = facet_jones_through(
+        (ge[0], ge[1], ge[2], ge[3], ge[4]), pol_i, pol_r, coat, p, o
+    )
     return mueller16(a, b, c, d, e, f, g, h)
 
 

@@ -15,7 +15,11 @@ block of :data:`VBLOCK` geometries:
    (the kernels use :mod:`~scatterbench.models.kernels.vector_math`, and ``error_model="numpy"`` lets a
    division by zero give inf, as numpy's, instead of raising); all reads and writes are in
    the one scratch at fixed offsets, so no overlap test is needed;
-3. the block's result rows are copied to ``out``.
+3. the block's result rows are copied to ``out`` (:func:`put`).
+
+The facet kernel's block first takes its polar angles' cosines and sines and its coating in a
+pass of its own (:func:`facet_prepass`), which skips the coating's refraction where the
+block has none; its loop (:func:`~scatterbench.models.kernels.facet.facet_lanes`) reads them.
 
 The kernels are the same functions as the scalar loop's, so both give the same bits
 (``tests/test_vector_kernels.py``).  :func:`vectorized` says which models and options take this
@@ -35,15 +39,18 @@ from numba import njit
 from numba.core import config
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
-from .common import NO_SHADOWING, azimuths
+from .common import NO_SHADOWING, azimuths, polar
 from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, column, own_kernel
+from .facet import coating, facet_lanes
 
-#: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (55 kB), stays
+#: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
 #: in the L2 cache
 VBLOCK = 256
-#: scratch rows: angles, azimuth cosine and sine, the 16 result rows, the parameters
+#: scratch rows: angles, azimuth cosine and sine, the 16 result rows, the parameters, and the
+#: facet kernel's polar cosines and sines and coating (:func:`facet_prepass`)
 _TI, _TR, _PR, _CP, _SP, _OUT, _PRM = 0, 1, 2, 3, 4, 5, 21
-_ROWS = _PRM + PARAM_ROWS
+_PRE = _PRM + PARAM_ROWS
+_ROWS = _PRE + 13
 #: the facet kernel's slope kinds that vectorize (the anisotropic ones rotate by a parameter
 #: through the C library's cosine; the unit one is left to the scalar loop: each kind costs
 #: about 2 s of compilation)
@@ -89,6 +96,57 @@ def _geometry(sc, k):
 
 
 @njit(error_model="numpy", inline="always")
+def _facet_geometry(sc, k):
+    """:func:`_geometry` followed by the rows :func:`facet_prepass` filled (:func:`~scatterbench.models.kernels.facet.facet_lanes`' ``ge``)."""
+    return _geometry(sc, k) + (
+        _at(sc, _PRE, k), _at(sc, _PRE + 1, k), _at(sc, _PRE + 2, k), _at(sc, _PRE + 3, k),
+        _at(sc, _PRE + 4, k), _at(sc, _PRE + 5, k), _at(sc, _PRE + 6, k), _at(sc, _PRE + 7, k),
+        _at(sc, _PRE + 8, k), _at(sc, _PRE + 9, k), _at(sc, _PRE + 10, k), _at(sc, _PRE + 11, k),
+        _at(sc, _PRE + 12, k),
+    )  # fmt: skip
+
+
+@njit(error_model="numpy")
+def facet_prepass(sc, m):
+    """The facet kernel's polar cosines and sines, and its :func:`~scatterbench.models.kernels.facet.coating`
+    for the block's ``m`` geometries, into the scratch rows from :data:`_PRE`: the coating's own
+    loop only where a column of the block has one (``n != 1``), otherwise its values for
+    ``n = 1``, the outer angles and ones.  A loop on SIMD lanes computes both sides of a branch,
+    so that the coating inside the kernel's loop (two square roots and two divisions a geometry)
+    cost an uncoated FacetBRDF about 7% of its time; a loop per case (its kernel compiled twice)
+    cost 1.1 s of a cold cache per option set (5.6 s for a report's five), this pass about 0.2 s
+    (both ad hoc: ``kernels.warm`` of the five in a fresh process, an empty cache)."""
+    coated = 0
+    for k in range(m):
+        coated += _at(sc, _PRM, k) != 1.0
+    if coated:
+        for k in range(m):
+            _coating_at(sc, k, _at(sc, _PRM, k))
+    else:
+        for k in range(m):
+            _coating_at(sc, k, 1.0)
+
+
+@njit(error_model="numpy", inline="always")
+def _coating_at(sc, k, n):
+    """Geometry ``k``'s polar cosines and sines and their
+    :func:`~scatterbench.models.kernels.facet.coating` into its 13 scratch rows (written out, as
+    :func:`_store`)."""
+    pol_i, pol_r = polar(_at(sc, _TI, k)), polar(_at(sc, _TR, k))
+    v = coating(pol_i, pol_r, n)
+    B, o = VBLOCK, _PRE * VBLOCK + k
+    sc[o], sc[o + B], sc[o + 2 * B], sc[o + 3 * B] = pol_i[0], pol_i[1], pol_r[0], pol_r[1]
+    o += 4 * B
+    sc[o], sc[o + B], sc[o + 2 * B], sc[o + 3 * B], sc[o + 4 * B] = v[0], v[1], v[2], v[3], v[4]
+    sc[o + 5 * B], sc[o + 6 * B], sc[o + 7 * B], sc[o + 8 * B] = v[5], v[6], v[7], v[8]
+
+
+@njit(error_model="numpy", inline="always")
+def _no_prepass(sc, m):
+    """The other kernels' (their loop computes all it needs)."""
+
+
+@njit(error_model="numpy", inline="always")
 def _scratch_params(sc, k):
     """Geometry ``k``'s parameters (:func:`gather` copied them)."""
     return (_at(sc, _PRM, k), _at(sc, _PRM + 1, k), _at(sc, _PRM + 2, k), _at(sc, _PRM + 3, k),
@@ -122,6 +180,19 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     for r in range(rows):  # a single model's too: the loop then reads them as a set's
         for k in range(m):
             sc[(_PRM + r) * VBLOCK + k] = prm[r, column(index, p, lo + k)]
+
+
+@njit(error_model="numpy")
+def put(out, sc, at, m):
+    """The block's ``m`` result columns of every row of ``out`` from the scratch into
+    ``out[:, at:at + m]``.  Unsigned indices: with signed ones numba adds a negative index's
+    wraparound to every store, which kept this copy scalar, a third of the FacetBRDF loop's
+    time (perf, 10^5 geometries on one thread)."""
+    base, w = np.uint64(at), np.uint64(m)
+    for r in range(out.shape[0]):
+        o = np.uint64((_OUT + r) * VBLOCK)
+        for k in range(w):
+            out[r, base + k] = sc[o + k]
 
 
 def lane_options(code, iopt) -> tuple:
@@ -176,13 +247,17 @@ def entry(code, opts):
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
             gather(sc, ti, tr, pr, prm, index, blo, m, turns, rows)
+            _PREPASS(sc, m)  # noqa: F821
             for k in range(m):
-                _store(sc, k, _KERNEL(_geometry(sc, k), _scratch_params(sc, k), o))  # noqa: F821
-            for r in range(out.shape[0]):
-                for k in range(m):
-                    out[r, start + blo + k] = sc[(_OUT + r) * VBLOCK + k]
+                _store(sc, k, _KERNEL(_GEOMETRY(sc, k), _scratch_params(sc, k), o))  # noqa: F821
+            put(out, sc, start + blo, m)
 
-    return own_kernel(run_range, code, "_".join("r" if k == RUNTIME else str(k) for k in opts))
+    tag = "_".join("r" if k == RUNTIME else str(k) for k in opts)
+    if code == FACET:  # its coating computed apart (facet_prepass), per block
+        return own_kernel(
+            run_range, code, tag, _KERNEL=facet_lanes, _GEOMETRY=_facet_geometry, _PREPASS=facet_prepass
+        )
+    return own_kernel(run_range, code, tag, _GEOMETRY=_geometry, _PREPASS=_no_prepass)
 
 
 #: numba's cache directory when this module was imported (:mod:`scatterbench.models.kernels`

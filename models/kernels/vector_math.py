@@ -231,9 +231,13 @@ def hypot(x, y):
     hi, lo = max(ax, ay), min(ax, ay)
     # (2^1022 at most: inverse_binade's scale of the top binade, 2^-1023, is not a normal
     # number; from there ``a`` is in [2, 4), as harmless)
-    scale = inverse_binade(min(hi, _TOP) if hi > 0.0 else 1.0)
+    e = (_to_bits(min(hi, _TOP) if hi > 0.0 else 1.0) >> 52) & 0x7FF
+    scale = _from_bits((2046 - e) << 52)  # inverse_binade's
+    # its inverse (2^-1023, subnormal, for a subnormal hi): a product, not a division, the same
+    # correctly rounded scaling of the same number (the divider is the lanes' narrowest unit)
+    back = _from_bits(e << 52) if e > 0 else _from_bits(np.int64(1) << 51)
     a, b = hi * scale, lo * scale
-    return sqrt(a * a + b * b) / scale
+    return sqrt(a * a + b * b) * back
 
 
 @njit(error_model="numpy", forceinline=True)
