@@ -67,6 +67,10 @@ def _fit_args(out, *extra):
     ]  # fmt: skip
 
 
+def _sigint_default():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_ctrl_c_during_a_fit_says_how_to_resume_in_one_line(tmp_path, workers):
     """SIGINT to the whole process group, as a terminal's Ctrl-C sends it (workers included).
@@ -79,6 +83,9 @@ def test_ctrl_c_during_a_fit_says_how_to_resume_in_one_line(tmp_path, workers):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        # as a terminal's foreground job: a suite run in the background (``pytest &``, nohup)
+        # ignores SIGINT, its children inherit that (POSIX), and the fit never saw the Ctrl-C
+        preexec_fn=_sigint_default,
     )
     try:
         deadline = time.monotonic() + 300
