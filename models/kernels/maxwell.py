@@ -9,7 +9,7 @@ import math
 from numba import njit
 
 from .common import diag16, mueller16, polar_from, scaled16
-from .facet import facet_jones_at
+from .facet import coating, facet_jones_through
 from .vector_math import atan2, exp_neg, sincos, sqrt
 
 
@@ -44,7 +44,10 @@ def maxwell(geo, p, o):
     pol_i, pol_r = polar_from(c_i, ti), polar_from(c_r, tr)
     ci, cr = pol_i[0], pol_r[0]
     so = shadow(T(s_i), ci, T(s_r), cr, cp, sp, p[9], p[10])
-    a, b, c, d, e, f, g, h = facet_jones_at(geo, pol_i, pol_r, p, o)
+    # uncoated (its coating row is 1, MaxwellBeardBRDF._kernel_spec): the constant folds the
+    # coating away, where reading the row had a loop on SIMD lanes compute it for every geometry
+    coat = coating(pol_i, pol_r, T(1.0))
+    a, b, c, d, e, f, g, h = facet_jones_through(geo, pol_i, pol_r, coat, p, o)
     if o[2] == 1:
         m = scaled16(mueller16(a, b, c, d, e, f, g, h), so)
     else:
