@@ -156,9 +156,9 @@ def rs_k(c, mr, mi, pec):
     if mr == T(1.0) and mi == T(0.0):
         return T(0.0), T(0.0), T(0.0), T(0.0)
     m2r, m2i, wr, wi = refraction_w(c, mr, mi)
-    cwr, cwi = c + wr, wi
     if T(1e-300) > T(0.0):  # float64: one division (its products stay in range; below)
         return _rs_k64(c, m2r, m2i, wr, wi)
+    cwr, cwi = c + wr, wi
     rsr, rsi = cdiv(c - wr, -wi, cwr, cwi)
     # 2 (1 - m^2) / (m^2 c + w) / (c + w): two divisions, not one by the product, which
     # overflows float32 from |m| ~ 7e12 (|m^2 c + w| |c + w| ~ |m|^3; float32's largest: 3.4e38)
@@ -192,18 +192,26 @@ def _rs_k64(c, m2r, m2i, wr, wi):
 
 
 @njit(error_model="numpy", forceinline=True)
+def coating_w(c, n):
+    """``w = n cos(theta_t) = sqrt(n^2 - 1 + c^2)`` of refraction into a non-absorbing coating
+    ``n`` at external cosine ``c``: what :func:`coating_cos` and :func:`coating_t` share."""
+    T = type(c)
+    return sqrt(n * n - T(1.0) + c * c)
+
+
+@njit(error_model="numpy", forceinline=True)
 def coating_cos(c, n):
     """Cosine of the refracted angle in a non-absorbing coating ``n`` from the external cosine
     ``c`` (:func:`scatterbench.models.fresnel.coating_cos`: no cancellation near grazing)."""
     T = type(c)
-    return sqrt(n * n - T(1.0) + c * c) * (T(1.0) / n)
+    return coating_w(c, n) * (T(1.0) / n)
 
 
 @njit(error_model="numpy", forceinline=True)
-def coating_t(c, n):
-    """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`scatterbench.models.fresnel.coating_transmission`)."""
+def coating_t(c, n, w):
+    """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`scatterbench.models.fresnel.coating_transmission`),
+    given :func:`coating_w`'s ``w``."""
     T = type(c)
-    w = sqrt(n * n - T(1.0) + c * c)
     a, b = c + w, n * n * c + w
     if T(1e-300) > T(0.0):  # float64: one division (a b ~ n^3 is in range for any index)
         r = T(2.0) * c / (a * b)
@@ -324,13 +332,18 @@ def smith_lambda(kind, c, s, cphi, sphi, sx, sy, cr, sr):
     Smith ``G``: isotropic or elliptical by its parameters)."""
     T = type(c)
     mu = abs(c) / s if s > T(0.0) else T(math.inf)
+    return lam_unit(kind, mu / smith_width(kind, cphi, sphi, sx, sy, cr, sr))
+
+
+@njit(error_model="numpy", forceinline=True)
+def smith_width(kind, cphi, sphi, sx, sy, cr, sr):
+    """The slopes' width along a direction of azimuth ``(cphi, sphi)``: ``sx`` for the isotropic
+    kinds, the ellipse's radius (rotated by ``(cr, sr)``) for the elliptical ones."""
     if kind == GAUSSIAN or kind == GGX:
-        alpha = sx
-    else:
-        cl = cphi * cr + sphi * sr
-        sl = sphi * cr - cphi * sr
-        alpha = sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
-    return lam_unit(kind, mu / alpha)
+        return sx
+    cl = cphi * cr + sphi * sr
+    sl = sphi * cr - cphi * sr
+    return sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
 
 
 @njit(error_model="numpy", forceinline=True)
@@ -340,12 +353,7 @@ def smith_h(kind, c, s, cphi, sphi, sx, sy, cr, sr):
     = (h_i + h_o) / 2``, which :func:`smith_g` divides by once (three divisions a direction
     fewer than through ``Lambda``).  ``h`` is infinite at grazing (``c = 0``: ``G = 0``, as
     ``Lambda``'s infinity gives) and 1 at normal incidence (``s = 0``)."""
-    if kind == GGX:
-        alpha = sx
-    else:
-        cl = cphi * cr + sphi * sr
-        sl = sphi * cr - cphi * sr
-        alpha = sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
+    alpha = smith_width(kind, cphi, sphi, sx, sy, cr, sr)
     return type(c)(hypot(type(c)(1.0), alpha * s / abs(c)))
 
 

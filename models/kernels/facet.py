@@ -9,7 +9,7 @@ import math
 
 from numba import njit
 
-from .common import NO_SHADOWING, coating_cos, coating_t, mueller16, p3, polar, rotation, rs_k, smith_g
+from .common import NO_SHADOWING, coating_t, coating_w, mueller16, p3, polar, rotation, rs_k, smith_g
 from .vector_math import sqrt
 
 
@@ -42,9 +42,10 @@ def coating(pol_i, pol_r, n):
     if n == one:
         return si_e, sr_e, ci_e, cr_e, one, one, one, one, one
     inv_n = one / n
-    tsi, tpi = coating_t(ci_e, n)
-    tsr, tpr = coating_t(cr_e, n)
-    return si_e * inv_n, sr_e * inv_n, coating_cos(ci_e, n), coating_cos(cr_e, n), tsi, tpi, tsr, tpr, inv_n
+    wi, wr = coating_w(ci_e, n), coating_w(cr_e, n)  # one root a direction: cosine and t's
+    tsi, tpi = coating_t(ci_e, n, wi)
+    tsr, tpr = coating_t(cr_e, n, wr)
+    return si_e * inv_n, sr_e * inv_n, wi * inv_n, wr * inv_n, tsi, tpi, tsr, tpr, inv_n
 
 
 @njit(error_model="numpy", forceinline=True)

@@ -125,8 +125,16 @@ def inverse_binade(x):
     """``2^-e`` for the float64 ``x > 0`` of exponent ``e`` (``1 <= x 2^-e < 2`` for a normal
     ``x``): an exact scale that brings ``x`` near 1 without a division (subnormal ``x``: the
     scale ``2^1023``, which still lifts it above 1e-16)."""
+    return binade_scales(x)[0]
+
+
+@njit(error_model="numpy", forceinline=True)
+def binade_scales(x):
+    """:func:`inverse_binade`'s scale and its inverse (``2^-1023``, subnormal, for a subnormal
+    ``x``), both exact: a product by the inverse undoes the scaling without a division (the
+    same correctly rounded number; the divider is the SIMD lanes' narrowest unit)."""
     e = (_to_bits(np.float64(x)) >> 52) & 0x7FF
-    return _from_bits((2046 - e) << 52)
+    return _from_bits((2046 - e) << 52), (_from_bits(e << 52) if e > 0 else _from_bits(np.int64(1) << 51))
 
 
 @intrinsic
@@ -231,11 +239,7 @@ def hypot(x, y):
     hi, lo = max(ax, ay), min(ax, ay)
     # (2^1022 at most: inverse_binade's scale of the top binade, 2^-1023, is not a normal
     # number; from there ``a`` is in [2, 4), as harmless)
-    e = (_to_bits(min(hi, _TOP) if hi > 0.0 else 1.0) >> 52) & 0x7FF
-    scale = _from_bits((2046 - e) << 52)  # inverse_binade's
-    # its inverse (2^-1023, subnormal, for a subnormal hi): a product, not a division, the same
-    # correctly rounded scaling of the same number (the divider is the lanes' narrowest unit)
-    back = _from_bits(e << 52) if e > 0 else _from_bits(np.int64(1) << 51)
+    scale, back = binade_scales(min(hi, _TOP) if hi > 0.0 else 1.0)
     a, b = hi * scale, lo * scale
     return sqrt(a * a + b * b) * back
 

@@ -117,9 +117,8 @@ def _run_sections(ctx, specs):
         for spec in sorted(specs, key=lambda sp: sp.stage):
             bar.set_postfix_str(spec.id)
             if spec.compiles and late is not None:
-                wait_for(
-                    [late]
-                )  # then its loops load from the cache; a failed compile leaves it to compile them
+                # then its loops load from the cache; a failed compile leaves it to compile them
+                wait_for([late])
             computed = early.pop(spec.id, None) or _computed(ctx, spec)
             done[spec.id] = _rendered(ctx, spec, computed)
             ctx.cache["section_times"][spec.id] = done[spec.id].seconds
