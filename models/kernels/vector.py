@@ -112,7 +112,7 @@ def facet_prepass(sc, m):
     for the block's ``m`` geometries, into the scratch rows from :data:`_PRE`: the coating's own
     loop only where a column of the block has one (``n != 1``), otherwise its values for
     ``n = 1``, the outer angles and ones.  A loop on SIMD lanes computes both sides of a branch,
-    so that the coating inside the kernel's loop (two square roots and two divisions a geometry)
+    so that the coating inside the kernel's loop (two square roots and three divisions a geometry)
     cost an uncoated FacetBRDF about 7% of its time; a loop per case (its kernel compiled twice)
     cost 1.1 s of a cold cache per option set (5.6 s for a report's five), this pass about 0.2 s
     (both ad hoc: ``kernels.warm`` of the five in a fresh process, an empty cache)."""
