@@ -21,6 +21,7 @@ from .facet_btdf import FacetBTDF
 from .phase import HenyeyGreenstein
 from .single_scatter import SingleScatterBRDF
 from .rough_diffuse import RoughDiffuseBRDF
+from .rough_subsurface import RoughSubsurfaceBRDF
 from .combination import mueller_with_error
 from .maxwell_beard import MaxwellBeardBRDF
 from .aperture import DetectorAperture
@@ -99,6 +100,7 @@ __all__ = [
     "DiffuseSubsurfaceBRDF",
     "FacetBTDF",
     "RoughDiffuseBRDF",
+    "RoughSubsurfaceBRDF",
     "mueller_with_error",
     "MaxwellBeardBRDF",
     "DetectorAperture",

@@ -38,7 +38,8 @@ its kernel of its own, :func:`~scatterbench.models.kernels.drive.own_kernel`, so
 compiles only the kernels its models use, and the loop written in the entry: each compiled
 level between an entry and its kernel cost another optimization of the inlined kernel), ``angles_ok``
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
-``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.aperture`'s
+``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.rough`'s ``_moments``,
+``_element_tables`` and ``write``, :mod:`~scatterbench.models.kernels.aperture`'s
 ``nodes`` and ``_tiles``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
 holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached
@@ -145,7 +146,7 @@ with _caching_in(cache_dir()):
     # every module with a cached entry, those the models import themselves too (montecarlo:
     # RoughDiffuseBRDF's Monte Carlo; aperture, disc: DetectorAperture's and PointSourceBRDF's
     # node algebra): one first imported elsewhere would cache beside the package
-    from . import aperture, disc, drive, montecarlo, vector  # noqa: E402, F401  (decorated here, cached there)
+    from . import aperture, disc, drive, montecarlo, rough, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
 def rbar_integrand():
@@ -256,6 +257,8 @@ def _other_entries(name):
             (drive.angles_ok, (a1, a1, a1)),
             (drive.outside_range, (a1, f, f, types.Array(i, 1, "C"), i, i)),
         ]
+    if name == "rough":  # RoughSubsurfaceBRDF
+        return rough.signatures()
     if name == "disc":  # PointSourceBRDF's disc quadrature
         return [(disc.points, (f, f, a1, a1, types.Array(b, 1, "C"), a1, a1) + (a2,) * 6)]
     raise KeyError(name)
@@ -285,7 +288,7 @@ def cold(kernel, precision="float64", option_sets=None, scalar=True) -> bool:
 def warm(kernel, precision="float64", option_sets=None, scalar=True):
     """Compile (or load from the cache) the loops of kernel ``kernel`` (a name of
     :data:`~scatterbench.models.kernels.drive.CODES`, or ``"montecarlo"``, ``"aperture"``,
-    ``"disc"``: those modules' entries) that :class:`Compiled` may call in
+    ``"disc"``, ``"rough"``: those modules' entries) that :class:`Compiled` may call in
     ``precision`` (the vector ones of ``option_sets`` only, when given; the scalar one unless
     ``scalar`` is false), for the argument types
     it passes, without running them: a first run compiles the kernels on its worker processes

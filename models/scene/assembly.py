@@ -17,6 +17,7 @@ from ..facet import FacetBRDF
 from ..maxwell_beard import MaxwellBeardBRDF
 from ..phase import HenyeyGreenstein
 from ..rough_diffuse import RoughDiffuseBRDF
+from ..rough_subsurface import RoughSubsurfaceBRDF
 from ..single_scatter import SingleScatterBRDF
 from ..slopes import GaussianSlopes
 from ..subsurface_facet import SubsurfaceFacetBRDF
@@ -137,6 +138,13 @@ def _volume_mechanisms(out, v, n, rough_top, top, monte_carlo):
     """Seed 003: volume scattering in the binder (index = the coating's); ``monte_carlo``:
     :func:`monte_carlo_volume`."""
     phase = HenyeyGreenstein(g=v["g"], polarized=v["polarized"])
+    if monte_carlo and v.get("method") == "quadrature":
+        model = RoughSubsurfaceBRDF(slopes=rough_top, coating=n, rho=v["rho"])
+        why = (
+            "a diffuser under a rough interface: seed 003 Sec. 2.5's totally diffuse term, its "
+            "expectation over facet pairs by quadrature (the rough surface's reflection is its own term)"
+        )
+        return out + [Mechanism("volume under a rough interface (quadrature)", model, why)]
     if monte_carlo:
         # The Monte Carlo model carries the direct reflection by the rough surface
         # (surface=True), so the separate rough-surface facet term is replaced.

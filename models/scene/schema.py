@@ -390,7 +390,7 @@ def _slope_keys_apply(path, s, kind, entry):
 def _volume(path, v, coating):
     """``[volume]``: a pigment in the binder (seed 003).  The binder's index is the
     coating's, so a ``[coating]`` table is required."""
-    _unknown(path, "[volume] ", v, set(VOLUME) | {"single", "interface"})
+    _unknown(path, "[volume] ", v, set(VOLUME) | {"single", "interface", "method"})
     if coating is None:
         raise _err(path, "[volume]", "needs a [coating] table: its index is the binder's index")
     out = {}
@@ -415,8 +415,9 @@ def _volume(path, v, coating):
             "not with a [volume] under the rough coating (interface = 'rough'): its Monte Carlo model "
             "carries the rough surface's reflection and has no shadowing; use interface = 'smooth' or omit it",
         )
+    out["method"] = _volume_method(path, v, coating, out, monte_carlo)
     for key in ("pairs", "seed"):
-        if key in v and not monte_carlo:
+        if key in v and (not monte_carlo or out["method"] == "quadrature"):
             raise _err(
                 path,
                 f"[volume] {key}",
@@ -428,6 +429,38 @@ def _volume(path, v, coating):
             path, "[volume] single_weight", "only with single = true (the weight of single scattering)"
         )
     return out
+
+
+def _volume_method(path, v, coating, out, monte_carlo):
+    """``[volume] method``: under the rough coating, ``"monte-carlo"`` (default: seed 003 Sec.
+    2.5, :class:`scatterbench.models.RoughDiffuseBRDF`) or ``"quadrature"`` (its totally diffuse
+    term's expectation, :class:`scatterbench.models.RoughSubsurfaceBRDF`: no single scattering,
+    Gaussian slopes)."""
+    method = v.get("method", "monte-carlo")
+    if method not in ("monte-carlo", "quadrature"):
+        raise _err(path, "[volume] method", f"must be 'monte-carlo' or 'quadrature'; got {method!r}")
+    if method == "monte-carlo":
+        return method
+    if not monte_carlo:
+        raise _err(
+            path,
+            "[volume] method",
+            "only under a rough coating (a [coating.roughness] with interface = 'rough')",
+        )
+    if out["single"]:
+        raise _err(
+            path,
+            "[volume] method",
+            "'quadrature' computes the totally diffuse term alone: set single = false "
+            "(single scattering under a rough interface is the Monte Carlo model's)",
+        )
+    if type(coating["roughness"]).__name__ != "GaussianSlopes":
+        raise _err(
+            path,
+            "[volume] method",
+            "'quadrature' integrates Gaussian slopes: [coating.roughness] distribution = 'gaussian'",
+        )
+    return method
 
 
 def _detector(path, d):
