@@ -5,11 +5,12 @@ time goes.
     python benchmarks/ptfe_joint_fit.py [--scene FILE] [--walkers W] [--max-steps N]
                                         [--threads T] [--seed S] [--moves de|stretch] [--burn B]
 
-Default scene: ``references/scenes/ptfe_smooth_diffuse_joint.toml`` (facets + totally diffuse
-subsurface under a smooth interface; 11 free parameters: roughness, albedo per wavelength, a
-Cauchy index, calibration, incidence offset, two noise levels), the fastest of seed 003's
-physical models that binds to a model set.  Which model is best is the model comparison's
-question (issue 29 part 4); this measures the speed of a joint fit.
+Default scene: ``references/scenes/ptfe_rough_diffuse_joint.toml`` (facets + totally diffuse
+subsurface under the rough interface, by quadrature; 11 free parameters: roughness, albedo per
+wavelength, a Cauchy index, calibration, incidence offset, two noise levels): the best physical
+model of the joint comparison (docs/guide/ptfe.md, "`rough_diffuse` jointly"), the fit issue
+29's 120 s is about.  ``--scene references/scenes/ptfe_smooth_diffuse_joint.toml``: the
+smooth-interface model, the figures of the sessions before.
 
 The run is ``run_fit`` (optimum, then emcee, every walker of a step in one call) with a step
 budget; the script prints the chain's own evaluations per second, the autocorrelation time it
@@ -86,7 +87,7 @@ def _elements_first(lik, U):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scene", default=os.path.join(ROOT, "references/scenes/ptfe_smooth_diffuse_joint.toml"))
+    ap.add_argument("--scene", default=os.path.join(ROOT, "references/scenes/ptfe_rough_diffuse_joint.toml"))
     ap.add_argument("--walkers", type=int, default=24)
     ap.add_argument("--max-steps", type=int, default=20000)
     ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS, help="numba threads")

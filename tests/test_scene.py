@@ -415,3 +415,51 @@ def test_monte_carlo_volume_is_one_rule(rough, interface):
                 scene.loads(text + extra, "v.toml")
         else:
             assert scene.loads(text + extra, "v.toml").mechanisms()
+
+
+_ROUGH = (
+    BASE
+    + "[coating]\nindex = 1.4\n[coating.roughness]\ndistribution = 'gaussian'\nsigma = 0.3\n"
+    + "[volume]\nrho = 0.9\nsingle = false\ninterface = 'rough'\n"
+)
+
+
+def test_quadrature_volume_is_the_facet_term_plus_the_expected_diffuser():
+    """``[volume] method = 'quadrature'``: the rough surface's facet reflection and
+    RoughSubsurfaceBRDF, the Monte Carlo's direct reflection and totally diffuse term without
+    its statistical error (within 4 standard errors of it at 2e5 pairs)."""
+    sc = scene.loads(_ROUGH + "method = 'quadrature'\n", "q.toml")
+    assert [type(m.model) for m in sc.mechanisms()] == [models.FacetBRDF, models.RoughSubsurfaceBRDF]
+    mc = scene.loads(_ROUGH + "pairs = 200000\n", "m.toml").build()
+    ti, tr, pr = np.array([0.2, 0.9]), np.array([0.6, 1.1]), np.array([0.4, 2.0])
+    M, err = mc.mueller_with_error(ti, tr, pr)
+    Q = sc.build().mueller(ti, tr, pr)
+    live = err > 0
+    assert np.max(np.abs(M - Q)[live] / err[live]) < 4.0
+
+
+@pytest.mark.parametrize(
+    "extra, key",
+    [
+        ("method = 'exact'\n", "[volume] method"),
+        ("method = 'quadrature'\npairs = 100\n", "[volume] pairs"),
+        ("method = 'quadrature'\nseed = 1\n", "[volume] seed"),
+    ],
+)
+def test_quadrature_volume_errors(extra, key):
+    with pytest.raises(scene.SceneError, match=re.escape(f"v.toml: {key}")):
+        scene.loads(_ROUGH + extra, "v.toml")
+
+
+@pytest.mark.parametrize(
+    "text, why",
+    [
+        (_ROUGH.replace("single = false", "single = true") + "method = 'quadrature'\n", "single = false"),
+        (_ROUGH.replace("'gaussian'", "'exponential'") + "method = 'quadrature'\n", "Gaussian"),
+        (_ROUGH.replace("interface = 'rough'", "interface = 'smooth'") + "method = 'quadrature'\n", "rough"),
+    ],
+)
+def test_quadrature_volume_refuses_what_it_does_not_compute(text, why):
+    with pytest.raises(scene.SceneError, match=r"v\.toml: \[volume\] method") as exc:
+        scene.loads(text, "v.toml")
+    assert why in str(exc.value)
