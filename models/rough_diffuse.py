@@ -52,6 +52,10 @@ implementation here, the reference the tests hold the kernel to (1e-12 relative 
 direct reflection by the exposed rough surface (:class:`scatterbench.models.FacetBRDF`
 with substrate ``n``, the coating's index) is added (deterministic, zero error).  No shadowing, as
 in the paper.
+
+Without single scattering (``single = 0``) the two facets of a path are independent and the
+estimate's expectation is a product of one factor per direction: :class:`RoughSubsurfaceBRDF`
+computes it by quadrature (Gaussian slopes), with no Monte Carlo error, fast enough for a fit.
 """
 
 from __future__ import annotations
