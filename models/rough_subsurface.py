@@ -64,7 +64,7 @@ from .constraints import Instance, Integer, Interval, Options, ScalarOrArray
 from .facts import Correspondence
 from .params import coating_param, param
 from .slopes import GaussianSlopes
-from .smooth_interface import internal_hemispherical_reflectance
+from .smooth_interface import interface_amplitudes, internal_hemispherical_reflectance
 
 __all__ = ["RoughSubsurfaceBRDF", "transmission_factor", "transmission_at"]
 
@@ -79,33 +79,40 @@ RHO_MAX = math.sqrt(42.0)
 
 
 @cache
-def _rules(nodes, radial=RADIAL, arc=ARC):
-    """The quadrature rules (read-only arrays): Gauss-Legendre ``(x, w)`` radial and arc,
-    Chebyshev points of the first kind ``x`` of ``nodes`` and of ``MOMENTS + 1``, Fejer's first
-    weights for ``nodes`` points on [-1, 1]."""
-    rx, rw = np.polynomial.legendre.leggauss(radial)
-    ax, aw = np.polynomial.legendre.leggauss(arc)
+def _slope_rules(radial=RADIAL, arc=ARC):
+    """The slope plane's Gauss-Legendre rules ``(rx, rw, ax, aw)``, radial and arc (read-only)."""
+    return _frozen(*np.polynomial.legendre.leggauss(radial), *np.polynomial.legendre.leggauss(arc))
+
+
+@cache
+def _node_rules(nodes):
+    """``(x, fejer, dct)``: the ``nodes`` Chebyshev points of the first kind on [-1, 1], Fejer's
+    first weights there, and the matrix ``(nodes, nodes)`` taking values at the points to the
+    interpolating series' coefficients (read-only)."""
     k = np.arange(nodes)
     tk = np.pi * (k + 0.5) / nodes
-    cheb = np.cos(tk)
     j = np.arange(1, nodes // 2 + 1)
     fejer = (2.0 / nodes) * (
         1.0 - 2.0 * np.sum(np.cos(2.0 * j[None, :] * tk[:, None]) / (4.0 * j * j - 1.0), axis=1)
     )
-    m = np.arange(MOMENTS + 1)
-    cm = np.cos(np.pi * (m + 0.5) / (MOMENTS + 1))
-    out = (rx, rw, ax, aw, cheb, fejer, cm)
-    for a in out:
+    x = np.cos(tk)
+    scale = np.full(nodes, 2.0 / nodes)
+    scale[0] *= 0.5
+    return _frozen(x, fejer, np.polynomial.chebyshev.chebvander(x, nodes - 1) * scale)
+
+
+def _frozen(*arrays):
+    for a in arrays:
         a.setflags(write=False)
-    return out
+    return arrays
 
 
 def _panels(sigma, nodes):
-    """``(u_b, u)``: the panel break and the ``2 nodes`` u-nodes (first panel, then second)."""
-    cheb = _rules(nodes)[4]
-    ub = min(0.5, 6.0 * sigma)
-    x = 0.5 * (cheb + 1.0)
-    return ub, np.concatenate([ub * x, ub + (1.0 - ub) * x])
+    """``(u_b, u)``: the panel break(s) and the ``2 nodes`` u-nodes (first panel, then second),
+    for a slope width or an array of them (``(..., 2 nodes)``)."""
+    x = 0.5 * (_node_rules(nodes)[0] + 1.0)
+    ub = np.minimum(0.5, 6.0 * np.asarray(sigma, dtype=float))[..., None]
+    return ub[..., 0], np.concatenate([ub * x, ub + (1.0 - ub) * x], axis=-1)
 
 
 def _moments_numpy(sigma, nodes):
@@ -116,7 +123,7 @@ def _moments_numpy(sigma, nodes):
 
 def _moments_at(sigma, us, radial=RADIAL, arc=ARC):
     """:func:`_moments_numpy` at cosines ``us`` (and slope-plane rules ``radial``, ``arc``)."""
-    rx, rw, ax, aw, _, _, _ = _rules(4, radial, arc)
+    rx, rw, ax, aw = _slope_rules(radial, arc)
     rmax = RHO_MAX * sigma
     A0 = np.empty((us.size, MOMENTS + 1))
     A1 = np.empty_like(A0)
@@ -160,18 +167,16 @@ def _radial_nodes(rho0, rmax, rx, rw):
 
 
 def _fresnel_series(n):
-    """Chebyshev coefficients ``(a, b)`` in ``x = 2 c - 1`` of ``(T_s + T_p) / 2`` and
-    ``(T_s - T_p) / 2`` at local cosine ``c`` entering index ``n`` (interpolated at the
-    ``MOMENTS + 1`` Chebyshev points)."""
-    cm = _rules(4)[6]
-    c = 0.5 * (cm + 1.0)
-    ct = np.sqrt(n * n - 1.0 + c * c) / n
-    ts = 4.0 * n * c * ct / (c + n * ct) ** 2
-    tp = 4.0 * n * c * ct / (n * c + ct) ** 2
-    V = np.polynomial.chebyshev.chebvander(cm, MOMENTS)
-    scale = np.full(MOMENTS + 1, 2.0 / (MOMENTS + 1))
-    scale[0] *= 0.5
-    return scale * (V.T @ (0.5 * (ts + tp))), scale * (V.T @ (0.5 * (ts - tp)))
+    """Chebyshev coefficients ``(a, b)`` ``(..., MOMENTS + 1)`` in ``x = 2 c - 1`` of
+    ``(T_s + T_p) / 2`` and ``(T_s - T_p) / 2`` at local cosine ``c`` entering index ``n`` (a
+    float or an array): the smooth interface's amplitudes
+    (:func:`~scatterbench.models.smooth_interface.interface_amplitudes`, ``T = n a^2``)
+    interpolated at the ``MOMENTS + 1`` Chebyshev points."""
+    x, _, dct = _node_rules(MOMENTS + 1)
+    n = np.asarray(n, dtype=float)[..., None]
+    _, _, a_s, a_p = interface_amplitudes(0.5 * (x + 1.0), n)
+    ts, tp = n * a_s * a_s, n * a_p * a_p
+    return (0.5 * (ts + tp)) @ dct, (0.5 * (ts - tp)) @ dct
 
 
 def transmission_factor(sigma, n, nodes=17):
@@ -188,6 +193,44 @@ def transmission_at(sigma, n, u, radial=RADIAL, arc=ARC):
     A0, A1 = _moments_at(sigma, np.asarray(u, dtype=float).reshape(-1), radial, arc)
     a, b = _fresnel_series(n)
     return A0 @ a, A1 @ b
+
+
+def _tables(sigma, n, rho, nodes, feedback):
+    """``(coef (E, 2, 2, nodes), ub (E,), scale (E,))`` for elements ``(sigma, n, rho)``: each
+    panel's Chebyshev coefficients of ``t0`` and ``t1`` in ``cos(theta)``, the panel break, and
+    ``(rho / pi) / (1 - rho R-bar) / n^2``.  The slope quadrature once per distinct width
+    (compiled on the numba backend, :mod:`scatterbench.models.kernels.rough`), the rest for all
+    elements at once."""
+    widths, which = np.unique(sigma, return_inverse=True)
+    compiled = _compiled()
+    if compiled is not None:
+        A0, A1 = compiled.moments(widths, nodes, *_slope_rules(), _node_rules(nodes)[0])
+    else:
+        A0, A1 = (np.stack(m) for m in zip(*(_moments_numpy(float(w), nodes) for w in widths), strict=True))
+    which = which.reshape(-1)
+    a, b = _fresnel_series(n)
+    t0 = np.einsum("ejm,em->ej", A0[which], a)
+    t1 = np.einsum("ejm,em->ej", A1[which], b)
+    dct = _node_rules(nodes)[2]
+    coef = np.stack([t0.reshape(-1, 2, nodes) @ dct, t1.reshape(-1, 2, nodes) @ dct], axis=2)
+    ub = _panels(sigma, nodes)[0]
+    rbar = _rbar(sigma, n, nodes, t0) if feedback == "rough" else _flat_rbar(n)
+    return coef, ub, (rho / math.pi) / (1.0 - rho * rbar) / (n * n)
+
+
+def _rbar(sigma, n, nodes, t0):
+    """The rough interface's R-bar, ``1 - (2 / n^2) int_0^1 t0(u) u du``, from the u-node values
+    ``t0`` ``(..., 2 nodes)`` (Fejer's rule on each panel)."""
+    ub, u = _panels(sigma, nodes)
+    f = _node_rules(nodes)[1]
+    w = np.concatenate([0.5 * ub[..., None] * f, 0.5 * (1.0 - ub[..., None]) * f], axis=-1)
+    return 1.0 - 2.0 / (n * n) * np.sum(w * u * t0, axis=-1)
+
+
+def _flat_rbar(n):
+    """Sec. 2.3's flat R-bar of each index (its quadrature once per distinct index)."""
+    values, inverse = np.unique(n, return_inverse=True)
+    return np.array([internal_hemispherical_reflectance(float(v)) for v in values])[inverse.reshape(-1)]
 
 
 @dataclass(frozen=True)
@@ -249,13 +292,9 @@ class RoughSubsurfaceBRDF(Model):
         )
 
     def tables(self, sigma, n, rho):
-        """``(coef (E, 2, 2, nodes), ub (E,), scale (E,))`` for elements ``(sigma, n, rho)``:
-        each panel's Chebyshev coefficients of ``t0`` and ``t1`` in ``cos(theta)``, the panel
-        break, and ``(rho / pi) / (1 - rho R-bar) / n^2``."""
-        compiled = _compiled()
-        if compiled is not None:
-            return compiled.tables(sigma, n, rho, self.nodes, self.feedback == "rough", *_rules(self.nodes))
-        return _tables_numpy(sigma, n, rho, self.nodes, self.feedback)
+        """:func:`_tables` of elements ``(sigma, n, rho)`` (flat arrays) with this model's
+        ``nodes`` and ``feedback``."""
+        return _tables(sigma, n, rho, self.nodes, self.feedback)
 
     def _mueller16(self, ti, tr, pr):
         size = max(ti.size, tr.size, 1)
@@ -286,14 +325,16 @@ class RoughSubsurfaceBRDF(Model):
     # -- a fit's model set: walkers x wavelengths, each element's tables once ---------------
     def flat_mueller16_indexed(self, index, ti, tr, pr, out, add=False):
         G = math.prod(self.param_shape) if self._sets else 1
-        values = self._write(
-            self.tables(*self._flat_params(G)), np.asarray(index), ti, tr, np.empty(out.shape)
-        )
-        if add:
-            out += values
-        else:
-            out[...] = values
-        return out
+        tables = self.tables(*self._flat_params(G))
+        inplace = type(out) is np.ndarray and out.flags.c_contiguous and out.dtype == np.float64
+        if add or not inplace:
+            values = self._write(tables, np.asarray(index), ti, tr, np.empty(out.shape))
+            if add:
+                out += values
+            else:
+                out[...] = values
+            return out
+        return self._write(tables, np.asarray(index), ti, tr, out)
 
     def indexed_kernel(self, index):
         """``(writer, index)`` for a fit's fused likelihood (``range_writer()``, as
@@ -309,13 +350,16 @@ class RoughSubsurfaceBRDF(Model):
 
     @cached_property
     def rbar(self):
-        """R-bar of Eq. 23 (a float, or an array in a model set)."""
+        """R-bar of Eq. 23 (a float, or an array in a model set): :func:`_tables`' own."""
         sigma, n, rho = self._flat_params(math.prod(self.param_shape) if self._sets else 1)
         if self.feedback == "flat":
-            vals = np.array([internal_hemispherical_reflectance(float(v)) for v in n])
+            vals = _flat_rbar(n)
         else:
             vals = np.array(
-                [_rough_rbar(float(s), float(v), self.nodes) for s, v in zip(sigma, n, strict=True)]
+                [
+                    _rbar(s, v, self.nodes, transmission_factor(s, v, self.nodes)[1])
+                    for s, v in zip(sigma, n, strict=True)
+                ]
             )
         return vals.reshape(self.param_shape) if self._sets else float(vals[0])
 
@@ -342,46 +386,6 @@ def _compiled():
     from .kernels import rough  # numba (heavy): compiled kernels load when one first runs
 
     return rough
-
-
-def _rough_rbar(sigma, n, nodes):
-    u, t0, _ = transmission_factor(sigma, n, nodes)
-    return _rbar_from(sigma, n, nodes, t0)
-
-
-def _rbar_from(sigma, n, nodes, t0):
-    """``1 - (2 / n^2) int_0^1 t0(u) u du`` from the u-node values (Fejer's rule per panel)."""
-    ub, u = _panels(sigma, nodes)
-    f = _rules(nodes)[5]
-    w = np.concatenate([0.5 * ub * f, 0.5 * (1.0 - ub) * f])
-    return 1.0 - 2.0 / (n * n) * float(np.sum(w * u * t0))
-
-
-def _tables_numpy(sigma, n, rho, nodes, feedback):
-    E = sigma.size
-    coef = np.empty((E, 2, 2, nodes))
-    ub = np.empty(E)
-    scale = np.empty(E)
-    V = np.polynomial.chebyshev.chebvander(_rules(nodes)[4], nodes - 1)
-    dct = np.full(nodes, 2.0 / nodes)
-    dct[0] *= 0.5
-    moments = {}
-    for e in range(E):
-        s = float(sigma[e])
-        if s not in moments:
-            moments[s] = _moments_numpy(s, nodes)
-        A0, A1 = moments[s]
-        a, b = _fresnel_series(float(n[e]))
-        t0, t1 = A0 @ a, A1 @ b
-        for p in range(2):
-            sl = slice(p * nodes, (p + 1) * nodes)
-            coef[e, p, 0] = dct * (V.T @ t0[sl])
-            coef[e, p, 1] = dct * (V.T @ t1[sl])
-        ub[e] = _panels(s, nodes)[0]
-        nn = float(n[e])
-        rbar = _rbar_from(s, nn, nodes, t0) if feedback == "rough" else internal_hemispherical_reflectance(nn)
-        scale[e] = (rho[e] / math.pi) / (1.0 - rho[e] * rbar) / (nn * nn)
-    return coef, ub, scale
 
 
 def _series_at(coef, ub, u):

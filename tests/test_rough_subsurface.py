@@ -73,7 +73,7 @@ def test_unit_albedo_returns_what_entered():
 
 def test_tends_to_the_smooth_interface():
     """A narrow interface (sigma 0.003) gives the smooth-interface diffuser of Sec. 2.3 (flat
-    R-bar both) within 1e-4 away from grazing."""
+    R-bar both) within 1e-4 of the largest M00 away from grazing (measured 1.0e-6)."""
     ti, tr, pr = np.array([0.0, 0.5, 1.0]), np.array([0.3, 0.8, 0.2]), np.array([0.0, 1.0, 3.0])
     rough = RoughSubsurfaceBRDF(slopes=GaussianSlopes(0.003), coating=1.5, rho=0.8, feedback="flat")
     smooth = models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.8)
@@ -122,7 +122,7 @@ def test_refuses_what_it_does_not_integrate():
 
 def test_transmission_factor_nodes_and_rbar_flat_limit():
     """The u-nodes lie inside (0, 1) on two panels; the rough R-bar of a narrow interface is the
-    flat one."""
+    flat one (within 1e-5; measured 8.0e-7 at sigma 0.002)."""
     u, t0, t1 = transmission_factor(0.2, 1.5)
     assert u.shape == t0.shape == t1.shape == (34,) and 0 < u.min() and u.max() < 1
     flat = models.DiffuseSubsurfaceBRDF(coating=1.5).rbar

@@ -38,8 +38,8 @@ its kernel of its own, :func:`~scatterbench.models.kernels.drive.own_kernel`, so
 compiles only the kernels its models use, and the loop written in the entry: each compiled
 level between an entry and its kernel cost another optimization of the inlined kernel), ``angles_ok``
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
-``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.rough`'s ``_moments``,
-``_element_tables`` and ``write``, :mod:`~scatterbench.models.kernels.aperture`'s
+``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.rough`'s ``_moments``
+and ``write``, :mod:`~scatterbench.models.kernels.aperture`'s
 ``nodes`` and ``_tiles``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
 holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached

@@ -1,6 +1,7 @@
 """The rough-interface diffuser of :class:`scatterbench.models.RoughSubsurfaceBRDF`, compiled: the
-slope-plane quadrature of its moments (once per distinct slope width), each element's tables
-(per index), and the per-geometry Chebyshev evaluation.  The rule is the numpy reference's
+slope-plane quadrature of its moments (once per distinct slope width) and the per-geometry
+Chebyshev evaluation; each element's tables are the numpy reference's own
+(:func:`scatterbench.models.rough_subsurface._tables`).  The rule is the numpy reference's
 (:mod:`scatterbench.models.rough_subsurface`, which documents it), written as loops; the tests
 hold the two within 1e-12 relative to ``M00``."""
 
@@ -117,144 +118,49 @@ def _reduce(x, w0, w1, L, tp, tc, a0, a1):  # pragma: no cover - compiled
         a1[m] /= norm
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
-def _element_tables(
-    A0, A1, which, sigma, n, nodes, rough, cheb, fejer, cm, coef, ub, rbars
-):  # pragma: no cover
-    """Every element's tables: its index's transmittance series, the moments' dot products at
-    the u-nodes, each panel's Chebyshev coefficients, R-bar and the scale."""
-    E = n.shape[0]
-    a = np.empty(_M + 1)
-    b = np.empty(_M + 1)
-    fa = np.empty(_M + 1)
-    fb = np.empty(_M + 1)
-    t0 = np.empty(2 * nodes)
-    t1 = np.empty(2 * nodes)
-    for e in range(E):
-        ne = n[e]
-        for l in range(_M + 1):
-            c = 0.5 * (cm[l] + 1.0)
-            ct = math.sqrt(ne * ne - 1.0 + c * c) / ne
-            ts = 4.0 * ne * c * ct / ((c + ne * ct) * (c + ne * ct))
-            tp = 4.0 * ne * c * ct / ((ne * c + ct) * (ne * c + ct))
-            fa[l] = 0.5 * (ts + tp)
-            fb[l] = 0.5 * (ts - tp)
-        _dct(fa, cm, a)
-        _dct(fb, cm, b)
-        k = which[e]
-        for j in range(2 * nodes):
-            s0 = 0.0
-            s1 = 0.0
-            for m in range(_M + 1):
-                s0 += A0[k, j, m] * a[m]
-                s1 += A1[k, j, m] * b[m]
-            t0[j] = s0
-            t1[j] = s1
-        u_b = min(0.5, 6.0 * sigma[e])
-        ub[e] = u_b
-        for p in range(2):
-            _dct(t0[p * nodes : (p + 1) * nodes], cheb, coef[e, p, 0])
-            _dct(t1[p * nodes : (p + 1) * nodes], cheb, coef[e, p, 1])
-        if rough:
-            total = 0.0
-            for j in range(2 * nodes):
-                x = 0.5 * (cheb[j % nodes] + 1.0)
-                width = u_b if j < nodes else 1.0 - u_b
-                u = u_b * x if j < nodes else u_b + (1.0 - u_b) * x
-                total += 0.5 * width * fejer[j % nodes] * u * t0[j]
-            rbar = 1.0 - 2.0 / (ne * ne) * total
-        else:
-            rbar = math.nan  # filled by the caller (the flat interface's quadrature)
-        rbars[e] = rbar
-
-
-@njit(error_model="numpy")
-def _dct(f, x, out):  # pragma: no cover - compiled
-    """Chebyshev coefficients ``out`` of the values ``f`` at the first-kind points ``x``."""
-    N = f.shape[0]
-    for m in range(N):
-        out[m] = 0.0
-    for i in range(N):
-        t_prev = 1.0
-        t = x[i]
-        out[0] += f[i]
-        if N > 1:
-            out[1] += f[i] * t
-        for m in range(2, N):
-            t_prev, t = t, 2.0 * x[i] * t - t_prev
-            out[m] += f[i] * t
-    for m in range(N):
-        out[m] *= (1.0 if m else 0.5) * 2.0 / N
-
-
-#: geometries a block of :func:`write` takes through its passes (arrays that stay in L1)
+#: geometries of one element a pass of :func:`write` takes (arrays that stay in L1)
 _BLOCK = 256
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def write(coef, ub, scale, index, ti, tr, out, lo, hi, col):  # pragma: no cover - compiled
     """Geometries ``lo .. hi - 1`` (element ``index[i]``; angles of length 1 or ``n``) into
-    ``out[:, i + col]``, a block of :data:`_BLOCK` at a time in passes over arrays (loops on
-    SIMD lanes): each angle's panel and variable, then the Clenshaw recurrences of ``t0`` and
-    ``t1`` of both angles (:func:`_clenshaw`), then the four elements.  One geometry at a time
-    the recurrences' latency bound the loop."""
-    K = coef.shape[3]
-    E2 = coef.shape[0] * 2
-    f0 = np.ascontiguousarray(coef[:, :, 0, :]).reshape(E2, K)
-    f1 = np.ascontiguousarray(coef[:, :, 1, :]).reshape(E2, K)
+    ``out[:, i + col]``, a run of one element (at most :data:`_BLOCK` geometries) at a time in
+    passes over arrays (loops on SIMD lanes): both angles' cosines, the Clenshaw recurrences of
+    ``t0`` and ``t1`` of each (:func:`_clenshaw`), then the four elements.  One geometry at a
+    time the recurrences' latency bound the loop; a fit's rows are long runs of one element (a
+    walker's wavelength)."""
     a, b = ti.shape[0] > 1, tr.shape[0] > 1
     xi, xr = np.empty(_BLOCK), np.empty(_BLOCK)
-    ri, rr = np.empty(_BLOCK, dtype=np.uint64), np.empty(_BLOCK, dtype=np.uint64)
     ai0, ai1, ar0, ar1 = np.empty(_BLOCK), np.empty(_BLOCK), np.empty(_BLOCK), np.empty(_BLOCK)
-    sc = np.empty(_BLOCK)
     b1, b2, d1, d2 = np.empty(_BLOCK), np.empty(_BLOCK), np.empty(_BLOCK), np.empty(_BLOCK)
     low = np.empty(_BLOCK, dtype=np.bool_)
-    for blo in range(lo, hi, _BLOCK):
-        L = min(_BLOCK, hi - blo)
-        e = index[blo]
-        one = True
+    i = lo
+    while i < hi:
+        e = index[i]
+        L = 1
+        while i + L < hi and L < _BLOCK and index[i + L] == e:
+            L += 1
         for q in range(L):
-            one &= index[blo + q] == e
-        if one:  # the common case (a fit's rows: one element for a walker's wavelength)
-            for q in range(L):
-                sc[q] = scale[e]
-                xi[q] = sincos(ti[(blo + q) * a])[1]
-                xr[q] = sincos(tr[(blo + q) * b])[1]
-            _clenshaw_one(coef[e], ub[e], xi, low, L, ai0, ai1, b1, b2, d1, d2)
-            _clenshaw_one(coef[e], ub[e], xr, low, L, ar0, ar1, b1, b2, d1, d2)
-        else:
-            for q in range(L):
-                i = blo + q
-                e = index[i]
-                u_b = ub[e]
-                sc[q] = scale[e]
-                xi[q], ri[q] = _panel(sincos(ti[i * a])[1], u_b, e)
-                xr[q], rr[q] = _panel(sincos(tr[i * b])[1], u_b, e)
-            _clenshaw(f0, xi, ri, L, ai0)
-            _clenshaw(f1, xi, ri, L, ai1)
-            _clenshaw(f0, xr, rr, L, ar0)
-            _clenshaw(f1, xr, rr, L, ar1)
-        j = blo + col
+            xi[q] = sincos(ti[(i + q) * a])[1]
+            xr[q] = sincos(tr[(i + q) * b])[1]
+        _clenshaw(coef[e], ub[e], xi, low, L, ai0, ai1, b1, b2, d1, d2)
+        _clenshaw(coef[e], ub[e], xr, low, L, ar0, ar1, b1, b2, d1, d2)
+        j = i + col
+        s = scale[e]
         for r in (2, 3, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15):
             for q in range(L):
                 out[r, j + q] = 0.0
         for q in range(L):
-            out[0, j + q] = sc[q] * ar0[q] * ai0[q]
-            out[1, j + q] = sc[q] * ar0[q] * ai1[q]
-            out[4, j + q] = sc[q] * ar1[q] * ai0[q]
-            out[5, j + q] = sc[q] * ar1[q] * ai1[q]
+            out[0, j + q] = s * ar0[q] * ai0[q]
+            out[1, j + q] = s * ar0[q] * ai1[q]
+            out[4, j + q] = s * ar1[q] * ai0[q]
+            out[5, j + q] = s * ar1[q] * ai1[q]
+        i += L
 
 
 @njit(error_model="numpy", forceinline=True)
-def _panel(u, u_b, e):  # pragma: no cover - compiled
-    """``(x, row)``: the variable on ``u``'s panel and the panel's row of the flat coefficients."""
-    if u < u_b:
-        return 2.0 * u / u_b - 1.0, np.uint64(2 * e)
-    return 2.0 * (u - u_b) / (1.0 - u_b) - 1.0, np.uint64(2 * e + 1)
-
-
-@njit(error_model="numpy", forceinline=True)
-def _clenshaw_one(c, u_b, u, low, L, t0, t1, b1, b2, d1, d2):  # pragma: no cover - compiled
+def _clenshaw(c, u_b, u, low, L, t0, t1, b1, b2, d1, d2):  # pragma: no cover - compiled
     """``t0``, ``t1`` at ``u[:L]`` (overwritten by the panels' variable) of one element's panels
     ``c`` ``(2, 2, K)``: both series at once, each lane's coefficients selected from the two
     panels' (no gather; ``low``: scratch, whether a lane is on the first panel)."""
@@ -280,57 +186,27 @@ def _clenshaw_one(c, u_b, u, low, L, t0, t1, b1, b2, d1, d2):  # pragma: no cove
         t1[q] = u[q] * d1[q] - d2[q] + (p1 if low[q] else q1)
 
 
-@njit(error_model="numpy", forceinline=True)
-def _clenshaw(f, x, row, L, out):  # pragma: no cover - compiled
-    """``out[q] = sum_k f[row[q], k] T_k(x[q])`` for ``q < L`` (unsigned rows: no wraparound
-    check, so the loop runs on SIMD lanes)."""
-    K = f.shape[1]
-    b1 = np.zeros(L)
-    b2 = np.zeros(L)
-    for k in range(K - 1, 0, -1):
-        for q in range(L):
-            v = 2.0 * x[q] * b1[q] - b2[q] + f[row[q], k]
-            b2[q] = b1[q]
-            b1[q] = v
-    for q in range(L):
-        out[q] = x[q] * b1[q] - b2[q] + f[row[q], 0]
-
-
 def signatures():
     """``[(entry, argument types)]`` of this module's cached entries, as the model calls them
     (compile-ahead: :func:`scatterbench.models.kernels.warm`)."""
     from numba import types
 
-    f, i, b = types.float64, types.int64, types.boolean
+    f, i = types.float64, types.int64
     a = lambda n: types.Array(f, n, "C")  # noqa: E731
     ro, ix = types.Array(f, 1, "C", readonly=True), types.Array(i, 1, "C")
     return [
-        (_moments, (a(1), i, ro, ro, ro, ro, ro, a(3), a(3), i, i)),
-        (_element_tables, (a(3), a(3), ix, a(1), a(1), i, b, ro, ro, ro, a(4), a(1), a(1))),
+        (_moments, (ro, i, ro, ro, ro, ro, ro, a(3), a(3), i, i)),
         (write, (a(4), a(1), a(1), ix, a(1), a(1), a(2), i, i, i)),
     ]
 
 
-def tables(sigma, n, rho, nodes, rough, rx, rw, ax, aw, cheb, fejer, cm):
-    """:func:`scatterbench.models.rough_subsurface._tables_numpy`'s tables, compiled: the
-    moments once per distinct slope width (over the cores), then every element's."""
-    from ..smooth_interface import internal_hemispherical_reflectance
-
-    # writable copies: one type per entry, whatever arrays the model holds (read-only sets)
-    sig, nn = np.array(sigma, dtype=np.float64), np.array(n, dtype=np.float64)
-    widths, which = np.unique(sig, return_inverse=True)
-    K = widths.shape[0]
-    A0 = np.empty((K, 2 * nodes, _M + 1))
+def moments(widths, nodes, rx, rw, ax, aw, cheb):
+    """:func:`scatterbench.models.rough_subsurface._moments_numpy` of each slope width of
+    ``widths`` (distinct), compiled and spread over the cores: ``(A0, A1)`` ``(K, 2 nodes,
+    MOMENTS + 1)``."""
+    widths = np.ascontiguousarray(widths, dtype=np.float64)
+    widths.setflags(write=False)  # one type: the rules are read-only too
+    A0 = np.empty((widths.shape[0], 2 * nodes, _M + 1))
     A1 = np.empty_like(A0)
-    spread(_moments, (widths, nodes, rx, rw, ax, aw, cheb, A0, A1), K, 1)
-    E = sig.shape[0]
-    coef = np.empty((E, 2, 2, nodes))
-    ub = np.empty(E)
-    rbar = np.empty(E)
-    _element_tables(
-        A0, A1, which.reshape(-1).astype(np.int64), sig, nn, nodes, rough, cheb, fejer, cm, coef, ub, rbar
-    )
-    if not rough:
-        rbar = np.array([internal_hemispherical_reflectance(float(v)) for v in nn])
-    r = np.asarray(rho, dtype=np.float64)
-    return coef, ub, (r / math.pi) / (1.0 - r * rbar) / (nn * nn)
+    spread(_moments, (widths, nodes, rx, rw, ax, aw, cheb, A0, A1), widths.shape[0], 1)
+    return A0, A1

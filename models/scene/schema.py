@@ -16,6 +16,7 @@ from ..aperture import DetectorAperture
 from ..facet import FacetBRDF
 from ..point_source import PointSourceBRDF
 from ..polarization import stokes
+from ..slopes import GaussianSlopes
 from ..subsurface_facet import SubsurfaceFacetBRDF
 from ..text import is_number, shown
 from ..thin_film import Films, FilmStack
@@ -454,7 +455,7 @@ def _volume_method(path, v, coating, out, monte_carlo):
             "'quadrature' computes the totally diffuse term alone: set single = false "
             "(single scattering under a rough interface is the Monte Carlo model's)",
         )
-    if type(coating["roughness"]).__name__ != "GaussianSlopes":
+    if not isinstance(coating["roughness"], GaussianSlopes):
         raise _err(
             path,
             "[volume] method",
