@@ -101,6 +101,44 @@ def test_vector_loop_model_sets_and_broadcast_angles(model):
     assert np.array_equal(a, b)
 
 
+@pytest.mark.parametrize("model", VECTORIZED[1::3], ids=lambda m: type(m).__name__)
+def test_vector_loop_ranges_take_what_every_block_shares(model):
+    """The rows every block shares (:func:`~scatterbench.models.kernels.vector.shared`: angles of
+    length 1, a single model's parameters) are written once per call, in the call's first
+    block's columns: ranges that start inside a block and end short of one (as the threads and
+    the fused likelihood call them) give the bits of one call over all geometries, and the
+    scalar loop's.  Fails if a later block reads columns the first did not fill."""
+    ti, tr, pr = _inputs()
+    kernel = Compiled(model, *model._kernel_spec())
+    prm, n = kernel.params("float64"), ti.size
+    for angles in ((ti, tr, pr), (ti[:1], tr, pr[:1]), (ti, tr[:1], pr)):
+        whole, parts = np.empty((16, n)), np.empty((16, n))
+        kernel.lanes(*angles, prm, drive.NO_INDEX, kernel.iopt, whole, 0, 0, n)
+        for lo, hi in ((0, 3), (3, 290), (290, n)):
+            kernel.lanes(*angles, prm, drive.NO_INDEX, kernel.iopt, parts, 0, lo, hi)
+        scalar = np.empty((16, n))
+        kernel.scalar(*angles, prm, drive.NO_INDEX, kernel.iopt, scalar, 0, 0, n)
+        assert np.array_equal(parts, whole) and np.array_equal(whole, scalar)
+
+
+def test_copy_into_refuses_strided_arrays():
+    """The scratch copies (``memcpy``) take C-contiguous arrays of one dtype; a strided one is
+    refused when the caller compiles, not copied as if contiguous."""
+    from numba.core.errors import TypingError
+
+    @njit
+    def copy(dst, src):
+        vector.copy_into(dst, 0, src, 0, 3)
+
+    dst, src = np.zeros(3), np.arange(6.0)
+    copy(dst, src)
+    assert dst.tolist() == [0.0, 1.0, 2.0]
+    with pytest.raises(TypingError, match="C-contiguous"):
+        copy(dst, src[::2])
+    with pytest.raises(TypingError, match="one dtype"):
+        copy(dst, src.astype(np.float32))
+
+
 @pytest.mark.parametrize("shadowing", ["none", "smith"])
 def test_facet_lanes_coating_per_block_and_per_lane(shadowing):
     """The facet loop on SIMD lanes takes its coating from a pass per block

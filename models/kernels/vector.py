@@ -7,15 +7,22 @@ library, and reads and writes several arrays the compiler must assume overlap.  
 block of :data:`VBLOCK` geometries:
 
 1. :func:`gather` copies the block's angles and parameters into one scratch
-   array and takes the azimuths' cosines and sines there with the polynomial
-   :func:`~scatterbench.models.kernels.vector_math.sincos` (the C library beyond its range:
-   :func:`~scatterbench.models.kernels.common.azimuths`);
+   array (``memcpy``, :func:`copy_into`; what every block shares, :func:`shared` wrote once
+   per call) and takes the azimuths' cosines and sines there with the polynomial
+   :func:`~scatterbench.models.kernels.vector_math.sincos` (the C library beyond its range);
 2. :func:`entry`'s loop runs the kernel over the scratch: one loop per model and option set (:func:`lane_options`), with
    the code and options constants, so that the branches left are selects; no call remains
    (the kernels use :mod:`~scatterbench.models.kernels.vector_math`, and ``error_model="numpy"`` lets a
    division by zero give inf, as numpy's, instead of raising); all reads and writes are in
    the one scratch at fixed offsets, so no overlap test is needed;
-3. the block's result rows are copied to ``out`` (:func:`put`).
+3. the block's result rows are copied to ``out`` (:func:`put`, ``memcpy``).
+
+Steps 1 and 3 are the same code in every entry, and LLVM optimizes and emits each entry's
+callees again inside it: written as loops, vectorized, versioned for overlap and unrolled,
+they were most of each entry's code (gather and put about 8,000 of the 9,500 lines of a
+Cook-Torrance entry's optimized IR) and about a third of its compile time (Cook-Torrance's six
+entries 7.0 s of CPU with both emptied, against 10.4-11.4 s; ad hoc, a fresh cache), and slower
+than ``memcpy`` at run time.
 
 The facet kernel's block first takes its polar angles' cosines and sines and its coating in a
 pass of its own (:func:`facet_prepass`), which skips the coating's refraction where the
@@ -34,14 +41,20 @@ its parameters, the ellipse's rotation given as the strokes' azimuth's cosine an
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from numba import njit
-from numba.core import config
+from llvmlite import ir
+from numba import njit, types
+from numba.core import cgutils, config
+from numba.core.errors import TypingError
+from numba.core.extending import intrinsic
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
-from .common import NO_SHADOWING, azimuths, polar
-from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, column, own_kernel
+from .common import NO_SHADOWING, REDUCED_MAX, polar
+from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, own_kernel
 from .facet import coating, facet_lanes
+from .vector_math import sincos
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
 #: in the L2 cache
@@ -65,6 +78,32 @@ BLINN, NO_COOK_SHADOWING, COOK_SMITH = (
 )
 
 
+@intrinsic
+def copy_into(typingctx, dst, dst_at, src, src_at, count):
+    """``count`` elements of ``src`` (flat, from ``src_at``) into ``dst`` (flat, from ``dst_at``):
+    one ``memcpy`` (the arrays C-contiguous of one dtype, not overlapping).  Other layouts
+    are refused when the caller compiles (a strided array's elements are not one block)."""
+    if not (isinstance(dst, types.Array) and isinstance(src, types.Array)):
+        raise TypingError("copy_into: arrays only")
+    if dst.layout != "C" or src.layout != "C" or dst.dtype != src.dtype:
+        raise TypingError(f"copy_into: C-contiguous arrays of one dtype only, not {dst} and {src}")
+    sig = types.void(dst, dst_at, src, src_at, count)
+
+    def codegen(context, builder, signature, args):
+        d = context.make_array(signature.args[0])(context, builder, args[0])
+        s = context.make_array(signature.args[2])(context, builder, args[2])
+        i64 = ir.IntType(64)
+        dp = builder.gep(d.data, [builder.sext(args[1], i64) if args[1].type != i64 else args[1]])
+        sp = builder.gep(s.data, [builder.sext(args[3], i64) if args[3].type != i64 else args[3]])
+        n = args[4] if args[4].type == i64 else builder.sext(args[4], i64)
+        cgutils.raw_memcpy(
+            builder, dp, sp, n, context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
+        )
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 def vectorized(code, iopt) -> bool:
     """Whether kernel ``code`` with options ``iopt`` takes the vector path (float64)."""
     if code == FACET:
@@ -81,12 +120,6 @@ def vectorized(code, iopt) -> bool:
 @njit(error_model="numpy", inline="always")
 def _at(sc, row, k):
     return sc[row * VBLOCK + k]
-
-
-@njit(error_model="numpy", inline="always")
-def _row(sc, row, m):
-    """The first ``m`` columns of scratch row ``row`` (a view)."""
-    return sc[row * VBLOCK : row * VBLOCK + m]
 
 
 @njit(error_model="numpy", inline="always")
@@ -166,33 +199,70 @@ def _store(sc, k, m):
 
 
 @njit(error_model="numpy")
-def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
-    """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch: angles, the azimuth's
-    cosine and sine (:func:`~scatterbench.models.kernels.common.azimuths` over the block), and the
-    first ``rows`` parameter rows, those the kernel reads (a single model's repeated; the columns :func:`~scatterbench.models.kernels.drive.column`
-    reads, without a branch that LLVM would unswitch the block loop on, copying the kernel)."""
-    a, b, c, p = ti.shape[0] > 1, tr.shape[0] > 1, pr.shape[0] > 1, prm.shape[1] > 1
+def shared(sc, ti, tr, pr, prm, index, m, rows):
+    """Once per call, the scratch rows that every block shares, in its first ``m`` columns: the
+    angles as if each were one value (:func:`gather` then copies over those that are not) and,
+    for parameters shared by every geometry (one column), the first ``rows`` parameter rows.
+    A single model's parameters are then not copied again per block."""
     for k in range(m):
-        i = lo + k
-        sc[_TI * VBLOCK + k], sc[_TR * VBLOCK + k], sc[_PR * VBLOCK + k] = ti[i * a], tr[i * b], pr[i * c]
+        sc[_TI * VBLOCK + k], sc[_TR * VBLOCK + k], sc[_PR * VBLOCK + k] = ti[0], tr[0], pr[0]
+    if index.shape[0] == 1 and prm.shape[1] == 1:
+        for r in range(rows):
+            v, o = prm[r, index[0]], (_PRM + r) * VBLOCK
+            for k in range(m):
+                sc[o + k] = v
+
+
+@njit(error_model="numpy")
+def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
+    """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch (over what :func:`shared`
+    wrote): angles given per geometry, the azimuth's cosine and sine (:func:`_azimuths`), and
+    the first ``rows`` parameter rows, those the kernel reads, when the parameters are per
+    geometry (the columns :func:`~scatterbench.models.kernels.drive.column` reads), the copies
+    ``memcpy`` (:func:`copy_into`).  Branches, not the arithmetic of ``column``: LLVM
+    unswitched the loop of that on its selects, a copy per case."""
+    if ti.shape[0] > 1:
+        copy_into(sc, _TI * VBLOCK, ti, lo, m)
+    if tr.shape[0] > 1:
+        copy_into(sc, _TR * VBLOCK, tr, lo, m)
+    if pr.shape[0] > 1:
+        copy_into(sc, _PR * VBLOCK, pr, lo, m)
     if turns:  # a constant of the kernel: only the diffuse one reads no azimuth
-        azimuths(_row(sc, _PR, m), _row(sc, _CP, m), _row(sc, _SP, m))
-    for r in range(rows):  # a single model's too: the loop then reads them as a set's
+        _azimuths(sc, m)
+    if index.shape[0] > 1:  # a column per geometry, picked
+        for r in range(rows):
+            o = (_PRM + r) * VBLOCK
+            for k in range(m):
+                sc[o + k] = prm[r, index[lo + k]]
+    elif prm.shape[1] > 1:  # a column per geometry, in order from index[0]
+        for r in range(rows):
+            copy_into(sc, (_PRM + r) * VBLOCK, prm, r * prm.shape[1] + index[0] + lo, m)
+
+
+@njit(error_model="numpy", inline="always")
+def _azimuths(sc, m):
+    """:func:`~scatterbench.models.kernels.common.azimuths` of the block's azimuths, read and
+    written at their rows' offsets (views would count references)."""
+    p, c, s = _PR * VBLOCK, _CP * VBLOCK, _SP * VBLOCK
+    far = 0
+    for k in range(m):
+        v = sc[p + k]
+        sc[s + k], sc[c + k] = sincos(v)
+        far += not abs(v) <= REDUCED_MAX
+    if far:
         for k in range(m):
-            sc[(_PRM + r) * VBLOCK + k] = prm[r, column(index, p, lo + k)]
+            v = sc[p + k]
+            if not abs(v) <= REDUCED_MAX:
+                sc[s + k], sc[c + k] = math.sin(v), math.cos(v)
 
 
 @njit(error_model="numpy")
 def put(out, sc, at, m):
-    """The block's ``m`` result columns of every row of ``out`` from the scratch into
-    ``out[:, at:at + m]``.  Unsigned indices: with signed ones numba adds a negative index's
-    wraparound to every store, which kept this copy scalar, a third of the FacetBRDF loop's
-    time (perf, 10^5 geometries on one thread)."""
-    base, w = np.uint64(at), np.uint64(m)
+    """The block's ``m`` result columns of every row of ``out`` (C-contiguous) from the scratch
+    into ``out[:, at:at + m]``, a ``memcpy`` a row."""
+    n = out.shape[1]
     for r in range(out.shape[0]):
-        o = np.uint64((_OUT + r) * VBLOCK)
-        for k in range(w):
-            out[r, base + k] = sc[o + k]
+        copy_into(out, r * n + at, sc, (_OUT + r) * VBLOCK, m)
 
 
 def lane_options(code, iopt) -> tuple:
@@ -244,6 +314,7 @@ def entry(code, opts):
         )
         sc = np.empty(_ROWS * VBLOCK)
         sc[(_PRM + rows) * VBLOCK :] = 0.0  # the parameter rows the kernel does not read: never gathered
+        shared(sc, ti, tr, pr, prm, index, min(VBLOCK, hi - lo), rows)
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
             gather(sc, ti, tr, pr, prm, index, blo, m, turns, rows)

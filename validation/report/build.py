@@ -132,7 +132,9 @@ def _run_sections(ctx, specs):
 #: Maxwell-Beard's 6; None: every one, or a module's entries), whether it calls the scalar loop
 #: (recorded by wrapping ``kernels.Compiled.scalar``: only for the options without lanes, the
 #: facets' other slopes and FacetBTDF), the Monte Carlo,
-#: aperture and disc entries, the fused Mueller likelihood of the PTFE section and the small
+#: aperture and disc entries, RoughSubsurfaceBRDF's (the conservation section's reciprocity
+#: check takes every registered model: left out, both workers compiled them during the sections,
+#: 2 x 4.7 s of CPU), the fused Mueller likelihood of the PTFE section and the small
 #: calls' angle check (the main process compiled those two, ~3 s, during the sections).  The
 #: loops only a later section runs are that section's (:attr:`~.core.SectionSpec.compiles`: the
 #: float32 facet, the speed section's), compiled while the sections before it run
@@ -153,7 +155,7 @@ COMPILE_GROUPS = (
      ("single", "float64", [(0, 0, 0), (1, 0, 0)], False), ("diffuse", "float64", [(0, 0, 0)], False)),
     (("facet", "float64", _FACET, True), ("maxwell", "float64", [(0, 0, 1), (1, 0, 0), (1, 0, 1)], False),
      ("btdf", "float64", [], True)),
-    (("aperture", "float64", None, False),),
+    (("aperture", "float64", None, False), ("rough", "float64", None, False)),
     (("likelihood", None, None, False),), (("disc", "float64", None, False),),
     (("angles", "float64", None, False),),
 )  # fmt: skip
