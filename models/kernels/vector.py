@@ -48,7 +48,7 @@ from llvmlite import ir
 from numba import njit, types
 from numba.core import cgutils, config
 from numba.core.errors import TypingError
-from numba.core.extending import intrinsic
+from numba.core.extending import intrinsic, overload
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
 from .common import NO_SHADOWING, REDUCED_MAX, polar
@@ -78,15 +78,26 @@ BLINN, NO_COOK_SHADOWING, COOK_SMITH = (
 )
 
 
-@intrinsic
-def copy_into(typingctx, dst, dst_at, src, src_at, count):
+def copy_into(dst, dst_at, src, src_at, count):
     """``count`` elements of ``src`` (flat, from ``src_at``) into ``dst`` (flat, from ``dst_at``):
-    one ``memcpy`` (the arrays C-contiguous of one dtype, not overlapping).  Other layouts
-    are refused when the caller compiles (a strided array's elements are not one block)."""
+    compiled, one ``memcpy`` (:func:`_memcpy`; the arrays C-contiguous of one dtype, not
+    overlapping: other layouts are refused when the caller compiles, as a strided array's
+    elements are not one block); in Python (``NUMBA_DISABLE_JIT=1``), numpy's copy."""
+    dst.reshape(-1)[dst_at : dst_at + count] = src.reshape(-1)[src_at : src_at + count]
+
+
+@overload(copy_into)
+def _copy_into_compiled(dst, dst_at, src, src_at, count):
     if not (isinstance(dst, types.Array) and isinstance(src, types.Array)):
         raise TypingError("copy_into: arrays only")
     if dst.layout != "C" or src.layout != "C" or dst.dtype != src.dtype:
         raise TypingError(f"copy_into: C-contiguous arrays of one dtype only, not {dst} and {src}")
+    return lambda dst, dst_at, src, src_at, count: _memcpy(dst, dst_at, src, src_at, count)
+
+
+@intrinsic
+def _memcpy(typingctx, dst, dst_at, src, src_at, count):
+    """:func:`copy_into`'s compiled form, LLVM's ``memcpy``."""
     sig = types.void(dst, dst_at, src, src_at, count)
 
     def codegen(context, builder, signature, args):
@@ -96,9 +107,8 @@ def copy_into(typingctx, dst, dst_at, src, src_at, count):
         dp = builder.gep(d.data, [builder.sext(args[1], i64) if args[1].type != i64 else args[1]])
         sp = builder.gep(s.data, [builder.sext(args[3], i64) if args[3].type != i64 else args[3]])
         n = args[4] if args[4].type == i64 else builder.sext(args[4], i64)
-        cgutils.raw_memcpy(
-            builder, dp, sp, n, context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
-        )
+        size = context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
+        cgutils.raw_memcpy(builder, dp, sp, n, size)
         return context.get_dummy_value()
 
     return sig, codegen
@@ -117,25 +127,26 @@ def vectorized(code, iopt) -> bool:
     return code in (SINGLE, DIFFUSE)
 
 
-@njit(error_model="numpy", inline="always")
-def _at(sc, row, k):
-    return sc[row * VBLOCK + k]
+# The scratch accessors index it directly: each call of a function numba inlines is typed and
+# lowered again where it is inlined, and a helper per element (19 per facet geometry) cost
+# every entry a fraction of a second of its compilation.
 
 
 @njit(error_model="numpy", inline="always")
 def _geometry(sc, k):
     """Geometry ``k`` of the scratch, as :func:`scatterbench.models.kernels.drive.geometry` gives it."""
-    return _at(sc, _TI, k), _at(sc, _TR, k), _at(sc, _PR, k), _at(sc, _CP, k), _at(sc, _SP, k)
+    B = VBLOCK
+    return sc[_TI * B + k], sc[_TR * B + k], sc[_PR * B + k], sc[_CP * B + k], sc[_SP * B + k]
 
 
 @njit(error_model="numpy", inline="always")
 def _facet_geometry(sc, k):
     """:func:`_geometry` followed by the rows :func:`facet_prepass` filled (:func:`~scatterbench.models.kernels.facet.facet_lanes`' ``ge``)."""
-    return _geometry(sc, k) + (
-        _at(sc, _PRE, k), _at(sc, _PRE + 1, k), _at(sc, _PRE + 2, k), _at(sc, _PRE + 3, k),
-        _at(sc, _PRE + 4, k), _at(sc, _PRE + 5, k), _at(sc, _PRE + 6, k), _at(sc, _PRE + 7, k),
-        _at(sc, _PRE + 8, k), _at(sc, _PRE + 9, k), _at(sc, _PRE + 10, k), _at(sc, _PRE + 11, k),
-        _at(sc, _PRE + 12, k),
+    B, o = VBLOCK, _PRE * VBLOCK + k
+    return (
+        sc[_TI * B + k], sc[_TR * B + k], sc[_PR * B + k], sc[_CP * B + k], sc[_SP * B + k],
+        sc[o], sc[o + B], sc[o + 2 * B], sc[o + 3 * B], sc[o + 4 * B], sc[o + 5 * B], sc[o + 6 * B],
+        sc[o + 7 * B], sc[o + 8 * B], sc[o + 9 * B], sc[o + 10 * B], sc[o + 11 * B], sc[o + 12 * B],
     )  # fmt: skip
 
 
@@ -151,10 +162,10 @@ def facet_prepass(sc, m):
     (both ad hoc: ``kernels.warm`` of the five in a fresh process, an empty cache)."""
     coated = 0
     for k in range(m):
-        coated += _at(sc, _PRM, k) != 1.0
+        coated += sc[_PRM * VBLOCK + k] != 1.0
     if coated:
         for k in range(m):
-            _coating_at(sc, k, _at(sc, _PRM, k))
+            _coating_at(sc, k, sc[_PRM * VBLOCK + k])
     else:
         for k in range(m):
             _coating_at(sc, k, 1.0)
@@ -165,7 +176,7 @@ def _coating_at(sc, k, n):
     """Geometry ``k``'s polar cosines and sines and their
     :func:`~scatterbench.models.kernels.facet.coating` into its 13 scratch rows (written out, as
     :func:`_store`)."""
-    pol_i, pol_r = polar(_at(sc, _TI, k)), polar(_at(sc, _TR, k))
+    pol_i, pol_r = polar(sc[_TI * VBLOCK + k]), polar(sc[_TR * VBLOCK + k])
     v = coating(pol_i, pol_r, n)
     B, o = VBLOCK, _PRE * VBLOCK + k
     sc[o], sc[o + B], sc[o + 2 * B], sc[o + 3 * B] = pol_i[0], pol_i[1], pol_r[0], pol_r[1]
@@ -182,9 +193,9 @@ def _no_prepass(sc, m):
 @njit(error_model="numpy", inline="always")
 def _scratch_params(sc, k):
     """Geometry ``k``'s parameters (:func:`gather` copied them)."""
-    return (_at(sc, _PRM, k), _at(sc, _PRM + 1, k), _at(sc, _PRM + 2, k), _at(sc, _PRM + 3, k),
-            _at(sc, _PRM + 4, k), _at(sc, _PRM + 5, k), _at(sc, _PRM + 6, k), _at(sc, _PRM + 7, k),
-            _at(sc, _PRM + 8, k), _at(sc, _PRM + 9, k), _at(sc, _PRM + 10, k))  # fmt: skip
+    B, o = VBLOCK, _PRM * VBLOCK + k
+    return (sc[o], sc[o + B], sc[o + 2 * B], sc[o + 3 * B], sc[o + 4 * B], sc[o + 5 * B],
+            sc[o + 6 * B], sc[o + 7 * B], sc[o + 8 * B], sc[o + 9 * B], sc[o + 10 * B])  # fmt: skip
 
 
 @njit(error_model="numpy", inline="always")
