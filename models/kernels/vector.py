@@ -330,10 +330,13 @@ def entry(code, opts):
         )
         sc = np.empty(_ROWS * VBLOCK)
         sc[(_PRM + rows) * VBLOCK :] = 0.0  # the parameter rows the kernel does not read: never gathered
-        shared(sc, ti, tr, pr, prm, index, min(VBLOCK, hi - lo), rows)
+        # the parameter rows to copy, a count LLVM cannot fold: with the constant, it unrolled
+        # shared's and gather's row loops in full, a vectorized inner loop per row, in every entry
+        copied = min(rows, prm.shape[0])
+        shared(sc, ti, tr, pr, prm, index, min(VBLOCK, hi - lo), copied)
         for blo in range(lo, hi, VBLOCK):
             m = min(VBLOCK, hi - blo)
-            gather(sc, ti, tr, pr, prm, index, blo, m, turns, rows)
+            gather(sc, ti, tr, pr, prm, index, blo, m, turns, copied)
             _PREPASS(sc, m)  # noqa: F821
             for k in range(m):
                 _store(sc, k, _KERNEL(_GEOMETRY(sc, k), _scratch_params(sc, k), o))  # noqa: F821
