@@ -65,15 +65,27 @@ def azimuth(p):
 @njit(error_model="numpy", forceinline=True)
 def azimuths(p, c, s):
     """:func:`azimuth` of every element of ``p`` into ``c``, ``s`` (float64 arrays of its
-    length), in two passes: the polynomial over all of them (a loop on SIMD lanes), then the
-    C library for the rare ones beyond its range (a branch to it per value, as in
+    length): :func:`azimuths_at` over the whole arrays."""
+    azimuths_at(p, 0, c, 0, s, 0, p.shape[0])
+
+
+@njit(error_model="numpy", inline="always")
+def azimuths_at(p, pa, c, ca, s, sa, n):
+    """:func:`azimuth` of ``p[pa:pa + n]`` into ``c[ca:ca + n]``, ``s[sa:sa + n]`` (flat float64
+    arrays; one array thrice for the lanes' scratch rows, where views would count references),
+    in two passes: the polynomial over all of them (a loop on SIMD lanes), then the C library
+    for the rare ones beyond its range, only if there are any (a branch to it per value, as in
     :func:`azimuth`, would keep the first loop scalar)."""
-    for k in range(p.shape[0]):
-        s[k], c[k] = sincos(p[k])
-    for k in range(p.shape[0]):
-        v = p[k]
-        if not abs(v) <= REDUCED_MAX:
-            s[k], c[k] = math.sin(v), math.cos(v)
+    far = 0
+    for k in range(n):
+        v = p[pa + k]
+        s[sa + k], c[ca + k] = sincos(v)
+        far += not abs(v) <= REDUCED_MAX
+    if far:
+        for k in range(n):
+            v = p[pa + k]
+            if not abs(v) <= REDUCED_MAX:
+                s[sa + k], c[ca + k] = math.sin(v), math.cos(v)
 
 
 @njit(error_model="numpy", forceinline=True)

@@ -41,8 +41,6 @@ its parameters, the ellipse's rotation given as the strokes' azimuth's cosine an
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from llvmlite import ir
 from numba import njit, types
@@ -51,10 +49,9 @@ from numba.core.errors import TypingError
 from numba.core.extending import intrinsic, overload
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
-from .common import NO_SHADOWING, REDUCED_MAX, polar
+from .common import NO_SHADOWING, azimuths_at, polar
 from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, own_kernel
 from .facet import coating, facet_lanes
-from .vector_math import sincos
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
 #: in the L2 cache
@@ -232,7 +229,8 @@ def shared(sc, ti, tr, pr, prm, index, m, rows):
 @njit(error_model="numpy")
 def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch (over what :func:`shared`
-    wrote): angles given per geometry, the azimuth's cosine and sine (:func:`_azimuths`), and
+    wrote): angles given per geometry, the azimuth's cosine and sine
+    (:func:`~scatterbench.models.kernels.common.azimuths_at`), and
     the first ``rows`` parameter rows, those the kernel reads, when the parameters are per
     geometry (the columns :func:`~scatterbench.models.kernels.drive.column` reads), the copies
     ``memcpy`` (:func:`copy_into`).  Branches, not the arithmetic of ``column``: LLVM
@@ -244,7 +242,7 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     if pr.shape[0] > 1:
         copy_into(sc, _PR * VBLOCK, pr, lo, m)
     if turns:  # a constant of the kernel: only the diffuse one reads no azimuth
-        _azimuths(sc, m)
+        azimuths_at(sc, _PR * VBLOCK, sc, _CP * VBLOCK, sc, _SP * VBLOCK, m)
     if index.shape[0] > 1:  # a column per geometry, picked
         for r in range(rows):
             o = (_PRM + r) * VBLOCK
@@ -253,23 +251,6 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     elif prm.shape[1] > 1:  # a column per geometry, in order from index[0]
         for r in range(rows):
             copy_into(sc, (_PRM + r) * VBLOCK, prm, r * prm.shape[1] + index[0] + lo, m)
-
-
-@njit(error_model="numpy", inline="always")
-def _azimuths(sc, m):
-    """:func:`~scatterbench.models.kernels.common.azimuths` of the block's azimuths, read and
-    written at their rows' offsets (views would count references)."""
-    p, c, s = _PR * VBLOCK, _CP * VBLOCK, _SP * VBLOCK
-    far = 0
-    for k in range(m):
-        v = sc[p + k]
-        sc[s + k], sc[c + k] = sincos(v)
-        far += not abs(v) <= REDUCED_MAX
-    if far:
-        for k in range(m):
-            v = sc[p + k]
-            if not abs(v) <= REDUCED_MAX:
-                sc[s + k], sc[c + k] = math.sin(v), math.cos(v)
 
 
 @njit(error_model="numpy")
