@@ -198,9 +198,20 @@ def transmission_at(sigma, n, u, radial=RADIAL, arc=ARC):
 def _tables(sigma, n, rho, nodes, feedback):
     """``(coef (E, 2, 2, nodes), ub (E,), scale (E,))`` for elements ``(sigma, n, rho)``: each
     panel's Chebyshev coefficients of ``t0`` and ``t1`` in ``cos(theta)``, the panel break, and
-    ``(rho / pi) / (1 - rho R-bar) / n^2``.  The slope quadrature once per distinct width
-    (compiled on the numba backend, :mod:`scatterbench.models.kernels.rough`), the rest for all
-    elements at once."""
+    ``(rho / pi) / (1 - rho R-bar) / n^2``, from the u-node values of :func:`_node_values`, for
+    all elements at once."""
+    t0, t1 = _node_values(sigma, n, nodes)
+    dct = _node_rules(nodes)[2]
+    coef = np.stack([t0.reshape(-1, 2, nodes) @ dct, t1.reshape(-1, 2, nodes) @ dct], axis=2)
+    ub = _panels(sigma, nodes)[0]
+    rbar = _rbar(sigma, n, nodes, t0) if feedback == "rough" else _flat_rbar(n)
+    return coef, ub, (rho / math.pi) / (1.0 - rho * rbar) / (n * n)
+
+
+def _node_values(sigma, n, nodes):
+    """``(t0, t1)`` ``(E, 2 nodes)`` at the u-nodes of elements ``(sigma, n)`` (flat arrays): the
+    slope quadrature once per distinct width (compiled on the numba backend,
+    :mod:`scatterbench.models.kernels.rough`), the Fresnel series for all elements at once."""
     widths, which = np.unique(sigma, return_inverse=True)
     compiled = _compiled()
     if compiled is not None:
@@ -209,13 +220,7 @@ def _tables(sigma, n, rho, nodes, feedback):
         A0, A1 = (np.stack(m) for m in zip(*(_moments_numpy(float(w), nodes) for w in widths), strict=True))
     which = which.reshape(-1)
     a, b = _fresnel_series(n)
-    t0 = np.einsum("ejm,em->ej", A0[which], a)
-    t1 = np.einsum("ejm,em->ej", A1[which], b)
-    dct = _node_rules(nodes)[2]
-    coef = np.stack([t0.reshape(-1, 2, nodes) @ dct, t1.reshape(-1, 2, nodes) @ dct], axis=2)
-    ub = _panels(sigma, nodes)[0]
-    rbar = _rbar(sigma, n, nodes, t0) if feedback == "rough" else _flat_rbar(n)
-    return coef, ub, (rho / math.pi) / (1.0 - rho * rbar) / (n * n)
+    return np.einsum("ejm,em->ej", A0[which], a), np.einsum("ejm,em->ej", A1[which], b)
 
 
 def _rbar(sigma, n, nodes, t0):
@@ -355,12 +360,7 @@ class RoughSubsurfaceBRDF(Model):
         if self.feedback == "flat":
             vals = _flat_rbar(n)
         else:
-            vals = np.array(
-                [
-                    _rbar(s, v, self.nodes, transmission_factor(s, v, self.nodes)[1])
-                    for s, v in zip(sigma, n, strict=True)
-                ]
-            )
+            vals = _rbar(sigma, n, self.nodes, _node_values(sigma, n, self.nodes)[0])
         return vals.reshape(self.param_shape) if self._sets else float(vals[0])
 
 
