@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from numba import njit
 
 from scatterbench import models as S
 from scatterbench.models import float32_domain as fd
@@ -189,6 +190,25 @@ def test_the_sine_error_of_the_kernels_is_the_stated_one():
 KERNEL_SINE = fd.EPS + 2.0**-26
 
 
+@njit
+def _polar_each(t):
+    """The kernels' ``polar`` of every value of ``t`` (helpers compile where a compiled function
+    calls them), kept in float64 arrays: a float64 result would show in its bits."""
+    c, s = np.empty(t.size), np.empty(t.size)
+    for i in range(t.size):
+        c[i], s[i] = common.polar(t[i])
+    return c, s
+
+
+@njit
+def _internal_sine_each(c, s, n):
+    """The sine inside a coating of index ``n`` from the float32 cosines ``c`` and sines ``s``."""
+    out = np.empty(c.size)
+    for i in range(c.size):
+        out[i] = common.internal_sine(np.float32(common.coating_cos(c[i], n)), s[i], n)
+    return out
+
+
 def test_the_kernels_sines_are_accurate_in_float32():
     """The float32 kernels' sines, and Snell's ``s / n`` in a coating, are within
     :data:`KERNEL_SINE` of the sine of the float32 angle they were given at every polar angle,
@@ -198,17 +218,10 @@ def test_the_kernels_sines_are_accurate_in_float32():
     t = np.concatenate([np.geomspace(1e-7, 0.05, 4001), np.linspace(0.05, 0.5 * math.pi, 4001)])
     t32 = t.astype(np.float32)
     exact = np.sin(t32.astype(float))
-    cs = [common.polar(x) for x in t32]  # float32 arguments: the float32 specialization
-    cosines, sines = (np.array(v) for v in zip(*cs, strict=True))
+    cosines, sines = _polar_each(t32)  # float32 arguments: the float32 specialization
     assert np.array_equal(sines, sines.astype(np.float32)) and sines[0] > 0  # float32 values
     assert np.max(np.abs(sines - exact)) <= KERNEL_SINE
-    f, n = np.float32, np.float32(1.5)
-    inside = np.array(
-        [
-            common.internal_sine(f(common.coating_cos(f(c), n)), f(s), n)
-            for c, s in zip(cosines, sines, strict=True)
-        ]
-    )
+    inside = _internal_sine_each(cosines.astype(np.float32), sines.astype(np.float32), np.float32(1.5))
     assert np.max(np.abs(inside - exact / 1.5)) <= KERNEL_SINE
     m, th = S.FacetBRDF(), np.geomspace(1e-6, 0.05, 2001)
     err = tradeoff.precision_error(

@@ -230,38 +230,60 @@ for m in (models.FacetBRDF(), smith, models.CookTorranceBRDF(), models.Varnished
     k.scalar(np.zeros(4), np.zeros(4), np.zeros(4), k.prm["float64"], drive.NO_INDEX, k.iopt, np.empty((16, 4)), 0, 0, 4)
     for name, fn in (("lanes", k.lanes), ("scalar", k.scalar)):  # each kernel's one compiled loop
         ir = "".join(fn.inspect_llvm().values())
-        print(label, name, len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M)), ir.count(" x double>"))
+        # the package's functions it calls, by name (numba's mangling: _ZN, then length-prefixed parts)
+        called = set()
+        for sym in re.findall(r'call [^@\\n]*@"?(_ZN12scatterbench[0-9A-Za-z_]+)', ir):
+            parts, rest = [], sym[3:]
+            while (d := re.match(r"\\d+", rest)) and int(d.group()) <= len(rest) - d.end():
+                parts.append(rest[d.end() : d.end() + int(d.group())])
+                rest = rest[d.end() + int(d.group()) :]
+            called.add(parts[-1] if parts else sym)
+        bodies = len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M))
+        print(label, name, bodies, ir.count(" x double>"), ",".join(sorted(called)) or "-")
 """
 
 
-# an earlier process that compiled two of the Cook-Torrance kernel's helpers on their own
-# (a test or a study calling them): with those cached, numba loaded them as object code in
-# the next process, which called them instead of inlining them, and its Cook loops stayed
-# scalar (6 vector loops instead of 8; 0.12 instead of 0.065 us per geometry)
+# an earlier process that compiled two of the Cook-Torrance kernel's helpers in a cached
+# function of its own (a test or a study calling them): when the helpers were cached
+# dispatchers, numba loaded them as object code in the next process, which called them
+# instead of inlining them, and its Cook loops stayed scalar (6 vector loops instead of 8;
+# 0.12 instead of 0.065 us per geometry)
 _EARLIER = """
+from numba import njit
 from scatterbench.models.kernels import common, cook
-cook.fresnel_average(0.5, 1.5, 0.1, False)
-common.stroke_d(0.1, 0.2, 0.9, 0.3, 0.3, 1.0, 0.0)
+
+@njit(cache=True)
+def both():
+    return cook.fresnel_average(0.5, 1.5, 0.1, False), common.stroke_d(0.1, 0.2, 0.9, 0.3, 0.3, 1.0, 0.0)
+
+both()
 """
 
 
 def test_the_lanes_are_vectorized_loops(tmp_path):
     """In a process that compiles the vector loop (its IR is inspected: a function loaded
-    from the cache has none), after an earlier process filled the cache with some of the
-    kernels' helpers: each model's vector loop (:func:`scatterbench.models.kernels.vector.lane_entries`)
+    from the cache has none), after an earlier process cached a function that inlines some of
+    the kernels' helpers: each model's vector loop (:func:`scatterbench.models.kernels.vector.lane_entries`)
     holds LLVM's vectorized loops (their ``vector.body`` blocks, on ``<N x double>`` values),
     the facet kernel's and Cook-Torrance's (under strokes) under Smith shadowing too (``erfc``,
     the ellipse's rotation from parameter rows);
     its scalar entry (:mod:`~scatterbench.models.kernels.drive`) has none.  Fails when a change puts a call or an exception
     back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
-    subprocess.run([sys.executable, "-c", _EARLIER], env=env, check=True)
+    earlier = tmp_path / "earlier.py"  # a file: numba caches no function of ``-c``'s
+    earlier.write_text(_EARLIER)
+    subprocess.run([sys.executable, str(earlier)], env=env, check=True)
     res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
-    counts = {tuple(ln.split()[:2]): tuple(int(x) for x in ln.split()[2:]) for ln in res.stdout.splitlines()}
+    rows = [ln.split() for ln in res.stdout.splitlines()]
+    counts = {tuple(r[:2]): (int(r[2]), int(r[3]), set(r[4].split(",")) - {"-"}) for r in rows}
     assert len(counts) == 10, res.stdout
-    for (model, loop), (bodies, vectors) in counts.items():
+    for (model, loop), (bodies, vectors, called) in counts.items():
         if loop == "lanes":  # one option set per entry: its loop, and LLVM's remainder copies
             assert bodies >= 1 and vectors > 0, (model, bodies, vectors)
+            # the block copies stay calls (kernels.helper's forceinline=None); a kernel's helper
+            # called, not inlined, kept Cook-Torrance's loop 3.5-5x slower with vector bodies left
+            called = {c for c in called if not c.startswith("run_range")}  # its own Python wrapper's
+            assert called <= {"gather", "shared", "put", "facet_prepass"}, (model, called)
         else:
             assert bodies == 0, (model, bodies)
 
@@ -296,13 +318,18 @@ def test_sincos_and_exp_within_two_ulp(span):
     assert np.all(np.isnan(r[~ok]))
 
 
-@njit
 def _each(f, a, b):
-    """``f(a[i], b[i])`` for every ``i``: a kernel helper of two arguments over arrays."""
-    out = np.empty_like(a)
-    for i in range(a.size):
-        out[i] = f(a[i], b[i])
-    return out
+    """``f(a[i], b[i])`` for every ``i``: a kernel helper of two arguments over arrays, in a
+    compiled loop that names it (a helper is an overload, not a value compiled code can take)."""
+
+    @njit
+    def loop(a, b):
+        out = np.empty_like(a)
+        for i in range(a.size):
+            out[i] = f(a[i], b[i])
+        return out
+
+    return loop(a, b)
 
 
 @pytest.mark.parametrize("scale", [1.0, 1e-300, 1e300])
@@ -345,8 +372,11 @@ def test_only_the_entry_points_are_cached():
     import pkgutil
 
     from numba.core.registry import CPUDispatcher
+    from numba.core.typing.templates import builtin_registry
 
     import scatterbench.models.kernels as kernels
+
+    registered = {fn for fn, _ in builtin_registry.globals}  # overloads: helper's and numba's
 
     entries = {
         "drive": {"angles_ok", "outside_range"},  # and the entries per kernel, below
@@ -355,11 +385,14 @@ def test_only_the_entry_points_are_cached():
         "disc": {"points"},
         "rough": {"_moments", "write"},
     }
-    seen = 0
+    seen = helpers = 0
     # every module of the package, so that a new one is held to the rule too
     for name in (info.name for info in pkgutil.iter_modules(kernels.__path__)):
         mod = importlib.import_module(f"scatterbench.models.kernels.{name}")
         for attr, fn in vars(mod).items():
+            if getattr(fn, "__module__", None) == mod.__name__ and fn in registered:
+                helpers += 1  # kernels.helper.helper's: compiled in each caller's process, never cached
+                assert attr not in entries.get(name, ()), f"{name}.{attr} is an entry, not a helper"
             if isinstance(fn, CPUDispatcher) and fn.py_func.__module__ == mod.__name__:
                 seen += 1
                 cached = type(fn._cache).__name__ != "NullCache"
@@ -367,7 +400,7 @@ def test_only_the_entry_points_are_cached():
                 if cached:  # in the package's cache directory, never beside the (read-only) package
                     where = fn._cache._cache_path
                     assert where.startswith(models.kernels.cache_dir()), f"{name}.{attr} caches in {where}"
-    assert seen > 40
+    assert seen > 20 and helpers > 60, (seen, helpers)
     # the loop per kernel (and per option set on SIMD lanes): closures, not module names
     per_kernel = list(drive.ENTRIES)
     per_kernel += [vector.lane_entries(c, np.zeros(3, dtype=np.int64)) for c in (0, 2, 3, 4, 5)]

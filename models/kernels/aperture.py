@@ -16,11 +16,12 @@ import numpy as np
 from numba import njit
 
 from .common import azimuths
+from .helper import helper
 from .threads import spread
 from .vector_math import atan2, inverse_binade, sincos, sqrt
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _double_angle(c, s):
     """``(cos 2x, sin 2x)`` of the angle of ``(c, s)``, both scaled first by the power of two
     that brings the larger near 1 (squares that would underflow near the normal: exact, and

@@ -26,6 +26,7 @@ from ..kernel_specs import (
     SHADOWING_KINDS,
     UNIT,
 )
+from .helper import helper
 from .vector_math import REDUCED_MAX, erfc, exp_neg, exp_neg_square, hypot, sincos, sqrt
 
 NO_SHADOWING, SMITH = SHADOWING_KINDS["none"], SHADOWING_KINDS["smith"]
@@ -34,7 +35,7 @@ _SQRT6 = math.sqrt(6.0)
 _INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def polar(t):
     """``(cos t, sin t)`` of a polar angle ``t`` in its precision, the sine as the numpy path
     takes it, ``sqrt(1 - cos^2)``, both computed in float64: in float32 that formula loses the
@@ -44,14 +45,14 @@ def polar(t):
     return polar_from(sincos(t)[1], t)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def polar_from(c, t):
     """:func:`polar` of ``t`` from its cosine ``c``, computed in float64."""
     T = type(t)
     return T(c), T(sqrt(1.0 - c * c))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def azimuth(p):
     """``(cos p, sin p)`` of an azimuth (float64; :func:`~scatterbench.models.kernels.vector_math.sincos`,
     the C library beyond its range)."""
@@ -62,7 +63,7 @@ def azimuth(p):
     return math.cos(v), math.sin(v)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def azimuths(p, c, s):
     """:func:`azimuth` of every element of ``p`` into ``c``, ``s`` (float64 arrays of its
     length): :func:`azimuths_at` over the whole arrays."""
@@ -88,7 +89,7 @@ def azimuths_at(p, pa, c, ca, s, sa, n):
                 s[sa + k], c[ca + k] = math.sin(v), math.cos(v)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def internal_sine(c_int, s_ext, n):
     """Sine of the refracted angle in a coating ``n`` of cosine ``c_int``, external sine
     ``s_ext``: float64 ``sqrt(1 - c_int^2)`` (the numpy path's); float32 ``s_ext / n`` (Snell;
@@ -99,7 +100,7 @@ def internal_sine(c_int, s_ext, n):
     return s_ext / n
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def csqrt(a, b):
     """Principal square root of ``a + ib`` (a ``+0`` imaginary part: the ``+i`` branch, TIR).
     No call (a loop that uses it vectorizes; its branches become selects there)."""
@@ -129,7 +130,7 @@ def csqrt(a, b):
     return (t, q) if right else (q, math.copysign(t, b))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def cdiv(a, b, c, d):
     """``(a + ib) / (c + id)`` as numpy divides complex numbers (Smith's algorithm with one
     reciprocal, ``scl = 1 / den``, and two products: bit for bit numpy's result, and one
@@ -146,7 +147,7 @@ def cdiv(a, b, c, d):
     return (a * r + b) * scl, (b * r - a) * scl
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def refraction_w(c, mr, mi):
     """``m^2`` and ``w = m cos(theta_t) = sqrt(m^2 - 1 + c^2)`` (principal branch) as
     ``(re, im)`` pairs, for cosine ``c`` and relative index ``m = mr + i mi``
@@ -158,7 +159,7 @@ def refraction_w(c, mr, mi):
     return m2r, m2i, wr, wi
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def rs_k(c, mr, mi, pec):
     """``r_s`` and ``K = (r_s + r_p) / sin^2`` at cosine ``c`` for relative index ``m = mr + i mi``
     (:func:`scatterbench.models.fresnel.reflection_rs_k`); ``pec``: a perfect conductor."""
@@ -179,7 +180,7 @@ def rs_k(c, mr, mi, pec):
     return rsr, rsi, kr, ki
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _rs_k64(c, m2r, m2i, wr, wi):
     """:func:`rs_k` in float64 with one division, where float32's takes six (three of
     :func:`cdiv`): ``r_s = (c - w) / D1`` and ``K = 2 (1 - m^2) / (D1 D2)``, ``D1 = c + w``,
@@ -203,7 +204,7 @@ def _rs_k64(c, m2r, m2i, wr, wi):
     return rsr, rsi, (er * pr + ei * pi) * s, (ei * pr - er * pi) * s
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def coating_w(c, n):
     """``w = n cos(theta_t) = sqrt(n^2 - 1 + c^2)`` of refraction into a non-absorbing coating
     ``n`` at external cosine ``c``: what :func:`coating_cos` and :func:`coating_t` share."""
@@ -211,7 +212,7 @@ def coating_w(c, n):
     return sqrt(n * n - T(1.0) + c * c)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def coating_cos(c, n):
     """Cosine of the refracted angle in a non-absorbing coating ``n`` from the external cosine
     ``c`` (:func:`scatterbench.models.fresnel.coating_cos`: no cancellation near grazing)."""
@@ -219,7 +220,7 @@ def coating_cos(c, n):
     return coating_w(c, n) * (T(1.0) / n)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def coating_t(c, n, w):
     """Real ``t_s``, ``t_p`` into a non-absorbing coating ``n`` (:func:`scatterbench.models.fresnel.coating_transmission`),
     given :func:`coating_w`'s ``w``."""
@@ -231,7 +232,7 @@ def coating_t(c, n, w):
     return T(2.0) * c / a, T(2.0) * n * c / b
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def dielectric_transmittance(c, n):
     """``1 - F`` for natural light at cosine ``c`` entering a non-absorbing ``n >= 1``
     (:func:`scatterbench.models.kernels.cook.fresnel_average` of a real index, in real arithmetic:
@@ -246,7 +247,7 @@ def dielectric_transmittance(c, n):
     return T(1.0) - T(0.5) * (rs * rs + rp * rp)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def hg_density(g, c):
     """Henyey-Greenstein density per sr at scattering cosine ``c``
     (:meth:`scatterbench.models.phase.HenyeyGreenstein.density`, the same form: its base
@@ -260,7 +261,7 @@ def hg_density(g, c):
     return u * (T(2.0) - u) / (T(4.0 * math.pi) * base * sqrt(base))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def p3(kind, zx, zy, sx, sy, rot, cov):
     """Slope density ``P3^xy`` of ``kind`` at ``(zx, zy)``; ``sx``, ``sy`` the widths (sigma,
     alpha; ``m_parallel``, ``m_perpendicular`` for strokes), ``rot`` the axes' rotation."""
@@ -291,7 +292,7 @@ def p3(kind, zx, zy, sx, sy, rot, cov):
     return cov * (stroke_d(zx, zy, T(1.0), sx, sy, c, s) / pi)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     """``exp(-tan^2 alpha / m(beta)^2) / m(beta)^2`` for a bisector ``h`` (seed 001 Eq. 8, 19;
     :func:`scatterbench.models.stroke_slopes.stroke_d`); ``c``, ``s``: cosine and sine of the strokes' azimuth."""
@@ -309,7 +310,7 @@ def stroke_d(hx, hy, hz2, m_par, m_perp, c, s):
     return exp_neg(q / hz2) * inv_m2
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def lam_unit(kind, mu):
     """Smith ``Lambda`` of the unit-width Gaussian or GGX family at ``mu = |cot theta|``: infinite
     at ``mu = 0``, zero at infinite ``mu``, without a branch or a call (the Gaussian's tail
@@ -324,7 +325,7 @@ def lam_unit(kind, mu):
     return T(math.inf) if mu == T(0.0) else lam
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def rotation(kind, rot):
     """Cosine and sine of slope kind ``kind``'s rotation ``rot`` (the elliptical kinds'; 1 and 0
     for the others, without a call): through the C library, so that a loop whose kind is a
@@ -335,7 +336,7 @@ def rotation(kind, rot):
     return math.cos(rot), math.sin(rot)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def smith_lambda(kind, c, s, cphi, sphi, sx, sy, cr, sr):
     """Smith ``Lambda`` (:func:`scatterbench.models.shadowing.smith_lambda`) of the Gaussian and GGX
     families, isotropic or elliptical, for a direction (cosine, sine, azimuth); ``cr``, ``sr``:
@@ -347,7 +348,7 @@ def smith_lambda(kind, c, s, cphi, sphi, sx, sy, cr, sr):
     return lam_unit(kind, mu / smith_width(kind, cphi, sphi, sx, sy, cr, sr))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def smith_width(kind, cphi, sphi, sx, sy, cr, sr):
     """The slopes' width along a direction of azimuth ``(cphi, sphi)``: ``sx`` for the isotropic
     kinds, the ellipse's radius (rotated by ``(cr, sr)``) for the elliptical ones."""
@@ -358,7 +359,7 @@ def smith_width(kind, cphi, sphi, sx, sy, cr, sr):
     return sqrt((sx * cl) ** 2 + (sy * sl) ** 2)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def smith_h(kind, c, s, cphi, sphi, sx, sy, cr, sr):
     """GGX's ``h = sqrt(1 + x^2)``, ``x = alpha tan theta`` (arguments as :func:`smith_lambda`'s):
     its ``Lambda = (h - 1) / 2``, so ``1 + Lambda = (1 + h) / 2`` and ``1 + Lambda_i + Lambda_o
@@ -369,7 +370,7 @@ def smith_h(kind, c, s, cphi, sphi, sx, sy, cr, sr):
     return type(c)(hypot(type(c)(1.0), alpha * s / abs(c)))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def smith_g(shadowing, kind, di, dio, sx, sy, cr, sr):
     """Shadowing-masking ``G`` for directions ``di``, ``dio`` = ``(cos, sin, cos phi, sin phi)``
     (no back-facing test: both see the facet from its front); ``cr``, ``sr`` as
@@ -388,7 +389,7 @@ def smith_g(shadowing, kind, di, dio, sx, sy, cr, sr):
     return T(1.0) / (T(1.0) + (li + lo))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     """The 16 Mueller elements (row-major) of a Jones matrix (Bohren & Huffman, as
     :func:`scatterbench.models.polarization.mueller16_from_jones`)."""
@@ -416,14 +417,14 @@ def mueller16(ssr, ssi, psr, psi, spr, spi, ppr, ppi):
     )  # fmt: skip
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def diag16(m00):
     """A depolarizer ``diag(m00, 0, 0, 0)`` (the scalar models)."""
     z = type(m00)(0.0)
     return (m00, z, z, z, z, z, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def scaled16(m, f):
     """The 16 elements ``m`` times ``f``."""
     return (

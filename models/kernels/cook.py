@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
 from ..kernel_specs import ANISO_GAUSSIAN, GAUSSIAN
 from .common import (
     SMITH,
@@ -21,10 +19,11 @@ from .common import (
     smith_g,
     stroke_d,
 )
+from .helper import helper
 from .vector_math import sqrt
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def fresnel_average(c, mr, mi, pec):
     """Natural-light reflectance ``(|r_s|^2 + |r_p|^2) / 2`` at cosine ``c`` for relative index
     ``mr + i mi`` (:func:`scatterbench.models.cook_torrance.fresnel_average`)."""
@@ -57,7 +56,7 @@ def fresnel_average(c, mr, mi, pec):
     return T(0.5) * ((rsr * rsr + rsi * rsi) + (rpr * rpr + rpi * rpi))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     """``D G F`` of Eq. 7 (:func:`scatterbench.models.cook_torrance.ct_kernel`) for polar cosines ``ci``, ``cr``
     and sines ``si``, ``sr``;
@@ -85,7 +84,7 @@ def ct_value(ci, si, cr, sr, cp, sp, p, mr, mi, shadowing):
     return val
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def cook(geo, p, o):
     """Cook-Torrance (``o[0] = 0``) or its varnished form (1); ``o[1]``: corrected
     convention, ``o[2]``: the shadowing (:data:`scatterbench.models.kernel_specs.COOK_SHADOWING`)."""

@@ -20,12 +20,13 @@ import math
 import numpy as np
 from numba import njit
 
+from .helper import helper
 from .vector_math import atan2, hypot, sincos, sqrt
 
 _TWO_PI = 2.0 * math.pi
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _t_of_v(v, h, krho):
     """:func:`scatterbench.models.disc_cubature._t_of_v`."""
     a = (krho / h) * (krho / (h + 1.0))
@@ -33,7 +34,7 @@ def _t_of_v(v, h, krho):
     return min(v * sqrt(2.0 - v * v * a) / (sqrt(h) * sqrt(h + 1.0) * s), 1.0)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _polar(k, h1, tan_c, sec_c, about_h, ox, v, chi, w):
     """``(psi, Phi, J)`` of the point ``(v, chi)`` (weight ``w``) in polar coordinates about
     ``O`` (``ox`` from the centre): about ``H`` when ``about_h``, else about the centre."""
@@ -52,13 +53,13 @@ def _polar(k, h1, tan_c, sec_c, about_h, ox, v, chi, w):
     return atan2(tan_psi, 1.0), atan2(y, x), w * rho * rho * j
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _share(r, h):
     """:func:`scatterbench.models.disc_cubature._share`."""
     return r * (r / (h * (h + 1.0)))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _wedge(k, xc, u, alpha, w):
     """``(psi, Phi, J)`` of the wedge's point ``(u, alpha)`` (:func:`scatterbench.models.disc_cubature._wedge`)."""
     phi = 0.5 * (np.remainder(alpha + math.pi, _TWO_PI) - math.pi)

@@ -24,6 +24,7 @@ from ..kernel_specs import KERNEL_ROWS
 from .common import azimuth
 from .cook import cook
 from .facet import btdf, facet
+from .helper import helper
 from .maxwell import maxwell
 from .volume import diffuse, single
 
@@ -41,7 +42,7 @@ OPTIONS = 3
 assert PARAM_ROWS == 11, "params() reads 11 rows"
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def geometry(ti, tr, pr):
     """``(theta_i, theta_r, phi_r, cos phi_r, sin phi_r)`` in the angles' precision."""
     T = type(pr)
@@ -49,20 +50,20 @@ def geometry(ti, tr, pr):
     return ti, tr, pr, T(c), T(s)
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def params(prm, j):
     """Column ``j`` of the parameter rows as a tuple."""
     return (prm[0, j], prm[1, j], prm[2, j], prm[3, j], prm[4, j], prm[5, j],
             prm[6, j], prm[7, j], prm[8, j], prm[9, j], prm[10, j])  # fmt: skip
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def options(iopt):
     """The options as a tuple."""
     return (iopt[0], iopt[1], iopt[2])
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def store(out, i, m):
     """The elements ``m`` into ``out[:, i]`` (only ``M00`` when ``out`` has one row)."""
     out[0, i] = m[0]

@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
 from .common import NO_SHADOWING, coating_t, coating_w, mueller16, p3, polar, rotation, rs_k, smith_g
+from .helper import helper
 from .vector_math import sqrt
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def facet_jones(g, p, o):
     """Jones elements ``(ss, ps, sp, pp)`` (re, im) of facet reflection, scaled so that their
     Mueller matrix is the BRDF (:func:`scatterbench.models.facet.facet_jones`); ``g``: the geometry
@@ -21,13 +20,13 @@ def facet_jones(g, p, o):
     return facet_jones_at(g, polar(g[0]), polar(g[1]), p, o)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def facet_jones_at(g, pol_i, pol_r, p, o):
     """:func:`facet_jones` given the polar angles' ``(cos, sin)`` (:func:`~scatterbench.models.kernels.common.polar`)."""
     return facet_jones_through(g, pol_i, pol_r, coating(pol_i, pol_r, p[0]), p, o)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def coating(pol_i, pol_r, n):
     """The directions of polar ``(cos, sin)`` ``pol_i``, ``pol_r`` inside a smooth non-absorbing
     coating ``n``: their sines and cosines ``(si, sr, ci, cr)``, the transmission coefficients
@@ -48,7 +47,7 @@ def coating(pol_i, pol_r, n):
     return si_e * inv_n, sr_e * inv_n, wi * inv_n, wr * inv_n, tsi, tpi, tsr, tpr, inv_n
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def facet_jones_through(g, pol_i, pol_r, coat, p, o):
     """:func:`facet_jones_at` given the :func:`coating`'s values ``coat`` (its transmission
     coefficients applied as they are: ones leave the bits alone)."""
@@ -98,14 +97,14 @@ def facet_jones_through(g, pol_i, pol_r, coat, p, o):
     )
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def facet(geo, p, o):
     """:class:`scatterbench.models.FacetBRDF` and :class:`scatterbench.models.SubsurfaceFacetBRDF` at one geometry."""
     a, b, c, d, e, f, g, h = facet_jones(geo, p, o)
     return mueller16(a, b, c, d, e, f, g, h)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def facet_lanes(ge, p, o):
     """:func:`facet` on SIMD lanes: ``ge`` the geometry followed by its polar angles' cosines and
     sines and its :func:`coating`'s values, which
@@ -118,17 +117,17 @@ def facet_lanes(ge, p, o):
     return mueller16(a, b, c, d, e, f, g, h)
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def dot3(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def cross3(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def transmission_factors(c, mr):
     """``t_s`` and ``(t_p - t_s) / sin^2`` of refraction at local cosine ``c`` into relative
     index ``mr`` (zero beyond the critical angle), as :func:`scatterbench.models.facet_btdf.facet_transmission_jones`."""
@@ -149,7 +148,7 @@ def transmission_factors(c, mr):
     return ts, delta * (T(1.0) / (w + mr * c))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     """Real Jones elements ``(ss, ps, sp, pp)`` of refraction through facet ``m`` and the local
     cosines ``(cos iota_in, cos iota_out)`` (the dyadic of seed 003 Eq. 40, Rodrigues' rotation)."""
@@ -171,14 +170,14 @@ def btdf_jones(k_in, k_out, m, mr, e_in, e_out):
     return ss, ps, sp, pp, c, c_out
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _btdf_element(ea, eb, v, a_in, a_out, cg, inv1, ts, delta):
     """One element of :func:`btdf_jones`: out-basis vector ``ea``, in-basis vector ``eb``."""
     rot = cg * dot3(ea, eb) + dot3(ea, cross3(v, eb)) + dot3(ea, v) * dot3(v, eb) * inv1
     return ts * rot + delta * dot3(ea, a_out) * dot3(a_in, eb)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def btdf(g, p, o):
     """:class:`scatterbench.models.FacetBTDF` (``convention="paper"``) at one geometry."""
     ti, tt, pt, _, _ = g

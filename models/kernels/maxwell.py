@@ -6,14 +6,13 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
 from .common import diag16, mueller16, polar_from, scaled16
 from .facet import coating, facet_jones_through
+from .helper import helper
 from .vector_math import atan2, exp_neg, sincos, sqrt
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def shadow(si, ci, sr, cr, cp, sp, tau, omega):
     """Shadowing/obscuration ``SO(theta_N, beta)`` (:func:`scatterbench.models.maxwell_beard.maxwell_beard_shadow`,
     whose docstring derives the two ``atan2``) from the angles' sines and cosines."""
@@ -30,7 +29,7 @@ def shadow(si, ci, sr, cr, cp, sp, tau, omega):
     return e if x == T(math.inf) else so  # theta_N / Omega overflowed (a tiny Omega): SO's limit
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def maxwell(geo, p, o):
     """Maxwell-Beard at one geometry; ``o[0]``: the slope kind, ``o[2]``: the facet Mueller
     matrix on the specular term.  No C library call: a loop over it runs on SIMD lanes

@@ -38,6 +38,7 @@ from numba import njit
 
 from .common import hg_density, mueller16
 from .facet import btdf_jones, cross3, dot3, transmission_factors
+from .helper import helper
 from .threads import spread
 
 __all__ = ["estimate", "exit_transmittance"]
@@ -48,7 +49,7 @@ _REACHED = np.array([0, 1, 2, 4, 5, 6, 8, 9, 10, 15])
 _NO_BASIS = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _ray_basis(k):
     """``(s, p)`` of ray ``k``: ``s = unit(z x k)``, ``+y`` along the z axis
     (:func:`scatterbench.models.facet_btdf.ray_basis`); selects, not a branch, so that a loop
@@ -59,7 +60,7 @@ def _ray_basis(k):
     return s, cross3(k, s)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _refracted(k, m, eta):
     """``(cos, k_t)``: the cosine ``-k . m`` of ray ``k`` striking the facet of unit normal ``m``
     (from the side ``m`` points to) and the ray refracted through it at relative index ``eta``
@@ -85,7 +86,7 @@ def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     return w, k1, e1, (ss, ps, sp, pp), n * c_out / (c_in if c_in > 0.0 else 1.0)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _leaving(k_r, n_r, zx, zy, m, n):
     """The internal ray ``k2`` that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
     ``(weight, cos(k_r, m), k2, whether it exists)``."""
@@ -96,7 +97,7 @@ def _leaving(k_r, n_r, zx, zy, m, n):
     return w, c, k2, w > 0.0 and c > 0.0 and k2[2] > 0.0
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _exit(k_r, e_r, n_r, zx, zy, m, n):
     """The internal ray that leaves along ``k_r`` through facet ``m`` (slopes ``zx, zy``):
     ``(whether it exists, weight, k2, basis of k2, Jones, flux factor)``, computed either way
@@ -107,7 +108,7 @@ def _exit(k_r, e_r, n_r, zx, zy, m, n):
     return live, w, k2, e2, (ss, ps, sp, pp), c_out / (n * (c_in if c_in > 0.0 else 1.0))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _volume(k1, e1, ji, k2, e2, jo, base, depth, prm):
     """One live pair's Mueller estimate: its :data:`_REACHED` elements, in that order (the
     others are zero), the totally diffuse term and the single scattering (depolarizing: a
@@ -178,12 +179,15 @@ def _entries(ti, n_i, z, m, n, ent):
         ent[14, j] = f_in
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _welford(acc, q, g, v, inv, live):
     """Welford's update of element ``q`` of geometry ``g`` (rows ``q``, ``10 + q``, ``20 + q`` of
     ``acc``: mean, sum of squared deviations, largest magnitude) by ``v`` where ``live``, as
     selects: the loop over geometries stays on SIMD lanes."""
-    a, b, c = q * _LANES + g, (10 + q) * _LANES + g, (20 + q) * _LANES + g
+    # the other rows as offsets of the mean's: each computed from q (``(10 + q) * _LANES + g``),
+    # in the one copy of a helper for every q (kernels.helper), kept the walk off the SIMD lanes
+    a = q * _LANES + g
+    b, c = a + 10 * _LANES, a + 20 * _LANES
     mu, m2, peak = acc[a], acc[b], acc[c]
     d = v - mu
     mu_new = mu + d * inv
@@ -192,7 +196,7 @@ def _welford(acc, q, g, v, inv, live):
     acc[c] = max(peak, abs(v)) if live else peak
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def _walk(dirs, count, ent, z, m, prm, inv_scale, acc):
     """Welford's running mean and sum of squared deviations of the live pairs' estimates times
     ``inv_scale`` (row ``q``: element ``q`` of :data:`_REACHED`), their largest magnitudes, and
@@ -386,7 +390,7 @@ def exit_transmittance(tr, pr, n_r, z, m, n):
 EXIT_GRAIN = 32
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _exit_t00(k_r, n_r, zx, zy, m, n):
     """``w_r M_out[0, 0]`` of one exit facet (slopes ``zx, zy``, unit normal ``m``) for the
     direction ``k_r``, without a branch the compiler keeps (the direction loop around it

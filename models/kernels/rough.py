@@ -12,6 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .helper import helper
 from .threads import spread
 from .vector_math import atan2, exp_neg, sincos, sqrt
 
@@ -57,7 +58,7 @@ def _moments(sigmas, nodes, rx, rw, ax, aw, cheb, A0, A1, lo, hi):  # pragma: no
             _reduce(xc, w0, w1, nr * P, tp, tc, A0[k, j], A1[k, j])
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _radii(rho0, sigma, rx, rw, rad):  # pragma: no cover - compiled
     """The radial rule at ``rho0 = cot(theta)`` into ``rad`` (radius, weight x density x half
     arc, arc start, half arc, ``1 + rho^2``); returns how many radii (one part or two)."""
@@ -159,7 +160,7 @@ def write(coef, ub, scale, index, ti, tr, out, lo, hi, col):  # pragma: no cover
         i += L
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def _clenshaw(c, u_b, u, low, L, t0, t1, b1, b2, d1, d2):  # pragma: no cover - compiled
     """``t0``, ``t1`` at ``u[:L]`` (overwritten by the panels' variable) of one element's panels
     ``c`` ``(2, 2, K)``: both series at once, each lane's coefficients selected from the two

@@ -52,6 +52,7 @@ from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, 
 from .common import NO_SHADOWING, azimuths_at, polar
 from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, own_kernel
 from .facet import coating, facet_lanes
+from .helper import helper
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
 #: in the L2 cache
@@ -152,7 +153,7 @@ def _facet_geometry(sc, k):
     )  # fmt: skip
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def facet_prepass(sc, m):
     """The facet kernel's polar cosines and sines, and its :func:`~scatterbench.models.kernels.facet.coating`
     for the block's ``m`` geometries, into the scratch rows from :data:`_PRE`: the coating's own
@@ -211,7 +212,7 @@ def _store(sc, k, m):
     sc[o + 12 * B], sc[o + 13 * B], sc[o + 14 * B], sc[o + 15 * B] = m[12], m[13], m[14], m[15]
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def shared(sc, ti, tr, pr, prm, index, m, rows):
     """Once per call, the scratch rows that every block shares, in its first ``m`` columns: the
     angles as if each were one value (:func:`gather` then copies over those that are not) and,
@@ -226,7 +227,7 @@ def shared(sc, ti, tr, pr, prm, index, m, rows):
                 sc[o + k] = v
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     """Geometries ``lo .. lo + m - 1`` of the inputs into the scratch (over what :func:`shared`
     wrote): angles given per geometry, the azimuth's cosine and sine
@@ -253,7 +254,7 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
             copy_into(sc, (_PRM + r) * VBLOCK, prm, r * prm.shape[1] + index[0] + lo, m)
 
 
-@njit(error_model="numpy")
+@helper(forceinline=None)
 def put(out, sc, at, m):
     """The block's ``m`` result columns of every row of ``out`` (C-contiguous) from the scratch
     into ``out[:, at:at + m]``, a ``memcpy`` a row."""

@@ -52,8 +52,10 @@ import math
 
 import numpy as np
 from llvmlite import ir
-from numba import config, njit, types
+from numba import config, types
 from numba.extending import intrinsic
+
+from .helper import helper
 
 #: ``pi/2`` in three parts: 30 + 30 significant bits, and the rest
 _P1, _P2, _P3 = 1.570796325802803, 9.920935791635221e-10, 5.170182981794105e-19
@@ -120,7 +122,7 @@ def _to_bits(typingctx, x):
     return sig, codegen
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def inverse_binade(x):
     """``2^-e`` for the float64 ``x > 0`` of exponent ``e`` (``1 <= x 2^-e < 2`` for a normal
     ``x``): an exact scale that brings ``x`` near 1 without a division (subnormal ``x``: the
@@ -128,7 +130,7 @@ def inverse_binade(x):
     return binade_scales(x)[0]
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def binade_scales(x):
     """:func:`inverse_binade`'s scale and its inverse (``2^-1023``, subnormal, for a subnormal
     ``x``), both exact: a product by the inverse undoes the scaling without a division (the
@@ -166,7 +168,7 @@ if config.DISABLE_JIT:
             return np.sqrt(x)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def sincos(x):
     """``(sin x, cos x)`` in float64 for ``|x| <= REDUCED_MAX`` (no branch, no call)."""
     v = np.float64(x)
@@ -182,7 +184,7 @@ def sincos(x):
     return (-sv if quad >= 2 else sv), (-cv if (quad == 1 or quad == 2) else cv)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def exp_neg(x):
     """``exp(-x)`` in the precision of ``x >= 0``, exactly zero from :data:`EXP_ZERO` on."""
     T = type(x)
@@ -196,7 +198,7 @@ def exp_neg(x):
     return T(e if v < EXP_ZERO else 0.0)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def exp_neg_square(x):
     """``exp(-x^2)`` for ``x >= 0`` (no branch, no call), the square taken exactly: ``x^2 = p + e``
     (Dekker's product), ``exp(-p) (1 - e)``; rounding ``x^2`` would cost up to ``x^2`` ulps of
@@ -212,7 +214,7 @@ def exp_neg_square(x):
     return T(exp_neg(p) * (1.0 - e))
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def erfc(x):
     """The complementary error function in float64 (no branch, no call): for ``a = |x|``,
     ``exp(-a^2) f(t) / (1 + 2 a)`` with ``t = (a - 4) / (a + 4)`` and ``f`` a polynomial of degree
@@ -230,7 +232,7 @@ def erfc(x):
     return T(2.0 - r if v < 0.0 else r)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def hypot(x, y):
     """``hypot(x, y)`` without overflow or underflow and without a call: both scaled by the
     power of two that brings the larger near 1 (exact), within about an ulp of the C
@@ -244,7 +246,7 @@ def hypot(x, y):
     return sqrt(a * a + b * b) * back
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def atan2(y, x):
     """``atan2(y, x)`` in float64 for finite ``x``, ``y`` (no branch, no call): the angle of
     ``(x, y)`` in [-pi, pi], with the C library's signs at zeros (``atan2(+-0, -0) = +-pi``)."""

@@ -4,15 +4,14 @@ call, as :mod:`scatterbench.models.single_scatter` and :mod:`scatterbench.models
 
 from __future__ import annotations
 
-from numba import njit
-
 from .common import coating_cos, hg_density, mueller16, polar
+from .helper import helper
 from .vector_math import sqrt
 
 #: parameter rows: the binder's index, then the phase's g (single) or the diffuse scale
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def amplitudes(c, s, n):
     """``(sin_int, cos_int, a_s, a_p)`` of :func:`scatterbench.models.smooth_interface.interface_amplitudes`
     for the external cosine and sine ``c``, ``s`` (:func:`scatterbench.models.kernels.common.polar`)."""
@@ -32,7 +31,7 @@ def amplitudes(c, s, n):
     return s_int, c_int, a_s, a_p
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def depolarized16(asi, api, asr, apr, scale):
     """:func:`scatterbench.models.smooth_interface.depolarized_between`'s 16 elements."""
     T = type(asi)
@@ -45,7 +44,7 @@ def depolarized16(asi, api, asr, apr, scale):
     return (s_out * s_in, s_out * d_in, z, z, d_out * s_in, d_out * d_in, z, z, z, z, z, z, z, z, z, z)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def single(geo, p, o):
     """Single scattering under a smooth interface (seed 003 Eq. 20); ``o[0]``: polarized phase."""
     ti, tr, _, cp, sp = geo
@@ -71,7 +70,7 @@ def single(geo, p, o):
     return mueller16(ss, z, ps, z, sp_, z, pp, z)
 
 
-@njit(error_model="numpy", forceinline=True)
+@helper
 def diffuse(geo, p, o):
     """Lambertian diffuser under a smooth interface (seed 003 Eq. 27); ``p[1]``: its scale."""
     ti, tr = geo[0], geo[1]
