@@ -268,7 +268,8 @@ def test_the_lanes_are_vectorized_loops(tmp_path):
     the facet kernel's and Cook-Torrance's (under strokes) under Smith shadowing too (``erfc``,
     the ellipse's rotation from parameter rows);
     its scalar entry (:mod:`~scatterbench.models.kernels.drive`) has none.  Fails when a change puts a call or an exception
-    back in a kernel the vector path takes, or caches a helper again (:mod:`scatterbench.models.kernels`)."""
+    back in a kernel the vector path takes, caches a helper again (:mod:`scatterbench.models.kernels`),
+    or leaves a call to a kernel helper (anything but the block copies) in a lane loop."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     earlier = tmp_path / "earlier.py"  # a file: numba caches no function of ``-c``'s
     earlier.write_text(_EARLIER)

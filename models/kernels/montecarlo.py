@@ -184,8 +184,9 @@ def _welford(acc, q, g, v, inv, live):
     """Welford's update of element ``q`` of geometry ``g`` (rows ``q``, ``10 + q``, ``20 + q`` of
     ``acc``: mean, sum of squared deviations, largest magnitude) by ``v`` where ``live``, as
     selects: the loop over geometries stays on SIMD lanes."""
-    # the other rows as offsets of the mean's: each computed from q (``(10 + q) * _LANES + g``),
-    # in the one copy of a helper for every q (kernels.helper), kept the walk off the SIMD lanes
+    # the other rows as offsets of the mean's: computed each from q, as ``(10 + q) * _LANES + g``,
+    # they kept the walk off the SIMD lanes once one copy of this helper served every q
+    # (kernels.helper; with a copy per literal q they did not)
     a = q * _LANES + g
     b, c = a + 10 * _LANES, a + 20 * _LANES
     mu, m2, peak = acc[a], acc[b], acc[c]

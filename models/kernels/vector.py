@@ -146,8 +146,7 @@ def _geometry(sc, k):
 def _facet_geometry(sc, k):
     """:func:`_geometry` followed by the rows :func:`facet_prepass` filled (:func:`~scatterbench.models.kernels.facet.facet_lanes`' ``ge``)."""
     B, o = VBLOCK, _PRE * VBLOCK + k
-    return (
-        sc[_TI * B + k], sc[_TR * B + k], sc[_PR * B + k], sc[_CP * B + k], sc[_SP * B + k],
+    return _geometry(sc, k) + (
         sc[o], sc[o + B], sc[o + 2 * B], sc[o + 3 * B], sc[o + 4 * B], sc[o + 5 * B], sc[o + 6 * B],
         sc[o + 7 * B], sc[o + 8 * B], sc[o + 9 * B], sc[o + 10 * B], sc[o + 11 * B], sc[o + 12 * B],
     )  # fmt: skip
