@@ -14,7 +14,8 @@ from numba import njit
 from test_kernels import CONFIGS, _geometries
 
 from scatterbench import models
-from scatterbench.models.kernels import Compiled, drive, vector
+from scatterbench.models.kernel_specs import GGX, SHADOWING_KINDS
+from scatterbench.models.kernels import Compiled, common, drive, memory, vector
 from scatterbench.models.kernels.vector_math import (
     REDUCED_MAX,
     atan2,
@@ -25,6 +26,7 @@ from scatterbench.models.kernels.vector_math import (
     sincos,
     sqrt,
 )
+from scatterbench.models.shadowing import smith_g
 
 #: test_kernels' configurations, and Cook-Torrance under strokes (its azimuth's cosine and
 #: sine are parameter rows)
@@ -121,14 +123,15 @@ def test_vector_loop_ranges_take_what_every_block_shares(model):
         assert np.array_equal(parts, whole) and np.array_equal(whole, scalar)
 
 
-def test_copy_into_refuses_strided_arrays():
-    """The scratch copies (``memcpy``) take C-contiguous arrays of one dtype; a strided one is
-    refused when the caller compiles, not copied as if contiguous."""
+@pytest.mark.parametrize("copy_fn", [memory.copy_into, memory.stream_into], ids=lambda f: f.__name__)
+def test_block_copies_refuse_strided_arrays(copy_fn):
+    """The scratch copies (``memcpy``, streaming stores) take C-contiguous arrays of one dtype; a
+    strided one is refused when the caller compiles, not copied as if contiguous."""
     from numba.core.errors import TypingError
 
     @njit
     def copy(dst, src):
-        vector.copy_into(dst, 0, src, 0, 3)
+        copy_fn(dst, 0, src, 0, 3)
 
     dst, src = np.zeros(3), np.arange(6.0)
     copy(dst, src)
@@ -137,6 +140,55 @@ def test_copy_into_refuses_strided_arrays():
         copy(dst, src[::2])
     with pytest.raises(TypingError, match="one dtype"):
         copy(dst, src.astype(np.float32))
+
+
+@njit
+def _streamed(dst, dst_at, src, src_at, count):
+    memory.stream_into(dst, dst_at, src, src_at, count)
+    memory.store_fence()
+
+
+def test_streamed_copies_are_the_elements():
+    """:func:`~scatterbench.models.kernels.memory.stream_into` at every start modulo a cache line
+    and lengths around it (the ordinary stores before the first line boundary, whole lines
+    streamed, the rest ordinary): exactly the elements, nothing written outside them."""
+    src = np.random.default_rng(4).random(200)
+    per = memory.LINE_BYTES // 8
+    for dst_at in range(2 * per):
+        for count in (0, 1, per - 1, per, per + 1, 3 * per + 5, 150):
+            dst = np.full(200, -1.0)
+            _streamed(dst, dst_at, src, 7, count)
+            want = np.full(200, -1.0)
+            want[dst_at : dst_at + count] = src[7 : 7 + count]
+            assert np.array_equal(dst, want), (dst_at, count)
+
+
+def test_results_stream_only_beyond_what_callers_read_back():
+    """Results of more than ``STREAM_MIN`` elements are streamed to memory; the buffers the
+    kernels' callers fill and read back at once (a chunk of a result that is not written in
+    place, ``kernels.Compiled.write``; a range of ``Compiled.accumulate``) never are."""
+    from scatterbench.models import evaluation, kernels
+
+    assert 16 * evaluation.KERNEL_CHUNK <= memory.STREAM_MIN
+    assert 16 * max(kernels.ADD_CHUNK, drive.BLOCK) <= memory.STREAM_MIN
+
+
+@pytest.mark.parametrize("model", VECTORIZED[::4], ids=lambda m: type(m).__name__)
+def test_streamed_results_are_the_stored_ones(model):
+    """A result beyond ``STREAM_MIN`` elements (streamed, its rows at every alignment: an odd
+    length) holds the bits of the same geometries evaluated in ranges into a small one."""
+    n = memory.STREAM_MIN // 16 + 37
+    rng = np.random.default_rng(6)
+    ti, tr, pr = rng.uniform(0.0, 1.5, n), rng.uniform(0.0, 1.5, n), rng.uniform(-np.pi, np.pi, n)
+    kernel = Compiled(model, *model._kernel_spec())
+    prm = kernel.params("float64")
+    whole = np.empty((16, n))
+    kernel.lanes(ti, tr, pr, prm, drive.NO_INDEX, kernel.iopt, whole, 0, 0, n)
+    part = np.empty((16, 4096))
+    for lo in range(0, n, 4096):
+        hi = min(n, lo + 4096)
+        kernel.lanes(ti, tr, pr, prm, drive.NO_INDEX, kernel.iopt, part, -lo, lo, hi)
+        assert np.array_equal(whole[:, lo:hi], part[:, : hi - lo]), lo
 
 
 @pytest.mark.parametrize("shadowing", ["none", "smith"])
@@ -239,7 +291,8 @@ for m in (models.FacetBRDF(), smith, models.CookTorranceBRDF(), models.Varnished
                 rest = rest[d.end() + int(d.group()) :]
             called.add(parts[-1] if parts else sym)
         bodies = len(re.findall(r"^vector\\.body[.\\w]*:", ir, re.M))
-        print(label, name, bodies, ir.count(" x double>"), ",".join(sorted(called)) or "-")
+        streamed = ir.count("!nontemporal")
+        print(label, name, bodies, ir.count(" x double>"), streamed, ",".join(sorted(called)) or "-")
 """
 
 
@@ -276,11 +329,13 @@ def test_the_lanes_are_vectorized_loops(tmp_path):
     subprocess.run([sys.executable, str(earlier)], env=env, check=True)
     res = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, check=True)
     rows = [ln.split() for ln in res.stdout.splitlines()]
-    counts = {tuple(r[:2]): (int(r[2]), int(r[3]), set(r[4].split(",")) - {"-"}) for r in rows}
+    counts = {tuple(r[:2]): (int(r[2]), int(r[3]), int(r[4]), set(r[5].split(",")) - {"-"}) for r in rows}
     assert len(counts) == 10, res.stdout
-    for (model, loop), (bodies, vectors, called) in counts.items():
+    for (model, loop), (bodies, vectors, streamed, called) in counts.items():
         if loop == "lanes":  # one option set per entry: its loop, and LLVM's remainder copies
             assert bodies >= 1 and vectors > 0, (model, bodies, vectors)
+            # a large result's rows streamed to memory (memory.stream_into), on x86-64
+            assert (streamed > 0) == memory.STREAMS, (model, streamed)
             # the block copies stay calls (kernels.helper's forceinline=None); a kernel's helper
             # called, not inlined, kept Cook-Torrance's loop 3.5-5x slower with vector bodies left
             called = {c for c in called if not c.startswith("run_range")}  # its own Python wrapper's
@@ -363,6 +418,35 @@ def test_hypot_within_two_ulp(scale):
     got = _each(hypot, x, y)
     assert np.all(np.isfinite(got)) and _ulps(got[ref != 0], ref[ref != 0]) <= 2.0
     assert np.array_equal(got[ref == 0], ref[ref == 0])
+
+
+@njit
+def _ggx_g_each(form, ci, si, co, so, cpo, spo, alpha):
+    """The kernels' GGX Smith ``G`` (:func:`scatterbench.models.kernels.common.smith_g`) of every
+    pair of directions, incidence in the plane of azimuth 0."""
+    out = np.empty_like(ci)
+    for k in range(ci.size):
+        di, do = (ci[k], si[k], -1.0, 0.0), (co[k], so[k], cpo[k], spo[k])
+        out[k] = common.smith_g(form, GGX, di, do, alpha, alpha, 1.0, 0.0)
+    return out
+
+
+@pytest.mark.parametrize("alpha", [1e-3, 0.2, 1.0, 30.0])
+@pytest.mark.parametrize("form", ["smith", "smith-correlated"])
+def test_ggx_smith_g_of_one_division_is_the_references(form, alpha):
+    """The kernels take GGX's ``G`` over one division, ``|c|`` multiplied out of ``h``
+    (:func:`~scatterbench.models.kernels.common.smith_h`): within 2e-15 relative (9 float64
+    epsilons; about ten roundings on each side, measured at most 8.7e-16) of
+    :func:`scatterbench.models.shadowing.smith_g` over the hemisphere, and exactly 0 (not NaN)
+    where a direction is grazing, its cosine exactly 0, one or both."""
+    rng = np.random.default_rng(5)
+    ti, to, po = (rng.uniform(lo, hi, 50_000) for lo, hi in ((0, np.pi / 2), (0, np.pi / 2), (-np.pi, np.pi)))
+    ci, si, co, so = np.cos(ti), np.sin(ti), np.cos(to), np.sin(to)
+    ci[:3], si[:3], co[:3], so[:3] = [0.0, 1.0, 0.0], [1.0, 0.0, 1.0], [0.5, 0.0, 0.0], [0.75**0.5, 1.0, 1.0]
+    got = _ggx_g_each(SHADOWING_KINDS[form], ci, si, co, so, np.cos(po), np.sin(po), alpha)
+    ref = smith_g(form, models.GGXSlopes(alpha=alpha), (ci, si, -1.0, 0.0), (co, so, np.cos(po), np.sin(po)))
+    assert np.array_equal(got[:3], np.zeros(3))
+    assert np.all(np.abs(got - ref) <= 2e-15 * np.abs(ref))
 
 
 def test_only_the_entry_points_are_cached():

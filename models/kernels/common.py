@@ -361,13 +361,15 @@ def smith_width(kind, cphi, sphi, sx, sy, cr, sr):
 
 @helper
 def smith_h(kind, c, s, cphi, sphi, sx, sy, cr, sr):
-    """GGX's ``h = sqrt(1 + x^2)``, ``x = alpha tan theta`` (arguments as :func:`smith_lambda`'s):
-    its ``Lambda = (h - 1) / 2``, so ``1 + Lambda = (1 + h) / 2`` and ``1 + Lambda_i + Lambda_o
-    = (h_i + h_o) / 2``, which :func:`smith_g` divides by once (three divisions a direction
-    fewer than through ``Lambda``).  ``h`` is infinite at grazing (``c = 0``: ``G = 0``, as
-    ``Lambda``'s infinity gives) and 1 at normal incidence (``s = 0``)."""
+    """GGX's ``|c| h = hypot(|c|, alpha s)`` for a direction (arguments as :func:`smith_lambda`'s),
+    ``h = sqrt(1 + x^2)``, ``x = alpha tan theta``: its ``Lambda = (h - 1) / 2``, so ``1 + Lambda
+    = (1 + h) / 2`` and ``1 + Lambda_i + Lambda_o = (h_i + h_o) / 2``; :func:`smith_g` takes
+    ``G`` of both directions over one division, ``|c|`` multiplied out (through ``h`` it took
+    three, through ``Lambda`` seven or eight; the divider is the SIMD lanes' narrowest unit).
+    Finite at grazing (``c = 0``: ``G = 0``, as ``Lambda``'s infinity gives), ``|c|`` at normal
+    incidence (``s = 0``)."""
     alpha = smith_width(kind, cphi, sphi, sx, sy, cr, sr)
-    return type(c)(hypot(type(c)(1.0), alpha * s / abs(c)))
+    return type(c)(hypot(abs(c), alpha * s))
 
 
 @helper
@@ -377,11 +379,13 @@ def smith_g(shadowing, kind, di, dio, sx, sy, cr, sr):
     :func:`smith_lambda`'s."""
     T = type(sx)
     if kind == GGX or kind == ANISO_GGX:
+        ci, co = abs(di[0]), abs(dio[0])
         hi = smith_h(kind, di[0], di[1], di[2], di[3], sx, sy, cr, sr)
         ho = smith_h(kind, dio[0], dio[1], dio[2], dio[3], sx, sy, cr, sr)
-        if shadowing == SMITH:
-            return T(4.0) / ((T(1.0) + hi) * (T(1.0) + ho))
-        return T(2.0) / (hi + ho)
+        if shadowing == SMITH:  # 4 / ((1 + h_i) (1 + h_o)), each h as |c| h / |c|
+            return T(4.0) * ci * co / ((ci + hi) * (co + ho))
+        den = co * hi + ci * ho  # 2 / (h_i + h_o); zero only where both are grazing, as G
+        return T(2.0) * ci * co / (den if den > T(0.0) else T(1.0))
     li = smith_lambda(kind, di[0], di[1], di[2], di[3], sx, sy, cr, sr)
     lo = smith_lambda(kind, dio[0], dio[1], dio[2], dio[3], sx, sy, cr, sr)
     if shadowing == SMITH:

@@ -42,17 +42,15 @@ its parameters, the ellipse's rotation given as the strokes' azimuth's cosine an
 from __future__ import annotations
 
 import numpy as np
-from llvmlite import ir
-from numba import njit, types
-from numba.core import cgutils, config
-from numba.core.errors import TypingError
-from numba.core.extending import intrinsic, overload
+from numba import njit
+from numba.core import config
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
 from .common import NO_SHADOWING, azimuths_at, polar
 from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, own_kernel
 from .facet import coating, facet_lanes
 from .helper import helper
+from .memory import STREAM_MIN, copy_into, line_aligned, store_fence, stream_into
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
 #: in the L2 cache
@@ -74,47 +72,6 @@ BLINN, NO_COOK_SHADOWING, COOK_SMITH = (
     COOK_SHADOWING["none"],
     COOK_SHADOWING["smith"],
 )
-
-
-def copy_into(dst, dst_at, src, src_at, count):
-    """``count`` elements of ``src`` (flat, from ``src_at``) into ``dst`` (flat, from ``dst_at``):
-    compiled, one ``memcpy`` (:func:`_memcpy`; the arrays C-contiguous of one dtype, not
-    overlapping: other layouts are refused when the caller compiles, as a strided array's
-    elements are not one block); in Python (``NUMBA_DISABLE_JIT=1``), numpy's copy."""
-    dst.reshape(-1)[dst_at : dst_at + count] = src.reshape(-1)[src_at : src_at + count]
-
-
-@overload(copy_into)
-def _copy_into_compiled(dst, dst_at, src, src_at, count):
-    if not (isinstance(dst, types.Array) and isinstance(src, types.Array)):
-        raise TypingError("copy_into: arrays only")
-    if dst.layout != "C" or src.layout != "C" or dst.dtype != src.dtype:
-        raise TypingError(f"copy_into: C-contiguous arrays of one dtype only, not {dst} and {src}")
-    return lambda dst, dst_at, src, src_at, count: _memcpy(dst, dst_at, src, src_at, count)
-
-
-@intrinsic
-def _memcpy(typingctx, dst, dst_at, src, src_at, count):
-    """:func:`copy_into`'s compiled form, LLVM's ``memcpy``."""
-    if not all(isinstance(t, types.Integer) and t.signed for t in (dst_at, src_at, count)):
-        raise TypingError("copy_into: offsets and count are signed integers")
-    sig = types.void(dst, dst_at, src, src_at, count)
-
-    def codegen(context, builder, signature, args):
-        d = context.make_array(signature.args[0])(context, builder, args[0])
-        s = context.make_array(signature.args[2])(context, builder, args[2])
-        i64 = ir.IntType(64)
-
-        def wide(v):  # the offsets and count, signed integers of any width, as int64
-            return v if v.type == i64 else builder.sext(v, i64)
-
-        dp, sp = builder.gep(d.data, [wide(args[1])]), builder.gep(s.data, [wide(args[3])])
-        n = wide(args[4])
-        size = context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
-        cgutils.raw_memcpy(builder, dp, sp, n, size)
-        return context.get_dummy_value()
-
-    return sig, codegen
 
 
 def vectorized(code, iopt) -> bool:
@@ -256,10 +213,16 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
 @helper(forceinline=None)
 def put(out, sc, at, m):
     """The block's ``m`` result columns of every row of ``out`` (C-contiguous) from the scratch
-    into ``out[:, at:at + m]``, a ``memcpy`` a row."""
+    into ``out[:, at:at + m]``, a ``memcpy`` a row, streamed to memory for a result of more than
+    :data:`~scatterbench.models.kernels.memory.STREAM_MIN` elements."""
     n = out.shape[1]
-    for r in range(out.shape[0]):
-        copy_into(out, r * n + at, sc, (_OUT + r) * VBLOCK, m)
+    if out.size <= STREAM_MIN:
+        for r in range(out.shape[0]):
+            copy_into(out, r * n + at, sc, (_OUT + r) * VBLOCK, m)
+    else:  # a result the caches do not hold: written to memory without reading it first
+        for r in range(out.shape[0]):
+            stream_into(out, r * n + at, sc, (_OUT + r) * VBLOCK, m)
+        store_fence()
 
 
 def lane_options(code, iopt) -> tuple:
@@ -309,7 +272,7 @@ def entry(code, opts):
             iopt[1] if r1 else np.int64(k1),
             iopt[2] if r2 else np.int64(k2),
         )
-        sc = np.empty(_ROWS * VBLOCK)
+        sc = line_aligned(_ROWS * VBLOCK)
         sc[(_PRM + rows) * VBLOCK :] = 0.0  # the parameter rows the kernel does not read: never gathered
         # the parameter rows to copy, a count LLVM cannot fold: with the constant, it unrolled
         # shared's and gather's row loops in full, a vectorized inner loop per row, in every entry
