@@ -166,11 +166,14 @@ def test_streamed_copies_are_the_elements():
 def test_results_stream_only_beyond_what_callers_read_back():
     """Results of more than ``STREAM_MIN`` elements are streamed to memory; the buffers the
     kernels' callers fill and read back at once (a chunk of a result that is not written in
-    place, ``kernels.Compiled.write``; a range of ``Compiled.accumulate``) never are."""
+    place, ``kernels.Compiled.write``; a range of ``Compiled.accumulate`` or of a fit's fused
+    likelihood) never are."""
     from scatterbench.models import evaluation, kernels
+    from scatterbench.validation.fitting import mueller_kernel
 
     assert 16 * evaluation.KERNEL_CHUNK <= memory.STREAM_MIN
     assert 16 * max(kernels.ADD_CHUNK, drive.BLOCK) <= memory.STREAM_MIN
+    assert 16 * mueller_kernel.RANGE_ROWS <= memory.STREAM_MIN  # a fit's fused likelihood's ranges
 
 
 @pytest.mark.parametrize("model", VECTORIZED[::4], ids=lambda m: type(m).__name__)
