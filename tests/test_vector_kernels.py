@@ -123,44 +123,55 @@ def test_vector_loop_ranges_take_what_every_block_shares(model):
         assert np.array_equal(parts, whole) and np.array_equal(whole, scalar)
 
 
-@pytest.mark.parametrize("copy_fn", [memory.copy_into, memory.stream_into], ids=lambda f: f.__name__)
-def test_block_copies_refuse_strided_arrays(copy_fn):
-    """The scratch copies (``memcpy``, streaming stores) take C-contiguous arrays of one dtype; a
+@njit
+def _copied(dst, src, stream):
+    memory.copy_rows(dst, 0, 3, src, 0, 3, 1, 3, stream)
+
+
+@pytest.mark.parametrize("stream", [False, True])
+def test_block_copies_refuse_strided_arrays(stream):
+    """The scratch copies (``memcpy``, streamed rows) take C-contiguous arrays of one dtype; a
     strided one is refused when the caller compiles, not copied as if contiguous."""
     from numba.core.errors import TypingError
 
     @njit
     def copy(dst, src):
-        copy_fn(dst, 0, src, 0, 3)
+        memory.copy_into(dst, 0, src, 0, 3)
 
-    dst, src = np.zeros(3), np.arange(6.0)
-    copy(dst, src)
-    assert dst.tolist() == [0.0, 1.0, 2.0]
-    with pytest.raises(TypingError, match="C-contiguous"):
-        copy(dst, src[::2])
-    with pytest.raises(TypingError, match="one dtype"):
-        copy(dst, src.astype(np.float32))
+    for fn in (copy, lambda dst, src: _copied(dst, src, stream)):
+        dst, src = np.zeros(3), np.arange(6.0)
+        fn(dst, src)
+        assert dst.tolist() == [0.0, 1.0, 2.0]
+        with pytest.raises(TypingError, match="C-contiguous"):
+            fn(dst, src[::2])
+        with pytest.raises(TypingError, match="one dtype"):
+            fn(dst, src.astype(np.float32))
 
 
 @njit
-def _streamed(dst, dst_at, src, src_at, count):
-    memory.stream_into(dst, dst_at, src, src_at, count)
-    memory.store_fence()
+def _rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream):
+    memory.copy_rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream)
 
 
-def test_streamed_copies_are_the_elements():
-    """:func:`~scatterbench.models.kernels.memory.stream_into` at every start modulo a cache line
-    and lengths around it (the ordinary stores before the first line boundary, whole lines
-    streamed, the rest ordinary): exactly the elements, nothing written outside them."""
-    src = np.random.default_rng(4).random(200)
+@pytest.mark.parametrize("stream", [False, True])
+def test_copied_rows_are_the_elements(stream):
+    """:func:`~scatterbench.models.kernels.memory.copy_rows`, ``memcpy`` or streamed (a ``memcpy``
+    to the first line boundary, whole lines streamed, a ``memcpy`` of the rest), at every start
+    modulo a cache line, row steps that shift it, lengths around a line: exactly the elements,
+    nothing written outside them."""
+    src = np.random.default_rng(4).random(400)
     per = memory.LINE_BYTES // 8
     for dst_at in range(2 * per):
-        for count in (0, 1, per - 1, per, per + 1, 3 * per + 5, 150):
-            dst = np.full(200, -1.0)
-            _streamed(dst, dst_at, src, 7, count)
-            want = np.full(200, -1.0)
-            want[dst_at : dst_at + count] = src[7 : 7 + count]
-            assert np.array_equal(dst, want), (dst_at, count)
+        for count in (0, 1, per - 1, per, per + 1, 3 * per + 5, 70):
+            for rows, step in ((1, 0), (3, 97), (4, 128)):
+                dst = np.full(700, -1.0)
+                _rows(dst, dst_at, step, src, 7, 101, rows, count, stream)
+                want = np.full(700, -1.0)
+                for r in range(rows):
+                    want[dst_at + r * step : dst_at + r * step + count] = src[
+                        7 + 101 * r : 7 + 101 * r + count
+                    ]
+                assert np.array_equal(dst, want), (dst_at, count, rows)
 
 
 def test_results_stream_only_beyond_what_callers_read_back():

@@ -1,24 +1,26 @@
 """The memory of the loops on SIMD lanes (:mod:`~scatterbench.models.kernels.vector`): their
 scratch (:func:`line_aligned`), and the block copies into it and out of it, compiled as LLVM's
-``memcpy`` or as streaming stores.
+``memcpy`` or with streaming stores.
 
-:func:`copy_into` is a ``memcpy``.  :func:`stream_into` copies with non-temporal stores, which
-write whole cache lines to memory without reading them first: a result too large for the caches
-then costs the bandwidth of one write, not of a read and a write.  For a smaller result, which
-its reader finds in the cache, ordinary stores are faster: FacetBRDF's Mueller matrices on
-one thread (``mueller`` then a sum of the result, ad hoc, three rounds alternating), 2.6 MB
-of result 27.0-27.6 ns a geometry streamed against 23.4-23.5, 5.1 MB 26.7-27.7 against
-24.9-26.9, 7.7 MB 26.4-28.4 against 29.5-32.9, 12.8 MB 27.2-29.4 against 31.4-33.8.
-:data:`STREAM_MIN` is where :func:`~scatterbench.models.kernels.vector.put` changes over.
+:func:`copy_into` is a ``memcpy``.  :func:`copy_rows` copies rows, each a ``memcpy`` or, for a
+result too large for the caches, with non-temporal stores, which write whole cache lines to
+memory without reading them first: the result then costs the bandwidth of one write, not of a
+read and a write.  For a smaller result, which its reader finds in the cache, ordinary stores
+are faster: FacetBRDF's Mueller matrices on one thread (``mueller`` then a sum of the result,
+ad hoc, three rounds alternating), 2.6 MB of result 27.0-27.6 ns a geometry streamed against
+23.4-23.5, 5.1 MB 26.7-27.7 against 24.9-26.9, 7.7 MB 26.4-28.4 against 29.5-32.9, 12.8 MB
+27.2-29.4 against 31.4-33.8.  :data:`STREAM_MIN` is where
+:func:`~scatterbench.models.kernels.vector.put` changes over.
 
 Both take C-contiguous arrays of one dtype that do not overlap (other layouts are refused when
 the caller compiles: a strided array's elements are not one block); in Python
-(``NUMBA_DISABLE_JIT=1``) both are numpy's copy.  Streaming stores and their fence are x86's
-(``vmovntpd``, ``sfence``); on other CPUs :func:`stream_into` is :func:`copy_into`.
+(``NUMBA_DISABLE_JIT=1``) they are numpy's copies.  Streaming stores and their fence are x86's
+(``vmovntpd``, ``sfence``); on other CPUs every row is a ``memcpy``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import platform
 
 import numpy as np
@@ -60,65 +62,51 @@ def copy_into(dst, dst_at, src, src_at, count):
     dst.reshape(-1)[dst_at : dst_at + count] = src.reshape(-1)[src_at : src_at + count]
 
 
-def stream_into(dst, dst_at, src, src_at, count):
-    """:func:`copy_into` with streaming stores (:func:`_stream`) where ``dst`` is line-aligned;
-    a compiled caller then calls :func:`store_fence` before its results are read elsewhere."""
-    copy_into(dst, dst_at, src, src_at, count)
+def copy_rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream):
+    """``rows`` rows of ``count`` elements, row ``r`` of ``src`` (flat) from ``src_at + r *
+    src_step`` into ``dst`` (flat) from ``dst_at + r * dst_step``: compiled, one loop over the rows
+    (:func:`_rows`), each row a ``memcpy``, or with ``stream`` (float64, x86-64) streamed to
+    memory and fenced once after the last (``sfence``: streaming stores are weakly ordered, and
+    another thread must see the rows written when it sees the copy done)."""
+    for r in range(rows):
+        copy_into(dst, dst_at + r * dst_step, src, src_at + r * src_step, count)
 
 
-def store_fence():
-    """Orders the streaming stores before it before every store after it (``sfence``): they
-    are weakly ordered, and another thread must see a range's results written when it sees
-    the range done.  Nothing in Python."""
-
-
-#: the compiled forms inline into their callers (the lanes test reads a lane loop's calls)
-_INLINE = {"forceinline": True}
-
-
-def _checked(name, dst, src, dst_at, src_at, count):
+def _checked(name, dst, src, *ints):
     """The compiled forms' typing checks, ``TypingError`` naming ``name``."""
     if not (isinstance(dst, types.Array) and isinstance(src, types.Array)):
         raise TypingError(f"{name}: arrays only")
     if dst.layout != "C" or src.layout != "C" or dst.dtype != src.dtype:
         raise TypingError(f"{name}: C-contiguous arrays of one dtype only, not {dst} and {src}")
-    if not all(isinstance(t, types.Integer) and t.signed for t in (dst_at, src_at, count)):
-        raise TypingError(f"{name}: offsets and count are signed integers")
+    if not all(isinstance(t, types.Integer) and t.signed for t in ints):
+        raise TypingError(f"{name}: offsets, steps and counts are signed integers")
 
 
-@overload(copy_into, jit_options=_INLINE)
+# the compiled forms inline into their callers (the lanes test reads a lane loop's calls)
+@overload(copy_into, jit_options={"forceinline": True})
 def _copy_into_compiled(dst, dst_at, src, src_at, count):
     _checked("copy_into", dst, src, dst_at, src_at, count)
     return lambda dst, dst_at, src, src_at, count: _memcpy(dst, dst_at, src, src_at, count)
 
 
-@overload(stream_into, jit_options=_INLINE)
-def _stream_into_compiled(dst, dst_at, src, src_at, count):
-    _checked("stream_into", dst, src, dst_at, src_at, count)
-    if dst.dtype != types.float64:
-        raise TypingError(f"stream_into: float64 arrays only, not {dst.dtype}")
-    if not STREAMS:
-        return lambda dst, dst_at, src, src_at, count: _memcpy(dst, dst_at, src, src_at, count)
-    return lambda dst, dst_at, src, src_at, count: _stream(dst, dst_at, src, src_at, count)
+@overload(copy_rows, jit_options={"forceinline": True})
+def _copy_rows_compiled(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream):
+    _checked("copy_rows", dst, src, dst_at, dst_step, src_at, src_step, rows, count)
+    if not isinstance(stream, types.Boolean):
+        raise TypingError(f"copy_rows: stream is a boolean, not {stream}")
+    if STREAMS and dst.dtype == types.float64:
+        return lambda dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream: _rows(
+            dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream
+        )
+    return lambda dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream: _rows(
+        dst, dst_at, dst_step, src, src_at, src_step, rows, count, False
+    )
 
 
-@overload(store_fence, jit_options=_INLINE)
-def _store_fence_compiled():
-    if not STREAMS:
-        return lambda: None
-    return lambda: _sfence()
-
-
-def _pointers(context, builder, signature, args):
-    """The destination's and source's element pointers at their offsets, and the count, as int64."""
-    d = context.make_array(signature.args[0])(context, builder, args[0])
-    s = context.make_array(signature.args[2])(context, builder, args[2])
+def _wide(builder, v):
+    """A signed integer of any width as int64."""
     i64 = ir.IntType(64)
-
-    def wide(v):  # the offsets and count, signed integers of any width, as int64
-        return v if v.type == i64 else builder.sext(v, i64)
-
-    return builder.gep(d.data, [wide(args[1])]), builder.gep(s.data, [wide(args[3])]), wide(args[4])
+    return v if v.type == i64 else builder.sext(v, i64)
 
 
 @intrinsic
@@ -127,61 +115,98 @@ def _memcpy(typingctx, dst, dst_at, src, src_at, count):
     sig = types.void(dst, dst_at, src, src_at, count)
 
     def codegen(context, builder, signature, args):
-        dp, sp, n = _pointers(context, builder, signature, args)
+        d = context.make_array(signature.args[0])(context, builder, args[0])
+        s = context.make_array(signature.args[2])(context, builder, args[2])
+        dp, sp = (
+            builder.gep(d.data, [_wide(builder, args[1])]),
+            builder.gep(s.data, [_wide(builder, args[3])]),
+        )
         size = context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
-        cgutils.raw_memcpy(builder, dp, sp, n, size)
+        cgutils.raw_memcpy(builder, dp, sp, _wide(builder, args[4]), size)
         return context.get_dummy_value()
 
     return sig, codegen
 
 
 @intrinsic
-def _stream(typingctx, dst, dst_at, src, src_at, count):
-    """:func:`stream_into`'s compiled form (float64): ordinary stores up to the destination's
-    first line boundary, then a line (eight elements) at a time with LLVM's ``nontemporal``
-    stores, aligned (x86's ``vmovntpd``; unaligned ones would be ordinary), the rest ordinary."""
-    sig = types.void(dst, dst_at, src, src_at, count)
+def _rows(typingctx, dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream):
+    """:func:`copy_rows`' compiled form: its loop over the rows, which LLVM does not unroll
+    (:func:`_rolled_loop`: unrolled 16 times, a row's copy stood 16 times in every lane entry)."""
+    sig = types.void(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream)
 
     def codegen(context, builder, signature, args):
-        dp, sp, n = _pointers(context, builder, signature, args)
-        i64, per = ir.IntType(64), LINE_BYTES // 8
-        line = ir.VectorType(ir.DoubleType(), per)
-
-        def c(v):
-            return ir.Constant(i64, v)
-
-        # elements to the first line boundary (0 .. per - 1), at most n
-        off = builder.and_(builder.ptrtoint(dp, i64), c(LINE_BYTES - 1))
-        head = builder.lshr(builder.and_(builder.sub(c(LINE_BYTES), off), c(LINE_BYTES - 1)), c(3))
-        head = builder.select(builder.icmp_signed("<", n, head), n, head)
-        lines = builder.sdiv(builder.sub(n, head), c(per))
-        tail = builder.add(head, builder.mul(lines, c(per)))
-        _plain(builder, dp, sp, c(0), head)
-        flag = builder.module.add_metadata([ir.Constant(ir.IntType(32), 1)])
-        with cgutils.for_range(builder, lines) as loop:
-            at = builder.add(head, builder.mul(loop.index, c(per)))
-            v = builder.load(builder.bitcast(builder.gep(sp, [at]), line.as_pointer()), align=8)
-            st = builder.store(v, builder.bitcast(builder.gep(dp, [at]), line.as_pointer()), align=LINE_BYTES)
-            st.set_metadata("nontemporal", flag)
-        _plain(builder, dp, sp, tail, n)
+        d = context.make_array(signature.args[0])(context, builder, args[0])
+        s = context.make_array(signature.args[3])(context, builder, args[3])
+        da, ds, sa, ss, nr, n = (_wide(builder, args[k]) for k in (1, 2, 4, 5, 6, 7))
+        size = context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
+        streamed = args[8] if isinstance(args[8].type, ir.IntType) and args[8].type.width == 1 else None
+        if streamed is None:  # numba's boolean as stored (i8)
+            streamed = builder.icmp_unsigned("!=", args[8], ir.Constant(args[8].type, 0))
+        with _rolled_loop(builder, nr) as r:
+            dp = builder.gep(d.data, [builder.add(da, builder.mul(r, ds))])
+            sp = builder.gep(s.data, [builder.add(sa, builder.mul(r, ss))])
+            with builder.if_else(streamed) as (then, otherwise):
+                with then:
+                    _streamed_row(builder, dp, sp, n)
+                with otherwise:
+                    cgutils.raw_memcpy(builder, dp, sp, n, size)
+        with builder.if_then(streamed):
+            fence = ir.FunctionType(ir.VoidType(), [])
+            builder.call(builder.module.declare_intrinsic("llvm.x86.sse.sfence", fnty=fence), [])
         return context.get_dummy_value()
 
     return sig, codegen
 
 
-def _plain(builder, dp, sp, start, stop):
-    """Ordinary element copies ``start .. stop - 1`` in :func:`_stream`'s code."""
-    with cgutils.for_range(builder, stop, start=start) as loop:
-        builder.store(builder.load(builder.gep(sp, [loop.index])), builder.gep(dp, [loop.index]))
+def _streamed_row(builder, dp, sp, n):
+    """``n`` float64 elements from ``sp`` to ``dp``: a ``memcpy`` up to the destination's first
+    line boundary, then a line (eight elements) at a time with LLVM's ``nontemporal`` stores,
+    aligned (x86's ``vmovntpd``; unaligned ones would be ordinary), and a ``memcpy`` of the rest."""
+    i64, per = ir.IntType(64), LINE_BYTES // 8
+    line = ir.VectorType(ir.DoubleType(), per).as_pointer()
+
+    def c(v):
+        return ir.Constant(i64, v)
+
+    # elements to the first line boundary (0 .. per - 1), at most n
+    off = builder.and_(builder.ptrtoint(dp, i64), c(LINE_BYTES - 1))
+    head = builder.lshr(builder.and_(builder.sub(c(LINE_BYTES), off), c(LINE_BYTES - 1)), c(3))
+    head = builder.select(builder.icmp_signed("<", n, head), n, head)
+    lines = builder.sdiv(builder.sub(n, head), c(per))
+    tail = builder.add(head, builder.mul(lines, c(per)))
+    cgutils.raw_memcpy(builder, dp, sp, head, 8)
+    flag = builder.module.add_metadata([ir.Constant(ir.IntType(32), 1)])
+    with _rolled_loop(builder, lines) as k:
+        at = builder.add(head, builder.mul(k, c(per)))
+        v = builder.load(builder.bitcast(builder.gep(sp, [at]), line), align=8)
+        st = builder.store(v, builder.bitcast(builder.gep(dp, [at]), line), align=LINE_BYTES)
+        st.set_metadata("nontemporal", flag)
+    cgutils.raw_memcpy(builder, builder.gep(dp, [tail]), builder.gep(sp, [tail]), builder.sub(n, tail), 8)
 
 
-@intrinsic
-def _sfence(typingctx):
-    """:func:`store_fence`'s compiled form, x86's ``sfence``."""
-
-    def codegen(context, builder, signature, args):
-        fn = builder.module.declare_intrinsic("llvm.x86.sse.sfence", fnty=ir.FunctionType(ir.VoidType(), []))
-        builder.call(fn, [])
-        return context.get_dummy_value()
-
-    return types.void(), codegen
+@contextlib.contextmanager
+def _rolled_loop(builder, count):
+    """A loop over ``0 .. count - 1`` (int64) in generated code, yielding its index, that LLVM
+    neither unrolls nor vectorizes (``llvm.loop`` metadata): a copy's loops are over a result's
+    16 rows and a row's 32 lines at most, which unrolled were code to compile in every entry."""
+    i64, module = ir.IntType(64), builder.module
+    before = builder.basic_block
+    body, after = builder.append_basic_block("lines"), builder.append_basic_block("lines.done")
+    builder.cbranch(builder.icmp_signed(">", count, ir.Constant(i64, 0)), body, after)
+    builder.position_at_end(body)
+    k = builder.phi(i64)
+    k.add_incoming(ir.Constant(i64, 0), before)
+    yield k
+    step = builder.add(k, ir.Constant(i64, 1))
+    k.add_incoming(step, builder.basic_block)
+    back = builder.cbranch(builder.icmp_signed("<", step, count), body, after)
+    off = [
+        module.add_metadata([ir.MetaDataString(module, "llvm.loop.unroll.disable")]),
+        module.add_metadata(
+            [ir.MetaDataString(module, "llvm.loop.vectorize.enable"), ir.Constant(ir.IntType(1), 0)]
+        ),
+    ]
+    loop_id = module.add_metadata(off)
+    loop_id.operands = (loop_id, *off)  # a loop's id refers to itself (LLVM's convention)
+    back.set_metadata("llvm.loop", loop_id)
+    builder.position_at_end(after)

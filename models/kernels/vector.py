@@ -50,7 +50,7 @@ from .common import NO_SHADOWING, azimuths_at, polar
 from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, own_kernel
 from .facet import coating, facet_lanes
 from .helper import helper
-from .memory import STREAM_MIN, copy_into, line_aligned, store_fence, stream_into
+from .memory import STREAM_MIN, copy_into, copy_rows, line_aligned
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
 #: in the L2 cache
@@ -214,15 +214,10 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
 def put(out, sc, at, m):
     """The block's ``m`` result columns of every row of ``out`` (C-contiguous) from the scratch
     into ``out[:, at:at + m]``, a ``memcpy`` a row, streamed to memory for a result of more than
-    :data:`~scatterbench.models.kernels.memory.STREAM_MIN` elements."""
+    :data:`~scatterbench.models.kernels.memory.STREAM_MIN` elements (a result the caches do not
+    hold, written to memory without reading it first)."""
     n = out.shape[1]
-    if out.size <= STREAM_MIN:
-        for r in range(out.shape[0]):
-            copy_into(out, r * n + at, sc, (_OUT + r) * VBLOCK, m)
-    else:  # a result the caches do not hold: written to memory without reading it first
-        for r in range(out.shape[0]):
-            stream_into(out, r * n + at, sc, (_OUT + r) * VBLOCK, m)
-        store_fence()
+    copy_rows(out, at, n, sc, _OUT * VBLOCK, VBLOCK, out.shape[0], m, out.size > STREAM_MIN)
 
 
 def lane_options(code, iopt) -> tuple:
