@@ -174,6 +174,37 @@ def test_copied_rows_are_the_elements(stream):
                 assert np.array_equal(dst, want), (dst_at, count, rows)
 
 
+_NO_STREAMS = """
+import numpy as np
+from numba import njit
+from scatterbench.models.kernels import memory
+memory.STREAMS = False  # as on a CPU other than x86-64, before anything compiles
+
+@njit
+def rows(dst, src):
+    memory.copy_rows(dst, 1, 40, src, 2, 30, 3, 25, True)
+
+dst, src = np.zeros(120), np.arange(100.0)
+rows(dst, src)
+want = np.zeros(120)
+for r in range(3):
+    want[1 + 40 * r : 26 + 40 * r] = src[2 + 30 * r : 27 + 30 * r]
+ir = "".join(rows.inspect_llvm().values())
+print(np.array_equal(dst, want), "nontemporal" in ir, "sfence" in ir)
+"""
+
+
+def test_rows_are_copied_without_streaming_code_elsewhere(tmp_path):
+    """Where streaming stores are not compiled (``memory.STREAMS`` false: a CPU other than
+    x86-64, whose LLVM has no ``sfence``), a streamed copy is each row's ``memcpy``: the same
+    elements, and neither a non-temporal store nor the fence in the code."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    res = subprocess.run(
+        [sys.executable, "-c", _NO_STREAMS], env=env, capture_output=True, text=True, check=True
+    )
+    assert res.stdout.split() == ["True", "False", "False"], res.stdout + res.stderr
+
+
 def test_results_stream_only_beyond_what_callers_read_back():
     """Results of more than ``STREAM_MIN`` elements are streamed to memory; the buffers the
     kernels' callers fill and read back at once (a chunk of a result that is not written in

@@ -94,12 +94,8 @@ def _copy_rows_compiled(dst, dst_at, dst_step, src, src_at, src_step, rows, coun
     _checked("copy_rows", dst, src, dst_at, dst_step, src_at, src_step, rows, count)
     if not isinstance(stream, types.Boolean):
         raise TypingError(f"copy_rows: stream is a boolean, not {stream}")
-    if STREAMS and dst.dtype == types.float64:
-        return lambda dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream: _rows(
-            dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream
-        )
     return lambda dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream: _rows(
-        dst, dst_at, dst_step, src, src_at, src_step, rows, count, False
+        dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream
     )
 
 
@@ -139,20 +135,24 @@ def _rows(typingctx, dst, dst_at, dst_step, src, src_at, src_step, rows, count, 
         s = context.make_array(signature.args[3])(context, builder, args[3])
         da, ds, sa, ss, nr, n = (_wide(builder, args[k]) for k in (1, 2, 4, 5, 6, 7))
         size = context.get_abi_sizeof(context.get_data_type(signature.args[0].dtype))
-        streamed = args[8] if isinstance(args[8].type, ir.IntType) and args[8].type.width == 1 else None
-        if streamed is None:  # numba's boolean as stored (i8)
+        streamed = None  # no streaming code at all but on x86-64, in float64
+        if STREAMS and signature.args[0].dtype == types.float64:
             streamed = builder.icmp_unsigned("!=", args[8], ir.Constant(args[8].type, 0))
         with _rolled_loop(builder, nr) as r:
             dp = builder.gep(d.data, [builder.add(da, builder.mul(r, ds))])
             sp = builder.gep(s.data, [builder.add(sa, builder.mul(r, ss))])
-            with builder.if_else(streamed) as (then, otherwise):
-                with then:
-                    _streamed_row(builder, dp, sp, n)
-                with otherwise:
-                    cgutils.raw_memcpy(builder, dp, sp, n, size)
-        with builder.if_then(streamed):
-            fence = ir.FunctionType(ir.VoidType(), [])
-            builder.call(builder.module.declare_intrinsic("llvm.x86.sse.sfence", fnty=fence), [])
+            if streamed is None:
+                cgutils.raw_memcpy(builder, dp, sp, n, size)
+            else:
+                with builder.if_else(streamed) as (then, otherwise):
+                    with then:
+                        _streamed_row(builder, dp, sp, n)
+                    with otherwise:
+                        cgutils.raw_memcpy(builder, dp, sp, n, size)
+        if streamed is not None:
+            with builder.if_then(streamed):
+                fence = ir.FunctionType(ir.VoidType(), [])
+                builder.call(builder.module.declare_intrinsic("llvm.x86.sse.sfence", fnty=fence), [])
         return context.get_dummy_value()
 
     return sig, codegen
