@@ -530,12 +530,15 @@ def test_only_the_entry_points_are_cached():
                 if cached:  # in the package's cache directory, never beside the (read-only) package
                     where = fn._cache._cache_path
                     assert where.startswith(models.kernels.cache_dir()), f"{name}.{attr} caches in {where}"
+                    # compiled by helper.entry_point: without the C wrapper nothing calls
+                    assert fn.targetoptions.get("no_cfunc_wrapper"), f"{name}.{attr} has a C wrapper"
     assert seen > 20 and helpers > 60, (seen, helpers)
     # the loop per kernel (and per option set on SIMD lanes): closures, not module names
     per_kernel = list(drive.ENTRIES)
     per_kernel += [vector.lane_entries(c, np.zeros(3, dtype=np.int64)) for c in (0, 2, 3, 4, 5)]
     for fn in per_kernel:
         assert type(fn._cache).__name__ != "NullCache", fn
+        assert fn.targetoptions.get("no_cfunc_wrapper"), fn
         assert fn._cache._cache_path.startswith(models.kernels.cache_dir()), fn
     names = {fn.py_func.__qualname__ for fn in per_kernel}
     assert len(names) == len(per_kernel)  # cache files of their own

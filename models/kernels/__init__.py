@@ -40,8 +40,8 @@ level between an entry and its kernel cost another optimization of the inlined k
 of :mod:`~scatterbench.models.kernels.drive`, :mod:`~scatterbench.models.kernels.montecarlo`'s
 ``_range`` and ``_exit_range``, :mod:`~scatterbench.models.kernels.rough`'s ``_moments``
 and ``write``, :mod:`~scatterbench.models.kernels.aperture`'s
-``nodes`` and ``_tiles``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``; a cached entry
-holds the code of
+``nodes`` and ``_tiles``, and :mod:`~scatterbench.models.kernels.disc`'s ``points``, each compiled by
+:func:`~scatterbench.models.kernels.helper.entry_point`; a cached entry holds the code of
 everything it calls.  The functions they call are not cached, because numba loads a cached
 function as object code, without the LLVM IR that inlining needs: an entry compiled in a
 process that had loaded its kernel from the cache called it instead of inlining it, which

@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 
 from .common import azimuths
-from .helper import helper
+from .helper import entry_point, helper
 from .threads import spread
 from .vector_math import atan2, inverse_binade, sincos, sqrt
 
@@ -42,7 +42,7 @@ TI, THETA, PHI, WEIGHT, COS2, SIN2 = range(6)
 ROWS = 6
 
 
-@njit(cache=True, error_model="numpy")
+@entry_point
 def nodes(ti, tr, pr, a, b, cos_u, w, out):
     """Every geometry's ``K`` nodes (offsets ``a``, ``b`` along ``p_r``, ``s_r``, ``cos u`` and
     area weights ``w``, each ``(K,)``), for ``n`` geometries ``(ti, tr, pr)``, into the rows
@@ -90,7 +90,7 @@ def rotate_sum(m, nodes_out, n, out, start):
     spread(_tiles, (m, nodes_out, n, out, start), (n + TILE - 1) // TILE, 4)
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@entry_point(nogil=True)
 def _tiles(m, nodes_out, n, out, start, t0, t1):
     """Tiles ``t0 .. t1 - 1`` of :func:`rotate_sum`."""
     for t in range(t0, t1):

@@ -18,9 +18,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from .helper import helper
+from .helper import entry_point, helper
 from .vector_math import atan2, hypot, sincos, sqrt
 
 _TWO_PI = 2.0 * math.pi
@@ -77,7 +76,7 @@ def _wedge(k, xc, u, alpha, w):
     return atan2(hypot(x, y), 1.0), atan2(y, x), j * w
 
 
-@njit(cache=True, error_model="numpy")
+@entry_point
 def points(k, h1, tan_c, sec_c, on_h, ox, xc, v, chi, w, psi, phi, jac):
     """The local incidences ``psi``, ``phi`` and irradiance weights ``jac`` (each ``(m, P)``,
     written) of the points ``(v, chi)`` with quadrature weights ``w`` (each ``(m, P)``) of

@@ -24,7 +24,7 @@ from ..kernel_specs import KERNEL_ROWS
 from .common import azimuth
 from .cook import cook
 from .facet import btdf, facet
-from .helper import helper
+from .helper import entry_point, helper
 from .maxwell import maxwell
 from .volume import diffuse, single
 
@@ -127,7 +127,7 @@ def own_kernel(fn, code, tag="", **own):
     fresh = FunctionType(
         fn.__code__, {**fn.__globals__, "_KERNEL": KERNELS[code], **own}, None, None, fn.__closure__
     )
-    return njit(cache=True, error_model="numpy", nogil=True)(named(code, tag)(fresh))
+    return entry_point(named(code, tag)(fresh), nogil=True)
 
 
 def entry(code):
@@ -154,7 +154,7 @@ def entry(code):
     return own_kernel(run_range, code)
 
 
-@njit(cache=True, error_model="numpy")
+@entry_point
 def angles_ok(ti, tr, pr):
     """True when every polar angle lies in [0, pi/2] and every azimuth is finite (the small-call
     path's validation; the general path raises the error that names the angle)."""
@@ -171,7 +171,7 @@ def angles_ok(ti, tr, pr):
     return True
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@entry_point(nogil=True)
 def outside_range(a, low, high, bad, lo, hi):
     """``bad[0] = 1`` when a value of ``a[lo:hi]`` lies outside ``[low, high]`` (NaN does): the
     general path's check of a large angle array, a range of it per thread (:func:`~scatterbench.models.kernels.within`)."""

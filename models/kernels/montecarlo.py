@@ -38,7 +38,7 @@ from numba import njit
 
 from .common import hg_density, mueller16
 from .facet import btdf_jones, cross3, dot3, transmission_factors
-from .helper import helper
+from .helper import entry_point, helper
 from .threads import spread
 
 __all__ = ["estimate", "exit_transmittance"]
@@ -313,7 +313,7 @@ def _tables():
     return np.empty(9 * L), np.empty(31 * L), np.empty(10 * L), np.empty(10 * L)
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@entry_point(nogil=True)
 def _range(ti, tr, pr, n_i, n_r, z, m, prm, safe, mean, err, lo, hi):
     """Geometries ``lo .. hi - 1`` (a range of :func:`~scatterbench.models.kernels.threads.spread`),
     the entry facets computed once per run of geometries with the same incidence (and
@@ -409,7 +409,7 @@ def _exit_t00(k_r, n_r, zx, zy, m, n):
     return 0.5 * (ts * ts + tp * tp) * flux * w if live else 0.0
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@entry_point(nogil=True)
 def _exit_range(tr, pr, n_r, z, m, n, out, lo, hi):
     """:func:`exit_transmittance` of the directions ``lo .. hi - 1`` into ``out``: the facets
     outer, the directions inner (a loop of selects over contiguous arrays that the compiler

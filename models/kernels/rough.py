@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .helper import helper
+from .helper import entry_point, helper
 from .threads import spread
 from .vector_math import atan2, exp_neg, sincos, sqrt
 
@@ -21,7 +21,7 @@ _M = 20
 _RHO_MAX = math.sqrt(42.0)
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@entry_point(nogil=True)
 def _moments(sigmas, nodes, rx, rw, ax, aw, cheb, A0, A1, lo, hi):  # pragma: no cover - compiled
     """``A0[k], A1[k]`` ``(2 nodes, _M + 1)`` of slope widths ``sigmas[lo:hi]``: per u-node, the
     radial nodes (:func:`_radii`), then every arc node into flat arrays (local cosine, weights;
@@ -123,7 +123,7 @@ def _reduce(x, w0, w1, L, tp, tc, a0, a1):  # pragma: no cover - compiled
 _BLOCK = 256
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@entry_point(nogil=True)
 def write(coef, ub, scale, index, ti, tr, out, lo, hi, col):  # pragma: no cover - compiled
     """Geometries ``lo .. hi - 1`` (element ``index[i]``; angles of length 1 or ``n``) into
     ``out[:, i + col]``, a run of one element (at most :data:`_BLOCK` geometries) at a time in
