@@ -124,28 +124,32 @@ def test_vector_loop_ranges_take_what_every_block_shares(model):
 
 
 @njit
-def _copied(dst, src, stream):
+def _copied(dst, src):
+    memory.copy_into(dst, 0, src, 0, 3)
+
+
+@njit
+def _copied_rows(dst, src, stream):
     memory.copy_rows(dst, 0, 3, src, 0, 3, 1, 3, stream)
 
 
-@pytest.mark.parametrize("stream", [False, True])
-def test_block_copies_refuse_strided_arrays(stream):
-    """The scratch copies (``memcpy``, streamed rows) take C-contiguous arrays of one dtype; a
-    strided one is refused when the caller compiles, not copied as if contiguous."""
+@pytest.mark.parametrize(
+    "copy",
+    [_copied, lambda d, s: _copied_rows(d, s, False), lambda d, s: _copied_rows(d, s, True)],
+    ids=["copy_into", "copy_rows", "copy_rows-streamed"],
+)
+def test_block_copies_refuse_strided_arrays(copy):
+    """The scratch copies (``memcpy``, rows, streamed rows) take C-contiguous arrays of one dtype;
+    a strided one is refused when the caller compiles, not copied as if contiguous."""
     from numba.core.errors import TypingError
 
-    @njit
-    def copy(dst, src):
-        memory.copy_into(dst, 0, src, 0, 3)
-
-    for fn in (copy, lambda dst, src: _copied(dst, src, stream)):
-        dst, src = np.zeros(3), np.arange(6.0)
-        fn(dst, src)
-        assert dst.tolist() == [0.0, 1.0, 2.0]
-        with pytest.raises(TypingError, match="C-contiguous"):
-            fn(dst, src[::2])
-        with pytest.raises(TypingError, match="one dtype"):
-            fn(dst, src.astype(np.float32))
+    dst, src = np.zeros(3), np.arange(6.0)
+    copy(dst, src)
+    assert dst.tolist() == [0.0, 1.0, 2.0]
+    with pytest.raises(TypingError, match="C-contiguous"):
+        copy(dst, src[::2])
+    with pytest.raises(TypingError, match="one dtype"):
+        copy(dst, src.astype(np.float32))
 
 
 @njit

@@ -8,7 +8,7 @@ from numba import njit
 from numba.extending import register_jitable
 
 
-def helper(fn=None, *, forceinline=True):
+def helper(fn=None, *, forceinline=True, fastmath=False):
     """``fn`` compiled where a compiled function calls it, in the caller's process, without the
     on-disk cache, inlined by LLVM (``forceinline``); from Python it is ``fn`` itself.
 
@@ -28,9 +28,10 @@ def helper(fn=None, *, forceinline=True):
     not set are inherited), which is what LLVM then does with it: inlined into a kernel
     (Cook-Torrance's ``fresnel_average``: with ``False`` LLVM called it from the lanes' loop,
     which ran 3.5-5x slower, ad hoc), or left to LLVM's own measure in an entry (the block
-    copies of :mod:`~scatterbench.models.kernels.vector`, called from several loops)."""
+    copies of :mod:`~scatterbench.models.kernels.vector`, called from several loops).
+    ``fastmath``: numba's (a set of LLVM's flags), for the helper's own operations."""
 
-    options = {"error_model": "numpy", "no_cfunc_wrapper": True}
+    options = {"error_model": "numpy", "no_cfunc_wrapper": True, "fastmath": fastmath}
     if forceinline is not None:
         options["forceinline"] = forceinline
     register = register_jitable(**options)

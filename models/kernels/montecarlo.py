@@ -72,7 +72,7 @@ def _refracted(k, m, eta):
     return c, (eta * k[0] + f * m[0], eta * k[1] + f * m[1], eta * k[2] + f * m[2])
 
 
-@njit(forceinline=True)
+@helper
 def _entry(k_i, e_i, ci, si, n_i, zx, m, n):
     """The incident ray through facet ``m`` (slope x ``zx``): ``(weight, k1, basis of k1,
     Jones, flux factor)``; weight 0 where the facet is not struck or the ray does not go

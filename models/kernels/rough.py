@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from .helper import entry_point, helper
 from .threads import spread
@@ -84,7 +83,7 @@ def _radii(rho0, sigma, rx, rw, rad):  # pragma: no cover - compiled
     return nr
 
 
-@njit(error_model="numpy", fastmath={"reassoc"}, forceinline=True)
+@helper(fastmath={"reassoc"})
 def _reduce(x, w0, w1, L, tp, tc, a0, a1):  # pragma: no cover - compiled
     """``a0[m] = sum w0 T_m(x) / sum w0``, ``a1[m] = sum w1 T_m(x) / sum w0`` over ``L`` nodes,
     the recurrence on arrays: sums reassociated (``fastmath={"reassoc"}``), so that each runs

@@ -15,7 +15,8 @@ block of :data:`VBLOCK` geometries:
    (the kernels use :mod:`~scatterbench.models.kernels.vector_math`, and ``error_model="numpy"`` lets a
    division by zero give inf, as numpy's, instead of raising); all reads and writes are in
    the one scratch at fixed offsets, so no overlap test is needed;
-3. the block's result rows are copied to ``out`` (:func:`put`, ``memcpy``).
+3. the block's result rows are copied to ``out`` (:func:`put`, a ``memcpy`` a row, or streamed
+   to memory for a result larger than the caches: :mod:`~scatterbench.models.kernels.memory`).
 
 Steps 1 and 3 are the same code in every entry, and LLVM optimizes and emits each entry's
 callees again inside it: written as loops, vectorized, versioned for overlap and unrolled,
@@ -190,7 +191,7 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     (:func:`~scatterbench.models.kernels.common.azimuths_at`), and
     the first ``rows`` parameter rows, those the kernel reads, when the parameters are per
     geometry (the columns :func:`~scatterbench.models.kernels.drive.column` reads), the copies
-    ``memcpy`` (:func:`copy_into`).  Branches, not the arithmetic of ``column``: LLVM
+    ``memcpy`` (:func:`copy_into`, :func:`copy_rows`).  Branches, not the arithmetic of ``column``: LLVM
     unswitched the loop of that on its selects, a copy per case."""
     if ti.shape[0] > 1:
         copy_into(sc, _TI * VBLOCK, ti, lo, m)
@@ -206,8 +207,7 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
             for k in range(m):
                 sc[o + k] = prm[r, index[lo + k]]
     elif prm.shape[1] > 1:  # a column per geometry, in order from index[0]
-        for r in range(rows):
-            copy_into(sc, (_PRM + r) * VBLOCK, prm, r * prm.shape[1] + index[0] + lo, m)
+        copy_rows(sc, _PRM * VBLOCK, VBLOCK, prm, index[0] + lo, prm.shape[1], rows, m, False)
 
 
 @helper(forceinline=None)
