@@ -18,7 +18,6 @@ import math
 from types import FunctionType
 
 import numpy as np
-from numba import njit
 
 from ..kernel_specs import KERNEL_ROWS
 from .common import azimuth
@@ -75,7 +74,7 @@ def store(out, i, m):
     out[13, i], out[14, i], out[15, i] = m[13], m[14], m[15]
 
 
-@njit(error_model="numpy", inline="always")
+@helper
 def column(index, p, i):
     """The parameter column geometry ``i`` reads: ``index[i]`` for an ``index`` longer than 1,
     otherwise ``index[0] + i * p`` (``p``: whether ``prm`` has a column per geometry), so that

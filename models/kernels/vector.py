@@ -88,19 +88,24 @@ def vectorized(code, iopt) -> bool:
     return code in (SINGLE, DIFFUSE)
 
 
-# The scratch accessors index it directly: numba types and lowers a function it inlines again
-# at each call site, and a helper per element (19 per facet geometry) made compiling the facet
-# task's loops inline 175 functions (now 19).
+# The scratch accessors index it directly (a helper per element, 19 per facet geometry, made
+# compiling the facet task's loops inline 175 functions), and are helpers (kernels.helper), typed
+# and lowered once per process, not numba's inline="always", which did that again in each of a
+# report's 17 lane entries: the two largest compile-ahead groups took 1.0-1.7 s less CPU each
+# (a fresh process and cache per group, two rounds alternating with 9c66b1a, ad hoc); LLVM
+# inlines them, and the entries' code is the same (the array's reference counts pruned: 13
+# increments and 32 decrements in each entry either way, the facet entry's 4522 lines of
+# assembly both).
 
 
-@njit(error_model="numpy", inline="always")
+@helper
 def _geometry(sc, k):
     """Geometry ``k`` of the scratch, as :func:`scatterbench.models.kernels.drive.geometry` gives it."""
     B = VBLOCK
     return sc[_TI * B + k], sc[_TR * B + k], sc[_PR * B + k], sc[_CP * B + k], sc[_SP * B + k]
 
 
-@njit(error_model="numpy", inline="always")
+@helper
 def _facet_geometry(sc, k):
     """:func:`_geometry` followed by the rows :func:`facet_prepass` filled (:func:`~scatterbench.models.kernels.facet.facet_lanes`' ``ge``)."""
     B, o = VBLOCK, _PRE * VBLOCK + k
@@ -131,7 +136,7 @@ def facet_prepass(sc, m):
             _coating_at(sc, k, 1.0)
 
 
-@njit(error_model="numpy", inline="always")
+@helper
 def _coating_at(sc, k, n):
     """Geometry ``k``'s polar cosines and sines and their
     :func:`~scatterbench.models.kernels.facet.coating` into its 13 scratch rows (written out, as
@@ -150,7 +155,7 @@ def _no_prepass(sc, m):
     """The other kernels' (their loop computes all it needs)."""
 
 
-@njit(error_model="numpy", inline="always")
+@helper
 def _scratch_params(sc, k):
     """Geometry ``k``'s parameters (:func:`gather` copied them)."""
     B, o = VBLOCK, _PRM * VBLOCK + k
@@ -158,7 +163,7 @@ def _scratch_params(sc, k):
             sc[o + 6 * B], sc[o + 7 * B], sc[o + 8 * B], sc[o + 9 * B], sc[o + 10 * B])  # fmt: skip
 
 
-@njit(error_model="numpy", inline="always")
+@helper
 def _store(sc, k, m):
     """The 16 elements ``m`` into the result rows, column ``k`` (written out: a loop over a
     tuple's index compiles to a switch, which keeps the loop around it scalar)."""
