@@ -178,6 +178,60 @@ def test_copied_rows_are_the_elements(stream):
                 assert np.array_equal(dst, want), (dst_at, count, rows)
 
 
+@njit
+def _filled(dst, dst_at, count, value):
+    memory.fill(dst, dst_at, count, value)
+
+
+@njit
+def _picked(dst, dst_at, dst_step, src, index, lo, rows, count):
+    memory.pick_rows(dst, dst_at, dst_step, src, index, lo, rows, count)
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "python"])
+def test_filled_and_picked_rows_are_the_elements(compiled):
+    """:func:`~scatterbench.models.kernels.memory.fill` and
+    :func:`~scatterbench.models.kernels.memory.pick_rows` (the lanes' scratch rows shared by every
+    block, and picked by a model set's column per geometry), compiled and as the Python they
+    stand for: exactly the elements, at every offset and length, nothing written outside them."""
+    fill, pick = (_filled, _picked) if compiled else (_filled.py_func, _picked.py_func)
+    rng = np.random.default_rng(5)
+    src = rng.random((4, 9))
+    index = rng.integers(0, 9, 300)
+    for at in (0, 1, 7, 8, 9):
+        for count in (0, 1, 7, 8, 9, 33):
+            dst = np.full(200, -1.0)
+            fill(dst, at, count, 0.25)
+            want = np.full(200, -1.0)
+            want[at : at + count] = 0.25
+            assert np.array_equal(dst, want), (at, count)
+            for rows, step, lo in ((1, 0, 0), (3, 40, 5), (4, 41, 200)):
+                dst = np.full(200, -1.0)
+                pick(dst, at, step, src, index, lo, rows, count)
+                want = np.full(200, -1.0)
+                for r in range(rows):
+                    want[at + r * step : at + r * step + count] = src[r, index[lo : lo + count]]
+                assert np.array_equal(dst, want), (at, count, rows)
+
+
+def test_fill_and_pick_refuse_strided_arrays():
+    """Like the copies, the fill and the picking take C-contiguous arrays (the picking one dtype
+    and 64-bit column numbers): anything else is refused when the caller compiles."""
+    from numba.core.errors import TypingError
+
+    dst, src, index = np.zeros(6), np.arange(12.0).reshape(2, 6), np.array([5, 0, 3])
+    with pytest.raises(TypingError, match="C-contiguous"):
+        _filled(dst[::2], 0, 2, 1.0)
+    with pytest.raises(TypingError, match="C-contiguous"):
+        _picked(dst, 0, 3, src[:, ::2], index, 0, 2, 3)
+    with pytest.raises(TypingError, match="index is a C-contiguous"):
+        _picked(dst, 0, 3, src, np.array([5, 0, 3, 1])[::2], 0, 2, 2)
+    with pytest.raises(TypingError, match="64-bit"):
+        _picked(dst, 0, 3, src, index.astype(np.int32), 0, 2, 3)
+    _picked(dst, 0, 3, src, index, 0, 2, 3)
+    assert dst.tolist() == [5.0, 0.0, 3.0, 11.0, 6.0, 9.0]
+
+
 _NO_STREAMS = """
 import numpy as np
 from numba import njit

@@ -7,8 +7,8 @@ library, and reads and writes several arrays the compiler must assume overlap.  
 block of :data:`VBLOCK` geometries:
 
 1. :func:`gather` copies the block's angles and parameters into one scratch
-   array (``memcpy``, :func:`copy_into`; what every block shares, :func:`shared` wrote once
-   per call) and takes the azimuths' cosines and sines there with the polynomial
+   array (``memcpy``, :func:`copy_into`, or :func:`pick_rows` for a model set's columns; what
+   every block shares, :func:`shared` wrote once per call with :func:`fill`) and takes the azimuths' cosines and sines there with the polynomial
    :func:`~scatterbench.models.kernels.vector_math.sincos` (the C library beyond its range);
 2. :func:`entry`'s loop runs the kernel over the scratch: one loop per model and option set (:func:`lane_options`), with
    the code and options constants, so that the branches left are selects; no call remains
@@ -51,7 +51,7 @@ from .common import NO_SHADOWING, azimuths_at, polar
 from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, own_kernel
 from .facet import coating, facet_lanes
 from .helper import helper
-from .memory import STREAM_MIN, copy_into, copy_rows, line_aligned
+from .memory import STREAM_MIN, copy_into, copy_rows, fill, line_aligned, pick_rows
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
 #: in the L2 cache
@@ -180,13 +180,12 @@ def shared(sc, ti, tr, pr, prm, index, m, rows):
     angles as if each were one value (:func:`gather` then copies over those that are not) and,
     for parameters shared by every geometry (one column), the first ``rows`` parameter rows.
     A single model's parameters are then not copied again per block."""
-    for k in range(m):
-        sc[_TI * VBLOCK + k], sc[_TR * VBLOCK + k], sc[_PR * VBLOCK + k] = ti[0], tr[0], pr[0]
+    fill(sc, _TI * VBLOCK, m, ti[0])
+    fill(sc, _TR * VBLOCK, m, tr[0])
+    fill(sc, _PR * VBLOCK, m, pr[0])
     if index.shape[0] == 1 and prm.shape[1] == 1:
         for r in range(rows):
-            v, o = prm[r, index[0]], (_PRM + r) * VBLOCK
-            for k in range(m):
-                sc[o + k] = v
+            fill(sc, (_PRM + r) * VBLOCK, m, prm[r, index[0]])
 
 
 @helper(forceinline=None)
@@ -196,7 +195,8 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     (:func:`~scatterbench.models.kernels.common.azimuths_at`), and
     the first ``rows`` parameter rows, those the kernel reads, when the parameters are per
     geometry (the columns :func:`~scatterbench.models.kernels.drive.column` reads), the copies
-    ``memcpy`` (:func:`copy_into`, :func:`copy_rows`).  Branches, not the arithmetic of ``column``: LLVM
+    ``memcpy`` (:func:`copy_into`, :func:`copy_rows`) or, a column per geometry picked,
+    :func:`pick_rows`.  Branches, not the arithmetic of ``column``: LLVM
     unswitched the loop of that on its selects, a copy per case."""
     if ti.shape[0] > 1:
         copy_into(sc, _TI * VBLOCK, ti, lo, m)
@@ -207,10 +207,7 @@ def gather(sc, ti, tr, pr, prm, index, lo, m, turns, rows):
     if turns:  # a constant of the kernel: only the diffuse one reads no azimuth
         azimuths_at(sc, _PR * VBLOCK, sc, _CP * VBLOCK, sc, _SP * VBLOCK, m)
     if index.shape[0] > 1:  # a column per geometry, picked
-        for r in range(rows):
-            o = (_PRM + r) * VBLOCK
-            for k in range(m):
-                sc[o + k] = prm[r, index[lo + k]]
+        pick_rows(sc, _PRM * VBLOCK, VBLOCK, prm, index, lo, rows, m)
     elif prm.shape[1] > 1:  # a column per geometry, in order from index[0]
         copy_rows(sc, _PRM * VBLOCK, VBLOCK, prm, index[0] + lo, prm.shape[1], rows, m, False)
 
