@@ -17,12 +17,13 @@ the caller compiles: a strided array's elements are not one block); in Python
 (``NUMBA_DISABLE_JIT=1``) they are numpy's copies.  Streaming stores and their fence are x86's
 (``vmovntpd``, ``sfence``); on other CPUs every row is a ``memcpy``.
 
-:func:`fill` (a value into a row) and :func:`pick_rows` (rows of a model set's parameters,
-picked by column per geometry) are loops LLVM neither vectorizes nor unrolls: they run once per
-call or once per block, and LLVM optimizes the copies again in each lane entry.  Kept scalar,
-they took 7-10% off the lane entries' compilation (eight entries, Cook-Torrance's, the diffuse
-and the single-scattering ones but the first, which types the helpers: 3.32 / 3.43 s of CPU
-against 3.59 / 3.79 s vectorized, a fresh cache, two rounds alternating, ad hoc), and the
+:func:`fill` (a value into a row: a line's worth a store, then one element a store) and
+:func:`pick_rows` (rows of a model set's parameters, picked by column per geometry) are loops
+LLVM neither vectorizes nor unrolls: they run once per call or once per block, and LLVM
+optimizes the copies again in each lane entry.  Written so, they took 6-9% off the lane
+entries' compilation (eight entries, Cook-Torrance's, the diffuse and the single-scattering
+ones but the first, which types the helpers: 3.34 / 3.33 s of CPU against 3.56 / 3.62 s with
+the loops LLVM vectorized, a fresh cache, two rounds alternating, ad hoc), and the
 vectorized picking was the slower: a model set of 24 elements over 2 x 10^5 geometries (both
 cores, best of 15, three rounds alternating, ad hoc) took 12.6-13.1 ns a geometry of
 Cook-Torrance picked one element at a time against 14.3-16.5 vectorized, FacetBRDF 14.1-15.2
@@ -74,9 +75,10 @@ def copy_into(dst, dst_at, src, src_at, count):
 
 
 def fill(dst, dst_at, count, value):
-    """``count`` elements of ``dst`` (flat, from ``dst_at``) set to ``value``: compiled, a loop
-    LLVM neither vectorizes nor unrolls (:func:`_fill`).  For what a call writes once, not per
-    block: vectorized and unrolled, such fills were code LLVM optimized again in every entry."""
+    """``count`` elements of ``dst`` (flat, from ``dst_at``) set to ``value``: compiled, a line's
+    worth a store in a loop LLVM neither vectorizes nor unrolls (:func:`_fill`).  For what a call
+    writes once, not per block: as loops LLVM vectorized and unrolled, such fills were code it
+    optimized again in every entry."""
     dst.reshape(-1)[dst_at : dst_at + count] = value
 
 
@@ -210,15 +212,27 @@ def _rows(typingctx, dst, dst_at, dst_step, src, src_at, src_step, rows, count, 
 
 @intrinsic
 def _fill(typingctx, dst, dst_at, count, value):
-    """:func:`fill`'s compiled form: one store an element, in a loop LLVM keeps as it is
-    (:func:`_rolled_loop`)."""
+    """:func:`fill`'s compiled form: a cache line's worth of elements a store (a vector of the
+    value), then one store an element for the rest, in loops LLVM keeps as they are
+    (:func:`_rolled_loop`): one store an element throughout made a 100-geometry call of the
+    lanes about 2% slower than the vectorized fills (``benchmarks/kernel_ab.py --what small``)."""
     sig = types.void(dst, dst_at, count, dst.dtype)
 
     def codegen(context, builder, signature, args):
         d = context.make_array(signature.args[0])(context, builder, args[0])
-        at = _wide(builder, args[1])
-        with _rolled_loop(builder, _wide(builder, args[2])) as k:
-            builder.store(args[3], builder.gep(d.data, [builder.add(at, k)]))
+        at, n, value = _wide(builder, args[1]), _wide(builder, args[2]), args[3]
+        i64, size = ir.IntType(64), context.get_abi_sizeof(value.type)
+        per = LINE_BYTES // size
+        vec = ir.VectorType(value.type, per)
+        splat = builder.insert_element(ir.Constant(vec, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
+        splat = builder.shuffle_vector(splat, splat, ir.Constant(ir.VectorType(ir.IntType(32), per), None))
+        whole = builder.sdiv(n, ir.Constant(i64, per))
+        with _rolled_loop(builder, whole) as k:
+            p = builder.gep(d.data, [builder.add(at, builder.mul(k, ir.Constant(i64, per)))])
+            builder.store(splat, builder.bitcast(p, vec.as_pointer()), align=size)  # an element's alignment
+        done = builder.mul(whole, ir.Constant(i64, per))
+        with _rolled_loop(builder, builder.sub(n, done)) as k:
+            builder.store(value, builder.gep(d.data, [builder.add(at, builder.add(done, k))]))
         return context.get_dummy_value()
 
     return sig, codegen
