@@ -215,7 +215,7 @@ def _fill(typingctx, dst, dst_at, count, value):
     """:func:`fill`'s compiled form: a cache line's worth of elements a store (a vector of the
     value), then one store an element for the rest, in loops LLVM keeps as they are
     (:func:`_rolled_loop`): one store an element throughout made a 100-geometry call of the
-    lanes about 2% slower than the vectorized fills (``benchmarks/kernel_ab.py --what small``)."""
+    lanes 1-3% slower than the vectorized fills (``benchmarks/kernel_ab.py --what small``)."""
     sig = types.void(dst, dst_at, count, dst.dtype)
 
     def codegen(context, builder, signature, args):

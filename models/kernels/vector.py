@@ -8,7 +8,8 @@ block of :data:`VBLOCK` geometries:
 
 1. :func:`gather` copies the block's angles and parameters into one scratch
    array (``memcpy``, :func:`copy_into`, or :func:`pick_rows` for a model set's columns; what
-   every block shares, :func:`shared` wrote once per call with :func:`fill`) and takes the azimuths' cosines and sines there with the polynomial
+   every block shares, :func:`shared` wrote once per call with :func:`fill`) and takes the
+   azimuths' cosines and sines there with the polynomial
    :func:`~scatterbench.models.kernels.vector_math.sincos` (the C library beyond its range);
 2. :func:`entry`'s loop runs the kernel over the scratch: one loop per model and option set (:func:`lane_options`), with
    the code and options constants, so that the branches left are selects; no call remains
