@@ -2,7 +2,8 @@
 count, and the first ``report --quick`` cold and warm.
 
     python benchmarks/scaling.py [--geometries 1000000] [--threads 1 2 ...] [--workers 1 2 ...]
-                                 [--studies sweep-quick presets ...] [--first-run] [--compile]
+                                 [--studies sweep-quick presets ...] [--first-run [--pairs N]]
+                                 [--compile]
                                  [--repeat 3]
 
 * **Kernels.** ``FacetBRDF.mueller16`` (Gaussian slopes, aluminium, no shadowing) on ``--geometries``
@@ -16,7 +17,8 @@ count, and the first ``report --quick`` cold and warm.
   worker count (the command exits 1 when they are not).
 * **First run** (``--first-run``): ``scatterbench report --quick`` with an empty numba cache
   (``NUMBA_CACHE_DIR`` a fresh folder: every kernel compiles) and then again with that cache
-  (warm), with the default ``--workers``.
+  (warm), with the default ``--workers``, ``--pairs`` times: the seconds of each and their
+  ratio.
 * **Compilation** (``--compile``): each compile group of a report
   (``validation.report.build.every_compile_group``: a kernel's loops, or the Monte Carlo, aperture or
   disc entries, grouped by the helpers they share; the last ones compiled beside the sections
@@ -31,6 +33,7 @@ machine are noisy.
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import subprocess
@@ -109,16 +112,32 @@ def studies(names, workers):
     return ok
 
 
-def first_run():
-    """``report --quick`` with an empty numba cache, then warm, each in a fresh process."""
-    print(f"\nfirst run: scatterbench report --quick; {_load()}")
-    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as out:
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        for label in ("cold (empty numba cache)", "warm"):
-            t = time.perf_counter()
-            cmd = [sys.executable, "-m", "scatterbench.validation.cli", "report", "--quick", "--out", out]
-            r = subprocess.run(cmd, env=env, capture_output=True, text=True)
-            print(f"  {label:<25} {time.perf_counter() - t:7.1f} s  exit {r.returncode}")
+def first_run(pairs=1):
+    """``report --quick`` with an empty numba cache, then warm, each in a fresh process, ``pairs``
+    times (a fresh cache each): per pair the whole command's seconds, ``results.json``'s and the
+    cold run's ratio to the warm one, then the ratios' range (a shared host moves them by more
+    than one pair shows)."""
+    print(f"\nfirst run: scatterbench report --quick, {pairs} pair(s); {_load()}")
+    ratios = []
+    for k in range(pairs):
+        with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as out:
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+            walls, seconds = [], []
+            for label in ("cold (empty numba cache)", "warm"):
+                t = time.perf_counter()
+                cmd = [sys.executable, "-m", "scatterbench.validation.cli", "report", "--quick", "--out", out]
+                r = subprocess.run(cmd, env=env, capture_output=True, text=True)
+                walls.append(time.perf_counter() - t)
+                with open(os.path.join(out, "results.json"), encoding="utf-8") as f:
+                    seconds.append(json.load(f)["meta"]["seconds"])
+                print(
+                    f"  pair {k + 1} {label:<25} {walls[-1]:7.1f} s  results.json {seconds[-1]:6.1f} s  exit {r.returncode}"
+                )
+            ratios.append(walls[0] / walls[1])
+            print(
+                f"  pair {k + 1} cold / warm: {ratios[-1]:.2f} of wall, {seconds[0] / seconds[1]:.2f} of results.json"
+            )
+    print(f"  cold / warm of wall over {pairs} pair(s): {min(ratios):.2f} - {max(ratios):.2f}; {_load()}")
 
 
 _COMPILE = """
@@ -173,6 +192,7 @@ def main():
     ap.add_argument("--studies", nargs="*", choices=STUDY_NAMES, default=list(REPORT_STUDIES))
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--first-run", action="store_true", help="also time report --quick cold and warm")
+    ap.add_argument("--pairs", type=int, default=1, help="cold and warm pairs of --first-run (default 1)")
     ap.add_argument("--compile", action="store_true", help="also time each compile-ahead task, empty cache")
     args = ap.parse_args()
     c = cores()
@@ -182,7 +202,7 @@ def main():
     if args.compile:
         compile_tasks()
     if args.first_run:
-        first_run()
+        first_run(args.pairs)
     print(f"\nend; {_load()}")
     if not ok:
         sys.exit("RESULTS DIFFER between worker counts: the results must not depend on them")
