@@ -128,6 +128,8 @@ def first_run(pairs=1):
                 cmd = [sys.executable, "-m", "scatterbench.validation.cli", "report", "--quick", "--out", out]
                 r = subprocess.run(cmd, env=env, capture_output=True, text=True)
                 walls.append(time.perf_counter() - t)
+                if r.returncode not in (0, 1):  # 1: a check failed, the report still written
+                    sys.exit(f"report --quick exited {r.returncode}:\n{r.stderr[-2000:]}")
                 with open(os.path.join(out, "results.json"), encoding="utf-8") as f:
                     seconds.append(json.load(f)["meta"]["seconds"])
                 print(
