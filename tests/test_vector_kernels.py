@@ -129,13 +129,17 @@ def _copied(dst, src):
 
 
 @njit
-def _copied_rows(dst, src, stream):
-    memory.copy_rows(dst, 0, 3, src, 0, 3, 1, 3, stream)
+def _rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream):
+    memory.copy_rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream)
 
 
 @pytest.mark.parametrize(
     "copy",
-    [_copied, lambda d, s: _copied_rows(d, s, False), lambda d, s: _copied_rows(d, s, True)],
+    [
+        _copied,
+        lambda d, s: _rows(d, 0, 3, s, 0, 3, 1, 3, False),
+        lambda d, s: _rows(d, 0, 3, s, 0, 3, 1, 3, True),
+    ],
     ids=["copy_into", "copy_rows", "copy_rows-streamed"],
 )
 def test_block_copies_refuse_strided_arrays(copy):
@@ -150,11 +154,6 @@ def test_block_copies_refuse_strided_arrays(copy):
         copy(dst, src[::2])
     with pytest.raises(TypingError, match="one dtype"):
         copy(dst, src.astype(np.float32))
-
-
-@njit
-def _rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream):
-    memory.copy_rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream)
 
 
 @pytest.mark.parametrize("stream", [False, True])
@@ -437,7 +436,7 @@ def test_the_lanes_are_vectorized_loops(tmp_path):
     for (model, loop), (bodies, vectors, streamed, called) in counts.items():
         if loop == "lanes":  # one option set per entry: its loop, and LLVM's remainder copies
             assert bodies >= 1 and vectors > 0, (model, bodies, vectors)
-            # a large result's rows streamed to memory (memory.stream_into), on x86-64
+            # a large result's rows streamed to memory (memory.copy_rows), on x86-64
             assert (streamed > 0) == memory.STREAMS, (model, streamed)
             # the block copies stay calls (kernels.helper's forceinline=None); a kernel's helper
             # called, not inlined, kept Cook-Torrance's loop 3.5-5x slower with vector bodies left

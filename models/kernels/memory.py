@@ -12,8 +12,8 @@ ad hoc, three rounds alternating), 2.6 MB of result 27.0-27.6 ns a geometry stre
 27.2-29.4 against 31.4-33.8.  :data:`STREAM_MIN` is where
 :func:`~scatterbench.models.kernels.vector.put` changes over.
 
-Both take C-contiguous arrays of one dtype that do not overlap (other layouts are refused when
-the caller compiles: a strided array's elements are not one block); in Python
+They all take C-contiguous arrays of one dtype that do not overlap (other layouts are refused
+when the caller compiles: a strided array's elements are not one block); in Python
 (``NUMBA_DISABLE_JIT=1``) they are numpy's copies.  Streaming stores and their fence are x86's
 (``vmovntpd``, ``sfence``); on other CPUs every row is a ``memcpy``.
 
@@ -103,12 +103,13 @@ def copy_rows(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream)
         copy_into(dst, dst_at + r * dst_step, src, src_at + r * src_step, count)
 
 
-def _checked(name, dst, src, *ints):
-    """The compiled forms' typing checks, ``TypingError`` naming ``name``."""
-    if not (isinstance(dst, types.Array) and isinstance(src, types.Array)):
+def _checked(name, arrays, *ints):
+    """The compiled forms' typing checks of their ``arrays`` (C-contiguous, one dtype) and
+    integer arguments, ``TypingError`` naming ``name``."""
+    if not all(isinstance(a, types.Array) for a in arrays):
         raise TypingError(f"{name}: arrays only")
-    if dst.layout != "C" or src.layout != "C" or dst.dtype != src.dtype:
-        raise TypingError(f"{name}: C-contiguous arrays of one dtype only, not {dst} and {src}")
+    if any(a.layout != "C" or a.dtype != arrays[0].dtype for a in arrays):
+        raise TypingError(f"{name}: C-contiguous arrays of one dtype only, not {', '.join(map(str, arrays))}")
     if not all(isinstance(t, types.Integer) and t.signed for t in ints):
         raise TypingError(f"{name}: offsets, steps and counts are signed integers")
 
@@ -116,13 +117,13 @@ def _checked(name, dst, src, *ints):
 # the compiled forms inline into their callers (the lanes test reads a lane loop's calls)
 @overload(copy_into, jit_options={"forceinline": True})
 def _copy_into_compiled(dst, dst_at, src, src_at, count):
-    _checked("copy_into", dst, src, dst_at, src_at, count)
+    _checked("copy_into", (dst, src), dst_at, src_at, count)
     return lambda dst, dst_at, src, src_at, count: _memcpy(dst, dst_at, src, src_at, count)
 
 
 @overload(copy_rows, jit_options={"forceinline": True})
 def _copy_rows_compiled(dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream):
-    _checked("copy_rows", dst, src, dst_at, dst_step, src_at, src_step, rows, count)
+    _checked("copy_rows", (dst, src), dst_at, dst_step, src_at, src_step, rows, count)
     if not isinstance(stream, types.Boolean):
         raise TypingError(f"copy_rows: stream is a boolean, not {stream}")
     return lambda dst, dst_at, dst_step, src, src_at, src_step, rows, count, stream: _rows(
@@ -132,16 +133,13 @@ def _copy_rows_compiled(dst, dst_at, dst_step, src, src_at, src_step, rows, coun
 
 @overload(fill, jit_options={"forceinline": True})
 def _fill_compiled(dst, dst_at, count, value):
-    if not (isinstance(dst, types.Array) and dst.layout == "C"):
-        raise TypingError(f"fill: a C-contiguous array only, not {dst}")
-    if not all(isinstance(t, types.Integer) and t.signed for t in (dst_at, count)):
-        raise TypingError("fill: offset and count are signed integers")
+    _checked("fill", (dst,), dst_at, count)
     return lambda dst, dst_at, count, value: _fill(dst, dst_at, count, dst.dtype.type(value))
 
 
 @overload(pick_rows, jit_options={"forceinline": True})
 def _pick_rows_compiled(dst, dst_at, dst_step, src, index, lo, rows, count):
-    _checked("pick_rows", dst, src, dst_at, dst_step, lo, rows, count)
+    _checked("pick_rows", (dst, src), dst_at, dst_step, lo, rows, count)
     if not (isinstance(index, types.Array) and index.ndim == 1 and index.layout == "C"):
         raise TypingError(f"pick_rows: index is a C-contiguous 1-d array, not {index}")
     if not (isinstance(index.dtype, types.Integer) and index.dtype.bitwidth == 64):
@@ -289,8 +287,9 @@ def _streamed_row(builder, dp, sp, n):
 @contextlib.contextmanager
 def _rolled_loop(builder, count):
     """A loop over ``0 .. count - 1`` (int64) in generated code, yielding its index, that LLVM
-    neither unrolls nor vectorizes (``llvm.loop`` metadata): a copy's loops are over a result's
-    16 rows and a row's 32 lines at most, which unrolled were code to compile in every entry."""
+    neither unrolls nor vectorizes (``llvm.loop`` metadata): the copies' loops are over a
+    result's 16 rows, a row's 32 lines or a block's 256 columns at most, which unrolled and
+    vectorized were code to compile again in every entry."""
     i64, module = ir.IntType(64), builder.module
     before = builder.basic_block
     body, after = builder.append_basic_block("lines"), builder.append_basic_block("lines.done")

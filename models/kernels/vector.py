@@ -44,7 +44,6 @@ its parameters, the ellipse's rotation given as the strokes' azimuth's cosine an
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numba.core import config
 
 from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, SHADOWING_KINDS
@@ -151,7 +150,7 @@ def _coating_at(sc, k, n):
     sc[o + 5 * B], sc[o + 6 * B], sc[o + 7 * B], sc[o + 8 * B] = v[5], v[6], v[7], v[8]
 
 
-@njit(error_model="numpy", inline="always")
+@helper
 def _no_prepass(sc, m):
     """The other kernels' (their loop computes all it needs)."""
 
@@ -271,7 +270,8 @@ def entry(code, opts):
             iopt[2] if r2 else np.int64(k2),
         )
         sc = line_aligned(_ROWS * VBLOCK)
-        sc[(_PRM + rows) * VBLOCK :] = 0.0  # the parameter rows the kernel does not read: never gathered
+        unread = (_PRM + rows) * VBLOCK  # the parameter rows the kernel does not read: never gathered
+        fill(sc, unread, sc.size - unread, 0.0)
         # the parameter rows to copy, a count LLVM cannot fold: with the constant, it unrolled
         # shared's and gather's row loops in full, a vectorized inner loop per row, in every entry
         copied = min(rows, prm.shape[0])
