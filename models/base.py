@@ -384,10 +384,18 @@ class Sum(Model):
     _numpy_sets = True  # its terms evaluate their own parameters
 
     def _mueller16(self, ti, tr, pr):
-        total = None
+        # a weight of 1 multiplies nothing (1 * x is x, bit for bit), and the sum is added in
+        # place once it is an array of its own (a term's result may be shared or read-only)
+        total, owned = None, False
         for w, m in self.terms:
-            block = w * m.flat_mueller16(ti, tr, pr)
-            total = block if total is None else total + block
+            block = m.flat_mueller16(ti, tr, pr)
+            block = block if w == 1.0 else w * block
+            if total is None:
+                total = block
+            elif owned:
+                total += block
+            else:
+                total, owned = total + block, True
         return total
 
     def lobe(self, theta_i):

@@ -11,6 +11,7 @@ from scatterbench import models, references
 from scatterbench.models import scene
 from scatterbench.validation.checks.fitting import InterruptAfter
 from scatterbench.validation.cli import main
+from scatterbench.validation.fitting import likelihood
 from scatterbench.validation.fitting.datafile import load_data
 from scatterbench.validation.fitting.executors import DaskExecutor, ProcessExecutor, SerialExecutor
 from scatterbench.validation.fitting.fit import fingerprint, run_fit
@@ -159,8 +160,8 @@ def test_the_likelihood_s_kernel_route_gives_the_models_bits(scene_file, data_fi
     (models.evaluation.FixedAngles: their angles validated and broadcast once per walker
     count): the Mueller matrices of
     ``model.mueller16``, bit for bit, for a single model and for model sets of 1 and 7
-    walkers, on the first call and on the cached angles (a sum of models takes the general
-    route)."""
+    walkers, on the first call and on the cached angles; a sum of models (the paint), which
+    has no kernel of its own, the same way through numpy's sum of its terms' kernels."""
     sc = scene.load(references.scene_path(scene_file))
     lik = Likelihood(sc, fitspec_from(sc), subsample(load_data(references.data_path(data_file)), 60))
     rng = np.random.default_rng(3)
@@ -172,11 +173,24 @@ def test_the_likelihood_s_kernel_route_gives_the_models_bits(scene_file, data_fi
             model = lik.model(lik.spec.physical(u[0]))
         else:
             model = lik.model(lik.spec.values(u).scene)
-        # a sum of models (the paint) has no kernel of its own: the general route
+        # a sum of models (the paint) has no kernel of its own
         assert models.evaluation.kernel_path(model) == (scene_file != "red_paint_fit.toml")
         shape, M = lik._rows.mueller16(model)
         ref_shape, ref = model.mueller16(d.theta_i, d.theta_r, d.phi_r)
         assert shape == ref_shape and np.array_equal(M, ref)
+
+
+def test_stokes_of_the_rows_are_einsum_s_bits():
+    """The likelihood's Stokes vectors (each row's Mueller matrix on its incident Stokes
+    vector, products added in the incident elements' order) are numpy's einsum's, bit for bit,
+    over magnitudes 1e-5..1e5, several walker counts and row counts, a zero V included."""
+    rng = np.random.default_rng(11)
+    for walkers, rows in [(1, 1), (1, 200), (12, 200), (7, 33), (24, 5)]:
+        M = rng.standard_normal((4, 4, walkers, rows)) * 10.0 ** rng.uniform(-5, 5, (4, 4, walkers, rows))
+        inc = rng.standard_normal((rows, 4))
+        inc[::2, 3] = 0.0
+        S = likelihood._stokes(M, np.ascontiguousarray(inc.T))
+        assert np.array_equal(S, np.einsum("ab...n,nb->a...n", M, inc))
 
 
 @pytest.mark.parametrize(

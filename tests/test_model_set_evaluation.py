@@ -14,6 +14,10 @@ def test_diffuse_subsurface_set_runs_one_quadrature_per_distinct_coating(monkeyp
     """R-bar is a quadrature (QUADPACK, ``_compiled_quad``; ``quad`` in Python where that gives
     nothing): a set of 64 coatings evaluated in several chunks runs it 64 times (it ran twice
     per coating: once deciding on the kernel, once per chunk)."""
+    # the compiled integrand exists once the kernels have loaded: run alone, this test built
+    # the set before anything loaded them, and every coating fell back to Python's quad
+    from scatterbench.models import kernels  # noqa: F401
+
     calls = []
     quad, python = smooth_interface._compiled_quad, smooth_interface._python_quad
     monkeypatch.setattr(smooth_interface, "_compiled_quad", lambda *a: calls.append(1) or quad(*a))

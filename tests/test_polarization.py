@@ -91,6 +91,18 @@ def test_ellipsometric_quantities():
     assert np.isnan(p[2])  # no light: polarization undefined, never a fake number
 
 
+def test_ellipsometric_with_light_everywhere_gives_the_masked_values(rng):
+    """Where every intensity is positive, ellipsometric skips its masks (a fit's rows): the
+    same bits as the rows of an input that also holds a dark row, which takes the masks."""
+    S = rng.standard_normal((500, 4)) * 10.0 ** rng.uniform(-8, 3, (500, 4))
+    S[:, 0] = np.abs(S[:, 0]) + 1e-12
+    lit = ellipsometric(S)
+    masked = ellipsometric(np.vstack([S, np.zeros(4)]))
+    for a, b in zip(lit, masked, strict=True):
+        assert np.array_equal(a, b[:-1])
+    assert np.isnan(masked[2][-1]) and np.isnan(masked[3][-1])
+
+
 def test_reciprocity_jones_and_mueller_agree(rng):
     J = random_jones(rng)
     np.testing.assert_allclose(

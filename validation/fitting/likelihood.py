@@ -87,6 +87,17 @@ def replicate(pred: dict, variances: dict, rng) -> dict:
 _LOG2PI = math.log(2.0 * math.pi)
 
 
+def _stokes(M, incident):
+    """The Stokes vectors ``(4, ..., rows)`` of Mueller elements ``M`` ``(4, 4, ..., rows)``
+    acting on each row's incident Stokes vector (``incident`` ``(4, rows)``): the products
+    added in the order of the incident elements, as numpy's ``einsum("ab...n,bn->a...n")``
+    adds them (the same bits, in half its time for a fit's 12 walkers x 200 rows)."""
+    S = M[:, 0] * incident[0]
+    for b in (1, 2, 3):
+        S += M[:, b] * incident[b]
+    return S
+
+
 def scene_for_data(scene, data):
     """``scene`` with the detector aperture of ``data``'s sidecar, when it records one
     (the instrument that took the data decides, not the scene's default)."""
@@ -142,6 +153,7 @@ class Likelihood(BatchPosterior):
         d = self.data
         self._log_obs = np.log(d.brdf)
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
+        self._incident_rows = np.ascontiguousarray(d.incident.T)  # (4, rows): a row per Stokes element
         # the fitted rows, evaluated for every walker of every step: validated once
         self._rows = evaluation.FixedAngles(d.theta_i, d.theta_r, d.phi_r)
         self.terms = _terms(spec, d)
@@ -188,7 +200,7 @@ class Likelihood(BatchPosterior):
                 if inc[b] != 0.0:
                     S += M[:, b] * inc[b]
         else:
-            S = np.einsum("ab...n,nb->a...n", M, d.incident)
+            S = _stokes(M, self._incident_rows if data is None else np.ascontiguousarray(d.incident.T))
         if terms == ("brdf",):
             return {"brdf": S[0] / d.incident[:, 0]}
         i, eta, pc, p = ellipsometric(np.moveaxis(S, 0, -1))
@@ -213,14 +225,23 @@ class Likelihood(BatchPosterior):
         return out
 
     def _pointwise_rows(self, noise, pred) -> np.ndarray:
+        """Per row, the sum over the terms of ``-(r^2 / v + ln 2 pi + ln v) / 2``, ``-inf`` where
+        a term's is not finite.  The operations of that expression, in its order, each in place
+        in one array per term; ``ln v`` of a variance per walker taken once per walker, not
+        once per row (the same values)."""
         res = self.residuals(pred)
         var = self._variances(noise)
         total = np.zeros(res["brdf"].shape)
-        for t in self.terms:
-            v = np.broadcast_to(var[t], total.shape)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ll = -0.5 * (res[t] ** 2 / v + _LOG2PI + np.log(v))
-            total += np.where(np.isfinite(ll), ll, -np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for t in self.terms:
+                v = var[t]
+                ll = np.square(res[t])
+                ll /= v
+                ll += _LOG2PI
+                ll += np.log(v)
+                ll *= -0.5
+                np.copyto(ll, -np.inf, where=~np.isfinite(ll))
+                total += ll
         return total
 
     def pointwise_batch(self, U) -> np.ndarray:
