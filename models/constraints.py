@@ -225,20 +225,17 @@ class Interval(Constraint):
         return f"{what} in {interval_notation(self.low, self.high, self.low_open, self.high_open)}"
 
     def outside(self, a) -> np.ndarray:
-        """Boolean array: where the float64 array ``a`` lies outside the interval (NaN always)."""
-        with np.errstate(invalid="ignore"):
-            bad = np.isnan(a)
-            inf_ok = np.zeros(a.shape, dtype=bool)
-            if self.high == math.inf and not self.high_open:
-                inf_ok |= a == math.inf
-            if self.low == -math.inf and not self.low_open:
-                inf_ok |= a == -math.inf
-            bad |= np.isinf(a) & ~inf_ok
-            if self.low is not None:
-                bad |= (a <= self.low) if self.low_open else (a < self.low)
-            if self.high is not None:
-                bad |= (a >= self.high) if self.high_open else (a > self.high)
-        return bad
+        """Boolean array: where the float64 array ``a`` lies outside the interval (NaN always).
+
+        Two comparisons, each false for NaN: an unbounded end (``None``) compares as an open
+        bound at infinity, which refuses that infinity, and a closed infinite bound admits its
+        own; so infinities need no test of their own (a fit checks its walkers' parameters at
+        every step: five numpy calls fewer an array)."""
+        low = -math.inf if self.low is None else self.low
+        high = math.inf if self.high is None else self.high
+        above = (a > low) if (self.low is None or self.low_open) else (a >= low)
+        below = (a < high) if (self.high is None or self.high_open) else (a <= high)
+        return ~(above & below)
 
     def _scalar(self, name, value) -> float:
         """``value`` as a float (a complex number with no imaginary part counts), unchecked range."""

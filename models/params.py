@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -301,6 +302,16 @@ class _DeclaredMeta(type):
             return super().__call__(*args, **kwargs)
 
 
+@functools.cache
+def _declared_constraint(cls, name):
+    """The constraint ``cls`` declares for ``name`` (``None``: not a declared parameter), looked
+    up once per class and name: a fit checks its walkers' parameters by name at every step."""
+    for f in dataclasses.fields(cls):
+        if f.name == name and "scatterbench" in f.metadata:
+            return f.metadata["scatterbench"].constraint
+    return None
+
+
 @contextlib.contextmanager
 def _naming_old(renamed):
     """A ValueError about a parameter that was given by an old name also names the old name."""
@@ -334,10 +345,10 @@ class Declared(metaclass=_DeclaredMeta):
         """``value`` validated as the declared parameter ``name`` (a ``ValueError`` naming it
         and its allowed range otherwise), without building an instance: for callers, such
         as scene files, that hold a value for a model they build later."""
-        for f in dataclasses.fields(cls):
-            if f.name == name and "scatterbench" in f.metadata:
-                return f.metadata["scatterbench"].constraint.check(name, value)
-        raise ValueError(f"{name}: not a declared parameter of {cls.__name__}")
+        constraint = _declared_constraint(cls, name)
+        if constraint is None:
+            raise ValueError(f"{name}: not a declared parameter of {cls.__name__}")
+        return constraint.check(name, value)
 
     @classmethod
     def _alias(cls, old) -> Alias:

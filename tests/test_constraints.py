@@ -77,6 +77,30 @@ def test_interval_admits_only_a_closed_infinite_bound():
         with_inf.check("d", -math.inf)
 
 
+@pytest.mark.parametrize("low", [None, -math.inf, -1.0, 0.0])
+@pytest.mark.parametrize("high", [None, 1.0, math.inf])
+@pytest.mark.parametrize("closed", ["both", "left", "right", "neither"])
+def test_interval_outside_follows_its_rule_element_by_element(low, high, closed):
+    """``outside`` (two comparisons an array) against the rule written out per value: NaN is
+    outside; an infinity only inside at a closed bound of that infinity (never at an unbounded
+    end); a finite value by the bounds' closedness."""
+    c = Interval(low, high, closed=closed)
+    a = np.array([-math.inf, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0, math.inf, math.nan])
+
+    def rule(x):
+        if math.isnan(x):
+            return True
+        if math.isinf(x):
+            bound, closed_there = (high, not c.high_open) if x > 0 else (low, not c.low_open)
+            return not (bound == x and closed_there)
+        below = low is not None and (x <= low if c.low_open else x < low)
+        above = high is not None and (x >= high if c.high_open else x > high)
+        return below or above
+
+    assert c.outside(a).tolist() == [rule(x) for x in a]
+    assert [bool(c.outside(np.float64(x))) for x in a] == [rule(x) for x in a]
+
+
 def test_interval_refuses_a_bad_declaration():
     with pytest.raises(ValueError, match="closed must be one of"):
         Interval(0, 1, closed="open")
