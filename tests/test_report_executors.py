@@ -171,6 +171,19 @@ def test_results_without_timings_differ_when_a_result_does(in_process):
     assert results_digest(moved) != results_digest(in_process)
 
 
+def test_results_without_timings_leave_out_the_commit_not_the_rest_of_provenance():
+    """Two commits' reports compare equal where their results are: the provenance table's
+    commit row is left out (as ``meta``'s ``git_commit``), its other rows stay."""
+    rows = [{"item": "numpy", "value": "2.4.6"}, {"item": "git commit", "value": "6e188bcff69c"}]
+    a = {"meta": {"git_commit": "6e188bc"}, "sections": {"provenance": {"numbers": {"provenance": rows}}}}
+    b = json.loads(json.dumps(a))
+    b["meta"]["git_commit"] = "unknown"
+    b["sections"]["provenance"]["numbers"]["provenance"][1]["value"] = "unknown"
+    assert results_digest(a) == results_digest(b)
+    b["sections"]["provenance"]["numbers"]["provenance"][0]["value"] = "2.5.0"
+    assert results_digest(a) != results_digest(b)
+
+
 def test_the_monte_carlo_checks_runs_identical_on_workers():
     """The slow Monte Carlo checks' runs (25 for the error scaling) are tasks of the run's executor."""
     from scatterbench.validation.checks.seed003 import mc_error_scaling

@@ -18,6 +18,10 @@ __all__ = ["without_timings", "results_digest"]
 _TIMED_KEYS = frozenset({"seconds", "date", "git_commit", "us per geometry (CPU)", "us per geometry (wall)"})
 #: per section: the ``numbers`` tables chosen by measured time (prefixes)
 _TIMED_TABLES = {"speed": ("pareto|",), "provenance": ("section_times",)}
+#: the provenance table's row naming the commit (as ``git_commit`` does in ``meta``): two
+#: commits' reports compare equal where their results are (``benchmarks/study_workers.py
+#: --baseline``: before, every run against another checkout differed by this row alone)
+_COMMIT_ROW = "git commit"
 
 
 def _strip(value):
@@ -35,6 +39,11 @@ def without_timings(results: dict) -> dict:
         numbers = out.get("sections", {}).get(sid, {}).get("numbers", {})
         for key in [k for k in numbers if k.startswith(prefixes)]:
             del numbers[key]
+    prov = out.get("sections", {}).get("provenance", {}).get("numbers", {})
+    if isinstance(prov.get("provenance"), list):
+        prov["provenance"] = [
+            r for r in prov["provenance"] if not (isinstance(r, dict) and r.get("item") == _COMMIT_ROW)
+        ]
     return out
 
 
