@@ -253,7 +253,8 @@ def comparison_settings(quick):
 
 def _comparison(quick, executor=None):
     """Seed 003's model comparison, its fits on ``executor`` (default: in-process); the full
-    run's 8 fits: 63.1 s in-process, 34.3 s on 2 workers (benchmarks/study_workers.py)."""
+    run's 8 fits of two chains: 86.4 s in-process, 42.2 s on 2 workers at 6e188bc (2 cores,
+    ``python benchmarks/study_workers.py --study comparison --workers 2 1``)."""
     return seed003_pairing(**comparison_settings(quick), executor=executor)  # same on any executor
 
 
