@@ -331,7 +331,10 @@ class FixedAngles:
         """``(shape, M)``: ``model.mueller16`` at the angles."""
         leaves = model._sets
         shape = np.broadcast_shapes(*(np.shape(a) for a in self.angles), *(v.shape for v in leaves.values()))
-        if math.prod(shape) > (KERNEL_CHUNK if kernel_path(model) else CHUNK):
+        n = math.prod(shape)
+        # up to CHUNK geometries either route takes one chunk: no need to ask for the kernel,
+        # whose spec flat() builds on the flattened model anyway
+        if n > CHUNK and n > (KERNEL_CHUNK if kernel_path(model) else CHUNK):
             return evaluate(model, *self.angles, 16)
         angles = self._flat.get(shape)
         if angles is None:

@@ -344,7 +344,7 @@ class Compiled:
         assert len(rows) == len(drive.ROWS[code]), f"{code} kernel rows: {drive.ROWS[code]}"
         self.name = code
         self.code = drive.CODES[code]
-        length = max((np.size(r) for r in rows), default=1)
+        length = max((r.size if type(r) is np.ndarray else np.size(r) for r in rows), default=1)
         prm = np.zeros((drive.PARAM_ROWS, length))  # padded: every kernel takes the same tuple
         for k, r in enumerate(rows):
             prm[k] = r
