@@ -385,18 +385,20 @@ class Sum(Model):
 
     def _mueller16(self, ti, tr, pr):
         # a weight of 1 multiplies nothing (1 * x is x, bit for bit), and the sum is added in
-        # place once it is an array of its own (a term's result may be shared or read-only)
+        # place once it is an array of its own: a term's result may be shared or read-only,
+        # and the sum's is the caller's
         total, owned = None, False
         for w, m in self.terms:
-            block = m.flat_mueller16(ti, tr, pr)
-            block = block if w == 1.0 else w * block
+            block, fresh = m.flat_mueller16(ti, tr, pr), w != 1.0
+            if fresh:
+                block = w * block
             if total is None:
-                total = block
+                total, owned = block, fresh
             elif owned:
                 total += block
             else:
                 total, owned = total + block, True
-        return total
+        return total if owned else total.copy()
 
     def lobe(self, theta_i):
         lobes = [m.lobe(theta_i) for _, m in self.terms]

@@ -341,7 +341,8 @@ class FixedAngles:
             angles = self._flat[shape] = [_whole(a, shape) for a in checked_angles(model, *self.angles)]
         if leaves:
             model = with_leaves(model, {k: _whole(v, shape) for k, v in leaves.items()})
-        return shape, flat(model, *angles, 16)
+        with np.errstate(over="ignore"):  # as fill() computes a numpy route's chunk
+            return shape, flat(model, *angles, 16)
 
 
 def _whole(a, shape):

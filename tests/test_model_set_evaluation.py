@@ -165,3 +165,28 @@ def test_indexed_kernel_call_gives_the_gathered_rows_bits(kind, tmp_path):
         assert np.array_equal(one[:, 0], r[:, 7])
         with pytest.raises(ValueError, match="index"):
             m.flat_mueller16_indexed(np.full(n, G), ti, tr, pr, np.empty((16, n)))
+
+
+def test_a_sum_adds_its_terms_in_order_and_returns_an_array_of_its_own(monkeypatch):
+    """A sum's Mueller elements are its weighted terms added in order, bit for bit (a weight
+    of 1 multiplies nothing, and the sum adds in place once it owns its array), and what it
+    returns is the caller's to write, also for a single term of weight 1."""
+    a = models.FacetBRDF(slopes=models.GaussianSlopes(0.2))
+    b = models.DiffuseSubsurfaceBRDF(coating=1.5, rho=0.5)
+    c = models.FacetBRDF(slopes=models.GGXSlopes(0.3))
+    ti, tr, pr = np.linspace(0.0, 1.4, 7), np.linspace(0.1, 1.2, 7), np.linspace(-3.0, 3.0, 7)
+    Ma, Mb, Mc = (m.flat_mueller16(ti, tr, pr) for m in (a, b, c))
+    for terms, ref in [
+        (((1.0, a), (1.0, b), (0.5, c)), Ma + Mb + 0.5 * Mc),
+        (((0.5, c), (1.0, a), (1.0, b)), 0.5 * Mc + Ma + Mb),
+        (((2.0, b),), 2.0 * Mb),
+    ]:
+        assert np.array_equal(models.Sum(terms=terms).flat_mueller16(ti, tr, pr), ref)
+    # a term whose result is read-only (a user's model may return a cached array)
+    shared = Ma.copy()
+    shared.flags.writeable = False
+    monkeypatch.setattr(models.FacetBRDF, "flat_mueller16", lambda self, ti, tr, pr: shared)
+    for terms in [((1.0, a),), ((1.0, a), (1.0, a))]:
+        got = models.Sum(terms=terms).flat_mueller16(ti, tr, pr)
+        assert got is not shared and got.flags.writeable
+        assert np.array_equal(got, Ma if len(terms) == 1 else Ma + Ma)
