@@ -7,9 +7,10 @@ The comparison (:func:`scatterbench.validation.checks.fitting.comparison_setting
 pairing: 8 fits of two chains each) runs its 16 chains as 16 tasks, so on enough workers it
 takes as long as its longest chain, and in-process as long as all of them.  For each burn-in
 (``ChainSettings.burn``: steps run before the kept chain, not kept) this prints each chain's
-seconds (burn-in included), kept steps, max tau and whether it reached N >= 50 tau, then the
-sum, the longest, and their ratio: the most any number of workers can speed the comparison up
-over one process.
+seconds (burn-in included) and their split (the optimum its chain starts from, the burn-in,
+the kept chain), kept steps, max tau and whether it reached N >= 50 tau, then the sum, the
+longest, and their ratio: the most any number of workers can speed the comparison up over one
+process.
 """
 
 from __future__ import annotations
@@ -30,7 +31,8 @@ from scatterbench.validation.fitting.fit import run_fit
 
 
 def chains(burn):
-    """``[(data, terms, hypothesis, chain, seconds, steps, max tau, converged)]`` under ``burn``."""
+    """``[(data, terms, hypothesis, chain, seconds, steps, max tau, converged, (optimum, burn-in,
+    kept chain seconds))]`` under ``burn``."""
     cfg = comparison_settings(False)
     settings = cfg["settings"]
     cases, groups = _pairing_cases(cfg["rows"], ("all", "brdf"))
@@ -40,9 +42,12 @@ def chains(burn):
             for c in range(cfg["chains"]):
                 s = settings.replace(seed=chain_seed(settings.seed, c), burn=burn)
                 t = time.perf_counter()
-                ch = run_fit(lik, s).chain
-                row = (case["generator"], case["terms"], name, c, time.perf_counter() - t)
-                out.append(row + (ch.steps, float(ch.tau.max()), ch.converged))
+                fit = run_fit(lik, s)
+                total, ch = time.perf_counter() - t, fit.chain
+                burned = fit.summary["sampling"]["burned_before_chain"]["seconds"]
+                split = (total - burned - ch.seconds, burned, ch.seconds)
+                row = (case["generator"], case["terms"], name, c, total)
+                out.append(row + (ch.steps, float(ch.tau.max()), ch.converged, split))
     return out
 
 
@@ -55,13 +60,15 @@ def main():
 
     numba.set_num_threads(min(args.threads, numba.config.NUMBA_NUM_THREADS))
     print(
-        f"{'data':<14}{'terms':<6}{'hypothesis':<15}{'chain':>5}{'burn':>6}{'seconds':>9}{'kept':>7}{'max tau':>9}  N >= 50 tau"
+        f"{'data':<14}{'terms':<6}{'hypothesis':<15}{'chain':>5}{'burn':>6}{'seconds':>9}"
+        f"{'optimum':>9}{'burn-in':>9}{'kept':>7}{'steps':>7}{'max tau':>9}  N >= 50 tau"
     )
     for burn in args.burn:
         rows = chains(burn)
-        for g, t, h, c, sec, steps, tau, ok in rows:
+        for g, t, h, c, sec, steps, tau, ok, (opt, burned, kept) in rows:
             print(
-                f"{g:<14}{t:<6}{h:<15}{c:>5}{burn:>6}{sec:9.1f}{steps:7d}{tau:9.1f}  {'yes' if ok else 'NO'}"
+                f"{g:<14}{t:<6}{h:<15}{c:>5}{burn:>6}{sec:9.1f}{opt:9.1f}{burned:9.1f}{kept:7.1f}"
+                f"{steps:7d}{tau:9.1f}  {'yes' if ok else 'NO'}"
             )
         total, longest = sum(r[4] for r in rows), max(r[4] for r in rows)
         print(
