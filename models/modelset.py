@@ -34,8 +34,15 @@ __all__ = [
 ]
 
 
-def _declared_fields(obj):
-    return [f for f in dataclasses.fields(obj) if "scatterbench" in f.metadata]
+@functools.cache
+def _declared_fields(cls) -> tuple:
+    """``(name, constraint)`` of each declared field of ``cls``, once per class: a fit walks its
+    walkers' model set at every step."""
+    return tuple(
+        (f.name, f.metadata["scatterbench"].constraint)
+        for f in dataclasses.fields(cls)
+        if "scatterbench" in f.metadata
+    )
 
 
 def _walk(obj, path, visit):
@@ -45,13 +52,12 @@ def _walk(obj, path, visit):
     A declared object where a value goes (a :class:`scatterbench.models.FilmStack` as a substrate
     index) is walked into, like an object parameter."""
     if isinstance(obj, Declared) and dataclasses.is_dataclass(obj):
-        for f in _declared_fields(obj):
-            constraint = f.metadata["scatterbench"].constraint
-            value = getattr(obj, f.name)
+        for name, constraint in _declared_fields(type(obj)):
+            value = getattr(obj, name)
             if constraint.arrays and not isinstance(value, Declared):
-                visit(path + (f.name,), value, constraint.kind)
+                visit(path + (name,), value, constraint.kind)
             else:
-                _walk(value, path + (f.name,), visit)
+                _walk(value, path + (name,), visit)
     elif isinstance(obj, tuple):
         for i, item in enumerate(obj):
             _walk(item, path + (i,), visit)
