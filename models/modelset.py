@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from .params import Declared
+from .params import Declared, declared_constraints
 
 __all__ = [
     "array_leaves",
@@ -34,17 +34,6 @@ __all__ = [
 ]
 
 
-@functools.cache
-def _declared_fields(cls) -> tuple:
-    """``(name, constraint)`` of each declared field of ``cls``, once per class: a fit walks its
-    walkers' model set at every step."""
-    return tuple(
-        (f.name, f.metadata["scatterbench"].constraint)
-        for f in dataclasses.fields(cls)
-        if "scatterbench" in f.metadata
-    )
-
-
 def _walk(obj, path, visit):
     """Call ``visit(path, value, kind)`` for every declared value under ``obj`` that may be an
     array (its constraint's ``arrays``), and walk into every other declared value.
@@ -52,7 +41,7 @@ def _walk(obj, path, visit):
     A declared object where a value goes (a :class:`scatterbench.models.FilmStack` as a substrate
     index) is walked into, like an object parameter."""
     if isinstance(obj, Declared) and dataclasses.is_dataclass(obj):
-        for name, constraint in _declared_fields(type(obj)):
+        for name, constraint in declared_constraints(type(obj)).items():
             value = getattr(obj, name)
             if constraint.arrays and not isinstance(value, Declared):
                 visit(path + (name,), value, constraint.kind)

@@ -303,13 +303,15 @@ class _DeclaredMeta(type):
 
 
 @functools.cache
-def _declared_constraint(cls, name):
-    """The constraint ``cls`` declares for ``name`` (``None``: not a declared parameter), looked
-    up once per class and name: a fit checks its walkers' parameters by name at every step."""
-    for f in dataclasses.fields(cls):
-        if f.name == name and "scatterbench" in f.metadata:
-            return f.metadata["scatterbench"].constraint
-    return None
+def declared_constraints(cls) -> dict:
+    """``{name: constraint}`` of the declared fields of dataclass ``cls``, in field order, read
+    once per class: building a model, checking a parameter by name and walking a model set's
+    tree each read it, a fit's walkers at every step.  Treat it as read-only."""
+    return {
+        f.name: f.metadata["scatterbench"].constraint
+        for f in dataclasses.fields(cls)
+        if "scatterbench" in f.metadata
+    }
 
 
 @contextlib.contextmanager
@@ -331,10 +333,8 @@ class Declared(metaclass=_DeclaredMeta):
     aliases: dict = {}
 
     def __post_init__(self):
-        for f in dataclasses.fields(self):
-            decl = f.metadata.get("scatterbench")
-            if decl is not None:
-                object.__setattr__(self, f.name, decl.constraint.check(f.name, getattr(self, f.name)))
+        for name, constraint in declared_constraints(type(self)).items():
+            object.__setattr__(self, name, constraint.check(name, getattr(self, name)))
         self._validate()
 
     def _validate(self):
@@ -345,7 +345,7 @@ class Declared(metaclass=_DeclaredMeta):
         """``value`` validated as the declared parameter ``name`` (a ``ValueError`` naming it
         and its allowed range otherwise), without building an instance: for callers, such
         as scene files, that hold a value for a model they build later."""
-        constraint = _declared_constraint(cls, name)
+        constraint = declared_constraints(cls).get(name)
         if constraint is None:
             raise ValueError(f"{name}: not a declared parameter of {cls.__name__}")
         return constraint.check(name, value)

@@ -214,8 +214,8 @@ def test_filled_and_picked_rows_are_the_elements(compiled):
 
 
 def test_fill_and_pick_refuse_strided_arrays():
-    """Like the copies, the fill and the picking take C-contiguous arrays (the picking one dtype
-    and 64-bit column numbers): anything else is refused when the caller compiles."""
+    """Like the copies, the fill and the picking take C-contiguous arrays (the picking one dtype,
+    a 2-d source and 64-bit column numbers): anything else is refused when the caller compiles."""
     from numba.core.errors import TypingError
 
     dst, src, index = np.zeros(6), np.arange(12.0).reshape(2, 6), np.array([5, 0, 3])
@@ -227,6 +227,8 @@ def test_fill_and_pick_refuse_strided_arrays():
         _picked(dst, 0, 3, src, np.array([5, 0, 3, 1])[::2], 0, 2, 2)
     with pytest.raises(TypingError, match="64-bit"):
         _picked(dst, 0, 3, src, index.astype(np.int32), 0, 2, 3)
+    with pytest.raises(TypingError, match="src is 2-d"):
+        _picked(dst, 0, 3, src.reshape(-1), index, 0, 1, 3)
     _picked(dst, 0, 3, src, index, 0, 2, 3)
     assert dst.tolist() == [5.0, 0.0, 3.0, 11.0, 6.0, 9.0]
 

@@ -140,6 +140,8 @@ def _fill_compiled(dst, dst_at, count, value):
 @overload(pick_rows, jit_options={"forceinline": True})
 def _pick_rows_compiled(dst, dst_at, dst_step, src, index, lo, rows, count):
     _checked("pick_rows", (dst, src), dst_at, dst_step, lo, rows, count)
+    if src.ndim != 2:  # _pick reads a row's length from the second dimension
+        raise TypingError(f"pick_rows: src is 2-d (rows by columns), not {src}")
     if not (isinstance(index, types.Array) and index.ndim == 1 and index.layout == "C"):
         raise TypingError(f"pick_rows: index is a C-contiguous 1-d array, not {index}")
     if not (isinstance(index.dtype, types.Integer) and index.dtype.bitwidth == 64):
