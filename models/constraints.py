@@ -230,7 +230,8 @@ class Interval(Constraint):
         Two comparisons, each false for NaN: an unbounded end (``None``) compares as an open
         bound at infinity, which refuses that infinity, and a closed infinite bound admits its
         own; so infinities need no test of their own (a fit checks its walkers' parameters at
-        every step: five numpy calls fewer an array)."""
+        every step: four numpy calls an array, where the tests of NaN and infinities took eight
+        to twelve)."""
         low = -math.inf if self.low is None else self.low
         high = math.inf if self.high is None else self.high
         above = (a > low) if (self.low is None or self.low_open) else (a >= low)

@@ -320,8 +320,8 @@ class FixedAngles:
     the angles are validated and broadcast once per broadcast shape and handed to
     :func:`flat` as :class:`Plan`'s single chunk hands them: the same flat inputs and the same
     implementation, so the same bits, without the validation, broadcasting and gathering a
-    :class:`Plan` repeats per call (a fit's sum of three compiled models: 150 us of its 900
-    us a call, ``benchmarks/likelihood_batch.py``)."""
+    :class:`Plan` repeats per call (for a fit's sum of three compiled models, with the other
+    changes of 8990f21: docs/guide/nightly.md, ``benchmarks/likelihood_batch.py``)."""
 
     def __init__(self, theta_i, theta_r, phi_r):
         self.angles = (theta_i, theta_r, phi_r)

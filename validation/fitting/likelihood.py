@@ -91,7 +91,8 @@ def _stokes(M, incident):
     """The Stokes vectors ``(4, ..., rows)`` of Mueller elements ``M`` ``(4, 4, ..., rows)``
     acting on each row's incident Stokes vector (``incident`` ``(4, rows)``): the products
     added in the order of the incident elements, as numpy's ``einsum("ab...n,bn->a...n")``
-    adds them (the same bits, in half its time for a fit's 12 walkers x 200 rows)."""
+    adds them (the same bits; 12 walkers x 200 rows 31 us against einsum's 56 us, best of 5,
+    ad hoc)."""
     S = M[:, 0] * incident[0]
     for b in (1, 2, 3):
         S += M[:, b] * incident[b]
