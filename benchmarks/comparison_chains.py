@@ -1,7 +1,7 @@
 """Every chain of the report's full model comparison, one after another on one thread, under
 each burn-in: what bounds the comparison on many workers.
 
-    python benchmarks/comparison_chains.py [--burn 0 1000] [--threads 1]
+    python benchmarks/comparison_chains.py [--burn 0 1000] [--walkers 24 48] [--threads 1]
 
 The comparison (:func:`scatterbench.validation.checks.fitting.comparison_settings`, seed 003's
 pairing: 8 fits of two chains each) runs its 16 chains as 16 tasks, so on enough workers it
@@ -10,7 +10,9 @@ takes as long as its longest chain, and in-process as long as all of them.  For 
 seconds (burn-in included) and their split (the optimum its chain starts from, the burn-in,
 the kept chain), kept steps, max tau and whether it reached N >= 50 tau, then the sum, the
 longest, and their ratio: the most any number of workers can speed the comparison up over one
-process.
+process.  ``--walkers`` runs them again with each other ensemble size (default: the
+comparison's own), to see whether more walkers shorten the longest chain's steps (its tau) by
+more than they lengthen each step.
 """
 
 from __future__ import annotations
@@ -30,11 +32,11 @@ from scatterbench.validation.fitting.diagnostics import chain_seed
 from scatterbench.validation.fitting.fit import run_fit
 
 
-def chains(burn):
+def chains(burn, walkers=None):
     """``[(data, terms, hypothesis, chain, seconds, steps, max tau, converged, (optimum, burn-in,
-    kept chain seconds))]`` under ``burn``."""
+    kept chain seconds))]`` under ``burn`` (and ``walkers``, default the comparison's)."""
     cfg = comparison_settings(False)
-    settings = cfg["settings"]
+    settings = cfg["settings"].replace(walkers=walkers or cfg["settings"].walkers)
     cases, groups = _pairing_cases(cfg["rows"], ("all", "brdf"))
     out = []
     for case, (liks, names) in zip(cases, groups, strict=True):
@@ -54,6 +56,9 @@ def chains(burn):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--burn", type=int, nargs="+", default=[0, comparison_settings(False)["settings"].burn])
+    ap.add_argument(
+        "--walkers", type=int, nargs="+", default=[None], help="ensemble sizes (default: the comparison's)"
+    )
     ap.add_argument("--threads", type=int, default=1, help="numba threads (default 1: a worker's share)")
     args = ap.parse_args()
     import numba
@@ -63,19 +68,35 @@ def main():
         f"{'data':<14}{'terms':<6}{'hypothesis':<15}{'chain':>5}{'burn':>6}{'seconds':>9}"
         f"{'optimum':>9}{'burn-in':>9}{'kept':>7}{'steps':>7}{'max tau':>9}  N >= 50 tau"
     )
-    for burn in args.burn:
-        rows = chains(burn)
-        for g, t, h, c, sec, steps, tau, ok, (opt, burned, kept) in rows:
-            print(
-                f"{g:<14}{t:<6}{h:<15}{c:>5}{burn:>6}{sec:9.1f}{opt:9.1f}{burned:9.1f}{kept:7.1f}"
-                f"{steps:7d}{tau:9.1f}  {'yes' if ok else 'NO'}"
-            )
-        total, longest = sum(r[4] for r in rows), max(r[4] for r in rows)
+    warm()
+    for walkers in args.walkers:
+        for burn in args.burn:
+            report(chains(burn, walkers), burn, walkers)
+
+
+def warm():
+    """Each likelihood evaluated once, untimed: its kernels loaded (or compiled), so that the
+    first chain of each hypothesis is timed as the later ones are (before 2026-12-07 the first
+    paid that, ~0.5 s each on a warm cache, and a later ``--walkers`` run would not have)."""
+    cfg = comparison_settings(False)
+    for liks, _ in _pairing_cases(cfg["rows"], ("all", "brdf"))[1]:
+        for lik in liks:
+            lik(lik.spec.u_bounds().mean(axis=1))
+
+
+def report(rows, burn, walkers):
+    for g, t, h, c, sec, steps, tau, ok, (opt, burned, kept) in rows:
         print(
-            f"burn {burn}: {sum(r[7] for r in rows)}/{len(rows)} chains converged; {total:.1f} s in all, "
-            f"the longest {longest:.1f} s: at most {total / longest:.1f}x on any number of workers\n",
-            flush=True,
+            f"{g:<14}{t:<6}{h:<15}{c:>5}{burn:>6}{sec:9.1f}{opt:9.1f}{burned:9.1f}{kept:7.1f}"
+            f"{steps:7d}{tau:9.1f}  {'yes' if ok else 'NO'}"
         )
+    total, longest = sum(r[4] for r in rows), max(r[4] for r in rows)
+    size = f"{walkers} walkers" if walkers else "the comparison's walkers"
+    print(
+        f"burn {burn}, {size}: {sum(r[7] for r in rows)}/{len(rows)} chains converged; {total:.1f} s in all, "
+        f"the longest {longest:.1f} s: at most {total / longest:.1f}x on any number of workers\n",
+        flush=True,
+    )
 
 
 if __name__ == "__main__":
