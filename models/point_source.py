@@ -77,7 +77,6 @@ from functools import cached_property
 from types import MappingProxyType
 
 import numpy as np
-from scipy import signal
 
 from .base import Model, _Wrapper, is_isotropic, rotated_set
 from .constraints import Instance, Integer, Interval, OneOf, Options, ScalarOrArray
@@ -489,4 +488,8 @@ class PointSourceBRDF(_Wrapper):
         ok = T < 0.5 * math.pi
         F = np.zeros(T.shape)
         F[ok] = self.model.brdf(ti, T[ok], P[ok])
+        # scipy.signal (with scipy.stats, which it imports) took ~0.5 s of every process's
+        # import of the models, a fit worker's included: loaded here, where it is used
+        from scipy import signal
+
         return signal.correlate(F, K, mode="valid", method="fft")

@@ -1,6 +1,8 @@
 """Seed 001 Eq. 25-30: the point-source wrapper (exact superposition and shift approximation)."""
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -147,3 +149,16 @@ def test_bad_grid():
     ps = models.PointSourceBRDF(model=BASE, distance=5.0, method="shift")
     with pytest.raises(ValueError, match="theta_r"):
         ps.brdf_grid(0.3, np.array([0.1, 0.3, 0.35]), np.array([0.0, 0.1]))
+
+
+def test_importing_the_models_leaves_scipy_signal_and_numba_unloaded():
+    """``import scatterbench.models`` stays light (0.5 s where it took 0.9 s with scipy.signal,
+    which also loads scipy.stats): the point source's grid loads scipy.signal when it first
+    correlates, the kernels load numba when one first runs."""
+    code = (
+        "import sys, scatterbench.models; "
+        "heavy = [m for m in ('scipy.signal', 'scipy.stats', 'numba') if m in sys.modules]; "
+        "assert not heavy, heavy"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
