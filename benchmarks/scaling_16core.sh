@@ -35,7 +35,21 @@ if [ -d .whl ]; then
     export PYTHONPATH=/tmp/site
 fi
 PIP="python3 -m pip install -q --no-index --no-deps --no-build-isolation"
-$PIP -e . || { $PIP --target /tmp/sb . && export PYTHONPATH=/tmp/sb:${PYTHONPATH:-}; } || exit 1
+# The checkout importable as `scatterbench` without building it (pyproject.toml's package-dir:
+# scatterbench is namespace/, its models, validation and references the top-level folders), for
+# an image whose setuptools cannot build it (no bdist_wheel: setuptools < 70.1 without wheel):
+# a device call lost to a failed install does not come back.
+link_checkout() {
+    echo "installing failed: importing the checkout through /tmp/sblink instead"
+    local d=/tmp/sblink/scatterbench
+    rm -rf /tmp/sblink && mkdir -p "$d" || return 1
+    ln -s "$PWD/namespace/__init__.py" "$d/__init__.py" || return 1
+    for sub in models validation references; do ln -s "$PWD/$sub" "$d/$sub" || return 1; done
+    export PYTHONPATH=/tmp/sblink:${PYTHONPATH:-}
+    python3 -c "import scatterbench.validation.cli"
+}
+$PIP -e . || { $PIP --target /tmp/sb . && export PYTHONPATH=/tmp/sb:${PYTHONPATH:-}; } \
+    || link_checkout || exit 1
 
 echo "== machine"
 nproc
@@ -45,6 +59,8 @@ python3 -c "import sys, numpy, numba, scipy; print(sys.version.split()[0], 'nump
 git log --oneline -1 2>/dev/null || true
 
 export NUMBA_CACHE_DIR=/tmp/numba-cache  # empty on a fresh machine: part 1 is the cold run
+# the reports' folders: fresh ones (a report refuses a folder holding files it does not write)
+WORK=$(mktemp -d /tmp/scaling16.XXXXXX) || exit 1
 SB="python3 -m scatterbench.validation.cli"
 digest() {
     python3 -c "import json, sys; from scatterbench.validation.report.timing import results_digest
@@ -54,19 +70,19 @@ timed() {  # timed LABEL LIMIT CMD...: wall seconds and exit status of CMD under
     local label=$1 limit=$2
     shift 2
     local t0=$(date +%s%N)
-    timeout "$limit" "$@" > "/tmp/$label.out" 2>&1
+    timeout "$limit" "$@" > "$WORK/$label.out" 2>&1
     local rc=$?
     local ms=$((($(date +%s%N) - t0) / 1000000))
     echo "$label: $((ms / 1000)).$(printf %03d $((ms % 1000))) s, exit $rc"
-    tail -3 "/tmp/$label.out"
+    tail -3 "$WORK/$label.out"
 }
 
 part1() {
     echo "== 1. first report --quick (empty numba cache), 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
-    timed quick-cold 200 $SB report --quick --out /tmp/rq
-    echo "quick digest $(digest /tmp/rq)"
-    timed quick-warm 100 $SB report --quick --out /tmp/rqw
-    echo "quick warm digest $(digest /tmp/rqw)"
+    timed quick-cold 200 $SB report --quick --out "$WORK/rq"
+    echo "quick digest $(digest "$WORK/rq")"
+    timed quick-warm 100 $SB report --quick --out "$WORK/rqw"
+    echo "quick warm digest $(digest "$WORK/rqw")"
 }
 part2() {
     [ -f .probe/threads_probe.py ] || return 0
@@ -79,9 +95,9 @@ part3() {
 }
 part4() {
     echo "== 4. full report, 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
-    timed full-16 200 $SB report --out /tmp/rf16
-    echo "full-16 digest $(digest /tmp/rf16)"
-    cp /tmp/rf16/results.json "$OUT/full16.json" 2>/dev/null
+    timed full-16 200 $SB report --out "$WORK/rf16"
+    echo "full-16 digest $(digest "$WORK/rf16")"
+    cp "$WORK/rf16/results.json" "$OUT/full16.json" 2>/dev/null
 }
 part5() {
     echo "== 5. the full model comparison on 16 workers and in-process; load $(cut -d' ' -f1-3 /proc/loadavg)"
@@ -90,9 +106,9 @@ part5() {
 }
 part6() {
     echo "== 6. full report on 2 cores; load $(cut -d' ' -f1-3 /proc/loadavg)"
-    NUMBA_NUM_THREADS=2 timed full-2cores 420 taskset -c 0,1 $SB report --workers 2 --out /tmp/rf2
-    echo "full-2cores digest $(digest /tmp/rf2)"
-    cp /tmp/rf2/results.json "$OUT/full2.json" 2>/dev/null
+    NUMBA_NUM_THREADS=2 timed full-2cores 420 taskset -c 0,1 $SB report --workers 2 --out "$WORK/rf2"
+    echo "full-2cores digest $(digest "$WORK/rf2")"
+    cp "$WORK/rf2/results.json" "$OUT/full2.json" 2>/dev/null
 }
 shift
 parts=("$@")
