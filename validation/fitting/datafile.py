@@ -267,11 +267,18 @@ def _read_lines(path):
     return _text_of(path, "data file").splitlines()
 
 
-def _split(path, raw_lines):
-    """``(header, header_line, rows)``: the first non-comment line and the ``(line, fields)`` after it."""
+def split_csv(path, raw_lines, comment=None):
+    """``(header, header_line, rows)``: the first non-comment line and the ``(line, fields)`` after
+    it; ``comment(lineno, line)`` is called for each comment line (``#``), if given (the Mueller
+    files' ``# key: value`` lines)."""
     header, header_line, rows = None, None, []
     for lineno, text in enumerate(raw_lines, 1):
-        if not text.strip() or text.lstrip().startswith("#"):
+        stripped = text.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            if comment is not None:
+                comment(lineno, text)
             continue
         try:
             fields = next(csv.reader([text]))
@@ -425,7 +432,7 @@ def load_data(path) -> Dataset:
     path = str(path)
     raw_lines = _read_lines(path)
     meta, side = _load_sidecar(path)
-    header, header_line, rows = _split(path, raw_lines)
+    header, header_line, rows = split_csv(path, raw_lines)
     col_of = _columns(path, header, header_line)
     _check_polarization_columns(path, header_line, col_of)
     _check_incident_given_once(path, header_line, col_of, meta, side)

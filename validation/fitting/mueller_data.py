@@ -43,7 +43,6 @@ starts with ``file:line:column`` and names the column and its allowed range.
 
 from __future__ import annotations
 
-import csv
 import math
 import re
 from dataclasses import dataclass, field, replace
@@ -54,7 +53,7 @@ import numpy as np
 from scatterbench.models.polarization import psps_to_xyxy, xyxy_to_psps
 from scatterbench.models.text import read_utf8
 
-from .datafile import DataFileError
+from .datafile import DataFileError, split_csv
 
 __all__ = [
     "FORMAT",
@@ -201,24 +200,10 @@ class MuellerData:
 def _split(path, text):
     """``(keys, header, header_line, rows)``: the ``# key: value`` lines, the first other
     non-comment line and the ``(line, fields)`` after it."""
-    keys, header, header_line, rows = {}, None, None, []
-    for lineno, line in enumerate(text.splitlines(), 1):
-        stripped = line.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            _header_key(path, lineno, line, keys)
-            continue
-        try:
-            fields = next(csv.reader([line]))
-        except csv.Error as exc:
-            raise DataFileError(path, lineno, None, f"not a CSV line ({exc})") from exc
-        if header is None:
-            header, header_line = [f.strip() for f in fields], lineno
-        else:
-            rows.append((lineno, fields))
-    if header is None:
-        raise DataFileError(path, max(1, len(text.splitlines())), None, "no header line (and no data)")
+    keys = {}
+    header, header_line, rows = split_csv(
+        path, text.splitlines(), comment=lambda lineno, line: _header_key(path, lineno, line, keys)
+    )
     return keys, header, header_line, rows
 
 
