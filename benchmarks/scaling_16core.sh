@@ -18,6 +18,10 @@
 #      COMPARISON_WORKERS, default "16 1", the worker counts);
 #   6. the full `report` restricted to 2 cores (taskset, 2 workers, NUMBA_NUM_THREADS=2: numba
 #      counts the host's cores, not the affinity mask).
+#   7. the comparison's 16 chains one after another on one thread, each split into its optimum,
+#      burn-in and kept chain (benchmarks/comparison_chains.py --burn 1000; ~85 s on the 2-core
+#      machine): what bounds part 5 on that machine, and by how much the workers' start-up and
+#      the busy cores' clock take it further down.  Not in the default list.
 # The reports' digests (results.json without timings) must be equal.
 # At 4235c56 the quick report, the kernels, the full report and the comparison in-process took
 # ~560 s of the device call's 600 (figures in docs/guide/nightly.md, "How it scales"); part 6
@@ -109,6 +113,10 @@ part6() {
     NUMBA_NUM_THREADS=2 timed full-2cores 420 taskset -c 0,1 $SB report --workers 2 --out "$WORK/rf2"
     echo "full-2cores digest $(digest "$WORK/rf2")"
     cp "$WORK/rf2/results.json" "$OUT/full2.json" 2>/dev/null
+}
+part7() {
+    echo "== 7. the comparison's chains, one thread, one after another; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    timeout 200 python3 benchmarks/comparison_chains.py --burn 1000
 }
 shift
 parts=("$@")
