@@ -488,7 +488,7 @@ class PointSourceBRDF(_Wrapper):
         ok = T < 0.5 * math.pi
         F = np.zeros(T.shape)
         F[ok] = self.model.brdf(ti, T[ok], P[ok])
-        # scipy.signal (with scipy.stats, which it imports) took ~0.5 s of every process's
+        # scipy.signal (with scipy.stats, which it imports) took ~0.4 s of every process's
         # import of the models, a fit worker's included: loaded here, where it is used
         from scipy import signal
 
