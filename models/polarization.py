@@ -192,11 +192,11 @@ def ellipsometric(S):
     eta = 0.5 * np.arctan2(u, q)
     with np.errstate(invalid="ignore", divide="ignore"):
         ok = i > 0
-        if ok.all():  # light everywhere (a fit's rows): the same values without the masks
-            return i, eta, v / i, np.sqrt(q * q + u * u + v * v) / i
-        safe = np.where(ok, i, 1.0)
-        pc = np.where(ok, v / safe, np.nan)
-        pol = np.where(ok, np.sqrt(q * q + u * u + v * v) / safe, np.nan)
+        lit = ok.all()  # light everywhere (a fit's rows): the same values without the masks
+        safe = i if lit else np.where(ok, i, 1.0)
+        pc, pol = v / safe, np.sqrt(q * q + u * u + v * v) / safe
+    if not lit:
+        pc, pol = np.where(ok, pc, np.nan), np.where(ok, pol, np.nan)
     return i, eta, pc, pol
 
 
