@@ -183,7 +183,8 @@ def test_the_likelihood_s_kernel_route_gives_the_models_bits(scene_file, data_fi
 def test_stokes_of_the_rows_are_einsum_s_bits():
     """The likelihood's Stokes vectors (each row's Mueller matrix on its incident Stokes
     vector, products added in the incident elements' order) are numpy's einsum's, bit for bit,
-    over magnitudes 1e-5..1e5, several walker counts and row counts, a zero V included."""
+    over magnitudes 1e-5..1e5, several walker counts and row counts, a zero V included; one
+    incident vector for all rows gives the same, and skips its zero element."""
     rng = np.random.default_rng(11)
     for walkers, rows in [(1, 1), (1, 200), (12, 200), (7, 33), (24, 5)]:
         M = rng.standard_normal((4, 4, walkers, rows)) * 10.0 ** rng.uniform(-5, 5, (4, 4, walkers, rows))
@@ -191,6 +192,12 @@ def test_stokes_of_the_rows_are_einsum_s_bits():
         inc[::2, 3] = 0.0
         S = likelihood._stokes(M, np.ascontiguousarray(inc.T))
         assert np.array_equal(S, np.einsum("ab...n,nb->a...n", M, inc))
+        # one incident vector for every row: the same sums, its zero element skipped, so that
+        # an infinite element it multiplies gives no NaN
+        one = np.ascontiguousarray(np.tile(inc[0], (rows, 1)).T)
+        assert np.array_equal(likelihood._stokes(M, inc[0]), likelihood._stokes(M, one))
+        M[:, 3] = np.inf
+        assert np.all(np.isfinite(likelihood._stokes(M, inc[0])))
 
 
 @pytest.mark.parametrize(

@@ -89,13 +89,15 @@ _LOG2PI = math.log(2.0 * math.pi)
 
 def _stokes(M, incident):
     """The Stokes vectors ``(4, ..., rows)`` of Mueller elements ``M`` ``(4, 4, ..., rows)``
-    acting on each row's incident Stokes vector (``incident`` ``(4, rows)``): the products
-    added in the order of the incident elements, as numpy's ``einsum("ab...n,bn->a...n")``
-    adds them (the same bits; 12 walkers x 200 rows 31 us against einsum's 56 us, best of 5,
-    ad hoc)."""
+    acting on the incident light: ``incident`` ``(4, rows)``, each row's Stokes vector, or
+    ``(4,)``, one for every row.  The products are added in the order of the incident
+    elements, as numpy's ``einsum("ab...n,bn->a...n")`` adds them (the same bits; 12 walkers x
+    200 rows 31 us against einsum's 56 us, best of 5, ad hoc); one incident vector's zero
+    elements are skipped (no NaN from an infinite element times 0, as einsum would give)."""
     S = M[:, 0] * incident[0]
     for b in (1, 2, 3):
-        S += M[:, b] * incident[b]
+        if incident.ndim == 2 or incident[b] != 0.0:
+            S += M[:, b] * incident[b]
     return S
 
 
@@ -194,14 +196,10 @@ class Likelihood(BatchPosterior):
         M = M.reshape((4, 4) + shape)
         if terms == ("brdf",):
             M = M[:1]
-        if self._same_incident and data is None:
-            inc = d.incident[0]
-            S = M[:, 0] * inc[0]
-            for b in (1, 2, 3):
-                if inc[b] != 0.0:
-                    S += M[:, b] * inc[b]
+        if data is None:  # the fitted rows: their incident light, arranged once
+            S = _stokes(M, d.incident[0] if self._same_incident else self._incident_rows)
         else:
-            S = _stokes(M, self._incident_rows if data is None else np.ascontiguousarray(d.incident.T))
+            S = _stokes(M, np.ascontiguousarray(d.incident.T))
         if terms == ("brdf",):
             return {"brdf": S[0] / d.incident[:, 0]}
         i, eta, pc, p = ellipsometric(np.moveaxis(S, 0, -1))
