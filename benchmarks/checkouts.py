@@ -5,8 +5,8 @@ only through an installation (pyproject.toml's package-dir), so a checkout on ``
 is not importable by itself.  :func:`environment` gives the environment of a child process
 that imports ``root``'s code: the running environment where its scatterbench is ``root``'s
 (an editable install of this checkout); otherwise ``root`` installed without dependencies into
-a folder of its own under the temporary directory (once per tree and state of its files) and
-put first on ``PYTHONPATH``; a tree from before the one namespace (top-level ``models``, no
+a folder of its own under the temporary directory (once per tree and state of its files; where
+it cannot be built, its packages linked there, :func:`linked`) and put first on ``PYTHONPATH``; a tree from before the one namespace (top-level ``models``, no
 ``namespace/``) is put on ``PYTHONPATH`` itself.  A child imports the models with
 :data:`IMPORT_MODELS`, which works in both layouts.
 """
@@ -15,9 +15,11 @@ from __future__ import annotations
 
 import hashlib
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
+import tomllib
 
 #: the import a child process runs: ``models`` bound in either layout
 IMPORT_MODELS = "try:\n    from scatterbench import models\nexcept ImportError:\n    import models\n"
@@ -57,8 +59,29 @@ def _installed(root):
             r = subprocess.run([*pip, *extra, root], capture_output=True, text=True)
             if r.returncode == 0:
                 break
-        else:
-            raise SystemExit(f"could not install {root}: {r.stderr[-2000:]}")
+        else:  # no build (setuptools < 70.1 without wheel) and no index to fetch one from
+            shutil.rmtree(target, ignore_errors=True)
+            linked(root, target)
+    return target
+
+
+def linked(root, target=None):
+    """``root``'s packages importable from ``target`` (default: a new temporary folder) without
+    building them: pyproject.toml's package-dir as links, the top package's files in a folder
+    of its own and each subpackage's folder linked in it.  Returns ``target``, for
+    ``PYTHONPATH``; the links follow ``root``'s files as they change."""
+    root = os.path.realpath(root)
+    with open(os.path.join(root, "pyproject.toml"), "rb") as f:
+        dirs = tomllib.load(f)["tool"]["setuptools"]["package-dir"]
+    target = target or tempfile.mkdtemp(prefix="scatterbench-links-")
+    top = os.path.join(target, "scatterbench")
+    os.makedirs(top)
+    src = os.path.join(root, dirs["scatterbench"])
+    for name in os.listdir(src):
+        os.symlink(os.path.join(src, name), os.path.join(top, name))
+    for package, folder in dirs.items():
+        if package != "scatterbench":
+            os.symlink(os.path.join(root, folder), os.path.join(target, *package.split(".")))
     return target
 
 

@@ -39,17 +39,15 @@ if [ -d .whl ]; then
     export PYTHONPATH=/tmp/site
 fi
 PIP="python3 -m pip install -q --no-index --no-deps --no-build-isolation"
-# The checkout importable as `scatterbench` without building it (pyproject.toml's package-dir:
-# scatterbench is namespace/, its models, validation and references the top-level folders), for
-# an image whose setuptools cannot build it (no bdist_wheel: setuptools < 70.1 without wheel):
-# a device call lost to a failed install does not come back.
+# Where installing fails (setuptools < 70.1 without wheel cannot build, and there is no index),
+# the checkout's packages are linked instead (benchmarks/checkouts.py's linked: pyproject.toml's
+# package-dir): a device call lost to a failed install does not come back.
 link_checkout() {
-    echo "installing failed: importing the checkout through /tmp/sblink instead"
-    local d=/tmp/sblink/scatterbench
-    rm -rf /tmp/sblink && mkdir -p "$d" || return 1
-    ln -s "$PWD/namespace/__init__.py" "$d/__init__.py" || return 1
-    for sub in models validation references; do ln -s "$PWD/$sub" "$d/$sub" || return 1; done
-    export PYTHONPATH=/tmp/sblink:${PYTHONPATH:-}
+    echo "installing failed: importing the checkout through links instead"
+    local d
+    d=$(python3 -c "import sys; sys.path.insert(0, '.'); from benchmarks.checkouts import linked; print(linked('.'))") \
+        || return 1
+    export PYTHONPATH=$d:${PYTHONPATH:-}
     python3 -c "import scatterbench.validation.cli"
 }
 $PIP -e . || { $PIP --target /tmp/sb . && export PYTHONPATH=/tmp/sb:${PYTHONPATH:-}; } \
