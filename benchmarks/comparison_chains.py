@@ -41,6 +41,10 @@ def chains(burn, walkers=None):
     out = []
     for case, (liks, names) in zip(cases, groups, strict=True):
         for lik, name in zip(liks, names, strict=True):
+            # untimed: its kernels loaded (or compiled), so that a hypothesis's first chain is
+            # timed as the later ones are (before 2026-12-07 the first paid ~0.5 s for that on a
+            # warm cache, and a later --walkers run in the same process would not have)
+            lik(lik.spec.u_bounds().mean(axis=1))
             for c in range(cfg["chains"]):
                 s = settings.replace(seed=chain_seed(settings.seed, c), burn=burn)
                 t = time.perf_counter()
@@ -68,20 +72,9 @@ def main():
         f"{'data':<14}{'terms':<6}{'hypothesis':<15}{'chain':>5}{'burn':>6}{'seconds':>9}"
         f"{'optimum':>9}{'burn-in':>9}{'kept':>7}{'steps':>7}{'max tau':>9}  N >= 50 tau"
     )
-    warm()
     for walkers in args.walkers:
         for burn in args.burn:
             report(chains(burn, walkers), burn, walkers)
-
-
-def warm():
-    """Each likelihood evaluated once, untimed: its kernels loaded (or compiled), so that the
-    first chain of each hypothesis is timed as the later ones are (before 2026-12-07 the first
-    paid that, ~0.5 s each on a warm cache, and a later ``--walkers`` run would not have)."""
-    cfg = comparison_settings(False)
-    for liks, _ in _pairing_cases(cfg["rows"], ("all", "brdf"))[1]:
-        for lik in liks:
-            lik(lik.spec.u_bounds().mean(axis=1))
 
 
 def report(rows, burn, walkers):
