@@ -15,16 +15,21 @@ one).  For each likelihood, on one thread, this prints the best of ``--rounds`` 
 ``--batches`` calls at fixed positions near the middle of the prior (``--walkers`` of them;
 default half the study's walkers), the trees alternating round by round in processes of
 their own, and a digest of the values at 64 positions: the digests must be equal (the change
-kept the bits), else the command exits 1.  ``--baseline DIR``: another checkout (e.g. ``git
+kept the bits), else the command exits 1; with ``--rtol R`` a change that moves the values
+(another order of operations, another libm function) passes where the largest difference, relative
+to the values', is at most ``R`` and prints it.  ``--baseline DIR``: another checkout (e.g. ``git
 archive <commit> | tar -x -C DIR``).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import subprocess
 import sys
+
+import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
@@ -62,14 +67,15 @@ for key, lik, w in todo:
     rng = np.random.default_rng(7)
     mid, width = b.mean(axis=1), b[:, 1] - b[:, 0]
     probe = mid + 0.02 * width * rng.standard_normal((64, len(mid)))
-    digest = hashlib.sha1(lik.batch(probe).tobytes()).hexdigest()[:16]
+    values = lik.batch(probe)
+    digest = hashlib.sha1(values.tobytes()).hexdigest()[:16]
     U = probe[:w]
     lik.batch(U)
     t = time.perf_counter()
     for _ in range(batches):
         lik.batch(U)
     us = (time.perf_counter() - t) / batches * 1e6
-    print(*key, w, f"{us:.1f}", digest)
+    print(*key, w, f"{us:.1f}", digest, ",".join(map(float.hex, values.tolist())))
 """
 
 
@@ -83,7 +89,10 @@ def run(tree, walkers, batches):
     )
     if r.returncode != 0:
         raise SystemExit(f"{tree}: exit {r.returncode}\n{r.stderr[-3000:]}")
-    return {tuple(f[:4]): (float(f[4]), f[5]) for f in (ln.split() for ln in r.stdout.splitlines())}
+    return {
+        tuple(f[:4]): (float(f[4]), f[5], [float.fromhex(x) for x in f[6].split(",")])
+        for f in (ln.split() for ln in r.stdout.splitlines())
+    }
 
 
 def main():
@@ -94,29 +103,49 @@ def main():
     )
     ap.add_argument("--batches", type=int, default=300, help="calls a round (default 300)")
     ap.add_argument("--rounds", type=int, default=3, help="rounds, each tree in a fresh process (default 3)")
+    ap.add_argument(
+        "--rtol",
+        type=float,
+        default=0.0,
+        help="largest relative difference of the values allowed (default 0: the same bits)",
+    )
     args = ap.parse_args()
     trees = [("this", ROOT)] + ([("baseline", args.baseline)] if args.baseline else [])
     best = {name: {} for name, _ in trees}
     for _ in range(args.rounds):
         for name, tree in trees:
-            for key, (us, digest) in run(tree, args.walkers, args.batches).items():
-                old = best[name].get(key, (float("inf"), digest))
-                best[name][key] = (min(old[0], us), digest)
+            for key, (us, digest, values) in run(tree, args.walkers, args.batches).items():
+                old = best[name].get(key, (float("inf"),))
+                best[name][key] = (min(old[0], us), digest, values)
     print(f"us a call, best of {args.rounds} rounds of {args.batches} calls, one thread")
     head = f"{'data':<14}{'terms':<6}{'hypothesis':<15}{'walkers':>8}{'this':>9}"
     print(head + (f"{'baseline':>10}{'ratio':>8}  bits" if args.baseline else "  digest"))
-    same = True
-    for key, (us, digest) in best["this"].items():
+    worst = 0.0
+    for key, (us, digest, values) in best["this"].items():
         line = f"{key[0]:<14}{key[1]:<6}{key[2]:<15}{key[3]:>8}{us:9.1f}"
         if args.baseline:
-            bus, bdigest = best["baseline"][key]
-            same &= bdigest == digest
-            line += f"{bus:10.1f}{bus / us:7.2f}x  {'same' if bdigest == digest else 'DIFFER'}"
+            bus, bdigest, bvalues = best["baseline"][key]
+            diff = _relative(values, bvalues)
+            worst = max(worst, diff)
+            bits = "same" if bdigest == digest else f"DIFFER by {diff:.1e}"
+            line += f"{bus:10.1f}{bus / us:7.2f}x  {bits}"
         else:
             line += f"  {digest}"
         print(line)
-    if not same:
-        sys.exit("the likelihoods' values differ between the trees")
+    if worst > args.rtol:
+        sys.exit(
+            f"the likelihoods' values differ between the trees by {worst:.1e} (relative), more than --rtol {args.rtol:g}"
+        )
+
+
+def _relative(a, b):
+    """The largest difference of two lists of values relative to their magnitude (infinite where
+    one is finite and the other not, 0 where both are the same infinity)."""
+    a, b = (np.asarray(x, dtype=float) for x in (a, b))
+    same = a == b
+    if not np.array_equal(np.isfinite(a), np.isfinite(b)) or not np.all(same | np.isfinite(a)):
+        return math.inf
+    return float(np.max(np.where(same, 0.0, np.abs(a - b) / np.maximum(np.abs(a), np.abs(b)))))
 
 
 if __name__ == "__main__":

@@ -36,6 +36,7 @@ from scatterbench.models.polarization import ellipsometric, wrap_axis
 from scatterbench.models.scene import binding
 
 from .fitspec import FitSpec, FitSpecError
+from .polarized_kernel import loglike_rows
 
 __all__ = ["Likelihood", "scene_for_data", "term_variances", "replicate", "TERMS"]
 
@@ -157,6 +158,16 @@ class Likelihood(BatchPosterior):
         self._log_obs = np.log(d.brdf)
         self._same_incident = bool(np.all(d.incident == d.incident[0]))
         self._incident_rows = np.ascontiguousarray(d.incident.T)  # (4, rows): a row per Stokes element
+        # the fused kernel's (polarized_kernel): one incident vector, or one per row; the data
+        # by term, a term not used as zeros (not read)
+        self._incident_kernel = (
+            self._incident_rows[:, :1].copy() if self._same_incident else self._incident_rows
+        )
+        self._brdf_in = np.ascontiguousarray(d.incident[:, 0])
+        zero = np.zeros(len(d))
+        self._obs = np.stack(
+            [self._log_obs] + [zero if getattr(d, c) is None else getattr(d, c) for c in ("eta", "P", "P_C")]
+        )
         # the fitted rows, evaluated for every walker of every step: validated once
         self._rows = evaluation.FixedAngles(d.theta_i, d.theta_r, d.phi_r)
         self.terms = _terms(spec, d)
@@ -255,7 +266,25 @@ class Likelihood(BatchPosterior):
             self.binding.check(model)  # vectorized: every walker's parameters at once
         except ValueError:
             return self._pointwise_valid(U)
-        return self._pointwise_rows(v.noise, self.predict(model, terms=self.terms))
+        return self._fused_rows(v.noise, model)
+
+    def _fused_rows(self, noise, model):
+        """:meth:`_pointwise_rows` of :meth:`predict` at the fitted rows (the reference, which
+        the tests hold this to), fused in one compiled pass (:mod:`.polarized_kernel`)."""
+        shape, M = self._rows.mueller16(model)
+        var = self._variances(noise)
+        out = np.empty(shape)
+        M = np.ascontiguousarray(M.reshape(16, -1))
+        loglike_rows(
+            M,
+            self._incident_kernel,
+            self._same_incident,
+            self._brdf_in,
+            self._obs,
+            [var.get(t) for t in TERMS],
+            out,
+        )
+        return out
 
     def _pointwise_valid(self, U):
         """Rows of ``-inf`` for the positions the scene refuses (rebuilt and validated one by

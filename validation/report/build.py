@@ -163,11 +163,14 @@ COMPILE_GROUPS = (
 
 def warm_task(task):
     """Compile (or load) what compile-ahead task ``task`` (of a group of :data:`COMPILE_GROUPS`) names: a
-    kernel's loops (:func:`scatterbench.models.kernels.warm`) or the fused Mueller likelihood
-    (``"likelihood"``: :func:`scatterbench.validation.fitting.mueller_kernel.warm`)."""
+    kernel's loops (:func:`scatterbench.models.kernels.warm`) or the fused likelihoods
+    (``"likelihood"``: :func:`scatterbench.validation.fitting.mueller_kernel.warm`, the Mueller
+    data's, and :func:`scatterbench.validation.fitting.polarized_kernel.warm`, the polarized
+    BRDF's)."""
     if task[0] == "likelihood":  # validation's, not a model kernel
-        from scatterbench.validation.fitting import mueller_kernel  # numba (heavy): on use
+        from scatterbench.validation.fitting import mueller_kernel, polarized_kernel  # numba (heavy): on use
 
+        polarized_kernel.warm()
         return mueller_kernel.warm()
     from scatterbench.models import kernels
 
@@ -177,9 +180,9 @@ def warm_task(task):
 def cold_task(task) -> bool:
     """Whether what ``task`` names (:func:`warm_task`) is not in numba's cache yet."""
     if task[0] == "likelihood":
-        from scatterbench.validation.fitting import mueller_kernel
+        from scatterbench.validation.fitting import mueller_kernel, polarized_kernel
 
-        return mueller_kernel.cold()
+        return mueller_kernel.cold() or polarized_kernel.cold()
     from scatterbench.models import kernels
 
     return kernels.cold(*task)
