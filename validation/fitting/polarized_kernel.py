@@ -7,6 +7,7 @@ makes a temporary array per quantity and operation; it is kept as the reference 
 hold this to (``tests/test_fit.py``, 1e-12 relative per row).
 
 What differs from the reference, and why its last bits may:
+
 - the principal angle's residual is wrapped to a half-turn by subtracting the nearest
   multiple of pi (``d - pi floor(d / pi + 1/2)``), where the reference takes
   ``arg(exp(2 i d)) / 2`` (a sine, a cosine and an arctangent per row: 57 us of a 500 us
