@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import command_files
 import numpy as np
 import pytest
+import worker_probe
 
 from scatterbench import models, references
 from scatterbench.models import scene
@@ -81,6 +82,18 @@ def _blas_threads_here(_):
     from threadpoolctl import threadpool_info
 
     return sorted({p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"})
+
+
+def test_local_workers_start_with_the_executor_and_import_the_fitting_machinery():
+    """A pool's workers start when it is made, not at its first map, and each imports the
+    preload (the fitting machinery) as it starts: a task that imports nothing of scatterbench
+    finds it loaded there, and not in a worker without the preload."""
+    fit = "scatterbench.validation.fitting.fit"
+    with ProcessExecutor(2) as ex:
+        assert len(ex._pool._processes) == 2  # before any map
+        assert ex.map(worker_probe.imported, [fit] * 2, tasks=2) == [True, True]
+    with ProcessExecutor(1, preload=()) as ex:
+        assert ex.map(worker_probe.imported, [fit]) == [False]
 
 
 def test_meanwhile_runs_beside_the_block_and_the_block_ends_after_it():

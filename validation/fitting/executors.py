@@ -28,6 +28,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import hashlib
+import importlib
 import multiprocessing
 import os
 import pickle
@@ -125,13 +126,27 @@ def _share_cores(threads):
         _LIMITED = threads
 
 
-def _worker_init(threads):
+#: the modules a local worker imports as it starts (as ``multiprocessing``'s forkserver
+#: preload): the fitting machinery (emcee, SciPy's optimizers, numba, the models), ~1 s that
+#: a worker otherwise spends at its first task; names, not imports, because the executors sit
+#: below the modules that use them
+PRELOAD = ("scatterbench.validation.fitting.fit",)
+
+
+def _worker_init(threads, preload=()):
     """A local worker's set-up: it leaves Ctrl-C to the parent (which stops the pool and says
     how to resume: the terminal sends it to every process of the group, and each would print
-    a traceback) and runs on its share of the cores (:func:`_share_cores`)."""
+    a traceback), runs on its share of the cores (:func:`_share_cores`) and imports
+    ``preload``."""
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _share_cores(threads)
+    for name in preload:
+        importlib.import_module(name)
+
+
+def _started():
+    """A task that does nothing: :class:`ProcessExecutor` submits one per worker to start them."""
 
 
 #: the functions a worker keeps unpickled: a report's sections run at once
@@ -234,7 +249,7 @@ class ProcessExecutor(SerialExecutor):
     kind = "processes"
     one_task_per_process = True
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, preload=PRELOAD):
         self.workers = _integer("workers", workers, 1)
         # spawn: no inherited locks or threads from the parent (safe with Dask/matplotlib loaded)
         self._fn = self._blob = self._key = None
@@ -243,8 +258,12 @@ class ProcessExecutor(SerialExecutor):
             workers,
             mp_context=multiprocessing.get_context("spawn"),
             initializer=_worker_init,
-            initargs=(kernel_threads(workers),),
+            initargs=(kernel_threads(workers), tuple(preload)),
         )
+        # every worker started now (a pool starts them at its first tasks), so that they import
+        # ``preload`` while this process sets its own work up
+        for _ in range(self.workers):
+            self._pool.submit(_started)
 
     def map(self, fn, items, tasks=None):
         """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker)."""
