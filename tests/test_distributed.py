@@ -4,10 +4,6 @@ stability sweep give the same results, in the same order, on a dask.distributed 
 processes and in-process."""
 
 import json
-import os
-import sys
-import threading
-import time
 from dataclasses import dataclass
 
 import command_files
@@ -31,7 +27,6 @@ from scatterbench.validation.fitting.executors import (
     _dask_kernel_threads,
     _local_cores,
     kernel_threads,
-    meanwhile,
 )
 from scatterbench.validation.fitting.fitspec import fitspec_from
 from scatterbench.validation.fitting.likelihood import Likelihood
@@ -94,36 +89,6 @@ def test_local_workers_start_with_the_executor_and_import_the_fitting_machinery(
         assert ex.map(worker_probe.imported, [fit] * 2, tasks=2) == [True, True]
     with ProcessExecutor(1, preload=()) as ex:
         assert ex.map(worker_probe.imported, [fit]) == [False]
-
-
-def test_meanwhile_runs_beside_the_block_and_the_block_ends_after_it():
-    seen = {}
-
-    def load():
-        time.sleep(0.2)  # still running when the block's own work is done
-        seen["thread"] = threading.current_thread() is not threading.main_thread()
-        if sys.platform == "linux":
-            seen["nice"] = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
-
-    with meanwhile(load):
-        seen["in block"] = "thread" not in seen
-    assert seen["in block"] and seen["thread"]  # beside the block, and waited for at its end
-    if sys.platform == "linux":
-        assert seen["nice"] == 19  # the lowest priority: idle cores only
-
-
-def test_meanwhile_leaves_exceptions_to_the_caller_and_can_be_off():
-    ran = []
-
-    def fails():
-        ran.append(True)
-        raise RuntimeError("the caller's own later use raises this")
-
-    with meanwhile(fails):
-        pass
-    with meanwhile(fails, when=False):
-        pass
-    assert ran == [True]
 
 
 def test_local_workers_share_the_cores_among_their_threads(monkeypatch):

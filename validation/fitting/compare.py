@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import pickle
 
 import numpy as np
 from scipy.special import logsumexp
@@ -23,8 +22,7 @@ from scatterbench.models import scene as scene_mod
 
 from .datafile import load_data
 from .diagnostics import chain_seed, rhat
-from .diagnostics import load as load_diagnostics
-from .executors import SerialExecutor, meanwhile
+from .executors import SerialExecutor
 from .fit import FitResult, information_criteria, predictive, predictive_checks, run_fit
 from .fitspec import fitspec_from
 from .likelihood import Likelihood
@@ -136,15 +134,9 @@ def _fit_one(job):
     return run_fit(lik, settings)
 
 
-def _load_rows(liks, chains):
-    """What the rows need loaded: ArviZ (with several chains) and each likelihood's kernels,
-    by one evaluation at the middle of its bounds of a copy (the likelihoods themselves are
-    left to the map: pickling only reads them)."""
-    if chains > 1:
-        load_diagnostics()
-    for lik in liks:
-        copy = pickle.loads(pickle.dumps(lik))
-        copy(copy.spec.u_bounds().mean(axis=1))
+def _row(job):
+    """A scene's comparison row from its chains (a task): ``job`` is ``(name, fits, seed)``."""
+    return _comparison_row(*job)
 
 
 def _ranked(rows):
@@ -158,22 +150,24 @@ def _ranked(rows):
 
 def _compare_groups(groups, settings, executor, chains=1):
     """:func:`compare_fits` of several ``(liks, names)`` groups with one map over all their
-    fits' chains (so every worker has a chain to run), then their rows here, regrouped in
+    fits' chains (so every worker has a chain to run), then one over their rows, regrouped in
     order.  Chain ``c`` of every fit is seeded :func:`chain_seed` ``(settings.seed, c)``.
 
-    A row takes ~0.04 s once ArviZ and its likelihood's kernels are loaded, which takes
-    seconds; where the chains run elsewhere, this process loads them while it waits.  (A map
-    of the rows, before 2026-12-07, had each worker load them after the longest chain: 1.0 s
-    of the quick comparison's 6.5 s on 2 workers, ad hoc.)"""
+    The rows stay tasks, although each worker's first one imports ArviZ (~2 s): 877275d
+    computed them in this process, importing ArviZ on a thread while the chains ran, and in a
+    report, whose sections run side by side on threads, that import crossed another's and
+    CPython handed one of them a half-imported ``dask.array`` (the comparison section failed
+    in about one ``report --quick`` of five)."""
 
     ex = executor or SerialExecutor()
     pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
     seeds = [chain_seed(settings.seed, c) for c in range(chains)]
     jobs = [(lik, dataclasses.replace(settings, seed=s)) for lik, _ in pairs for s in seeds]
-    with meanwhile(lambda: _load_rows([lik for lik, _ in pairs], chains), when=ex.kind != "serial"):
-        done = ex.map(_fit_one, jobs, tasks=len(jobs))
+    done = ex.map(_fit_one, jobs, tasks=len(jobs))
     per_fit = [done[i * chains : (i + 1) * chains] for i in range(len(pairs))]
-    rows = [_comparison_row(nm, f, settings.seed) for (_, nm), f in zip(pairs, per_fit, strict=True)]
+    rows = ex.map(
+        _row, [(nm, f, settings.seed) for (_, nm), f in zip(pairs, per_fit, strict=True)], tasks=len(pairs)
+    )
     out, start = [], 0
     for liks, _ in groups:
         part = slice(start, start + len(liks))

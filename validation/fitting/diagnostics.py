@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-__all__ = ["rhat", "chain_seed", "load"]
+__all__ = ["rhat", "chain_seed"]
 
 
 def chain_seed(seed: int, index: int) -> int:
@@ -21,11 +21,6 @@ def chain_seed(seed: int, index: int) -> int:
     if index == 0:
         return int(seed)
     return int(np.random.SeedSequence([int(seed), int(index)]).generate_state(1)[0])
-
-
-def load():
-    """Import ArviZ (about 2 s): :func:`rhat` does on its first call."""
-    import arviz  # noqa: F401
 
 
 def rhat(draws) -> float:

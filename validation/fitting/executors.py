@@ -33,7 +33,6 @@ import multiprocessing
 import os
 import pickle
 import signal
-import sys
 import threading
 import time
 
@@ -50,7 +49,6 @@ __all__ = [
     "make_executor",
     "check_scheduler_address",
     "default_workers",
-    "meanwhile",
 ]
 
 #: seconds :class:`DaskExecutor` waits for a scheduler given by address to answer: one deadline
@@ -186,32 +184,6 @@ def _sigint_between_calls():
         signal.signal(signal.SIGINT, signal.default_int_handler)
     if got:
         raise KeyboardInterrupt
-
-
-@contextlib.contextmanager
-def meanwhile(fn, when=True):
-    """Run ``fn()`` on a thread of this process while the block runs (``when`` true), and wait
-    for it at the block's end (not when the block raises).  For what the caller needs after a
-    map whose tasks run elsewhere (other processes, a cluster), loaded while this process
-    would only wait: its exceptions are left to the caller's own later use of the same
-    thing, which raises them where they belong."""
-    if not when:
-        yield
-        return
-    t = threading.Thread(target=_quietly, args=(fn,), name="scatterbench-meanwhile", daemon=True)
-    t.start()
-    yield  # an exception (Ctrl-C) leaves at once: the thread is a daemon
-    t.join()
-
-
-def _quietly(fn):
-    """``fn()`` at the lowest priority, so that it takes the cores the tasks leave idle (as
-    chains end) rather than time from a busy one; its exceptions left to the caller."""
-    if sys.platform == "linux":  # a thread's own nice value (elsewhere the id is no process's)
-        with contextlib.suppress(OSError):
-            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
-    with contextlib.suppress(Exception):
-        fn()
 
 
 class SerialExecutor:
