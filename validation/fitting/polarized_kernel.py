@@ -4,7 +4,8 @@ polarization and of circular polarization, their residuals and Gaussian log-dens
 per row in one pass.  The numpy form (:meth:`~.likelihood.Likelihood.predict`,
 :meth:`~.likelihood.Likelihood.residuals` and :meth:`~.likelihood.Likelihood._pointwise_rows`)
 makes a temporary array per quantity and operation; it is kept as the reference that the tests
-hold this to (``tests/test_fit.py``, 1e-12 relative per row).
+hold this to (``tests/test_polarized_kernel.py``: the same rows of ``-inf``, each finite row
+within 1e-12 of the sum of its terms' magnitudes).
 
 What differs from the reference, and why its last bits may:
 
@@ -17,8 +18,10 @@ What differs from the reference, and why its last bits may:
   polynomial within 2 ulp of the C library's that runs on SIMD lanes (the C library's call
   kept the loop scalar: 70 against 42 us for the call below), and the BRDF's logarithm the C
   library's, where numpy may use its own SIMD functions;
-- a row whose Stokes Q or U is not finite (a model's infinite Mueller element) has no angle
-  here, so its eta term is ``-inf`` (the reference takes the arctangent of the infinities).
+- :func:`~scatterbench.models.kernels.vector_math.atan2` takes finite arguments: a row whose
+  Stokes Q or U is infinite (a model's infinite Mueller element) may get another eta term
+  here, ``-inf`` where the polynomial gives NaN, than the reference's arctangent of the
+  infinities.  The tests compare finite Mueller elements.
 
 Each term is a loop over a walker's rows with no call and no branch inside, as in
 :mod:`.mueller_kernel`.  Measured (ad hoc, 2026-12-07, one thread, 12 walkers x 200 rows of
