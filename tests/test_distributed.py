@@ -3,6 +3,8 @@ stability sweep give the same results, in the same order, on a dask.distributed 
 (two worker processes, so everything crosses a process boundary pickled), on local
 processes and in-process."""
 
+import functools
+import importlib
 import json
 from dataclasses import dataclass
 
@@ -89,6 +91,19 @@ def test_local_workers_start_with_the_executor_and_import_the_fitting_machinery(
         assert ex.map(worker_probe.imported, [fit] * 2, tasks=2) == [True, True]
     with ProcessExecutor(1, preload=()) as ex:
         assert ex.map(worker_probe.imported, [fit]) == [False]
+
+
+def test_a_map_queues_its_after_tasks_behind_its_own_and_returns_its_own_results():
+    """``after`` tasks run on the workers behind the map's own chunks (one worker: the next
+    map's task finds what they loaded), and the map gives its own items' results alone."""
+    name = "tabnanny"  # a module nothing here imports
+    load = functools.partial(importlib.import_module, name)
+    with ProcessExecutor(1) as ex:
+        assert ex.map(worker_probe.imported, [name, name], tasks=2, after=(load, 2)) == [False, False]
+        assert ex.map(worker_probe.imported, [name]) == [True]
+    with ProcessExecutor(1) as ex:
+        assert ex.map(worker_probe.imported, [name]) == [False]
+        assert ex.map(worker_probe.imported, [name]) == [False]
 
 
 def test_local_workers_share_the_cores_among_their_threads(monkeypatch):

@@ -22,6 +22,7 @@ from scatterbench.models import scene as scene_mod
 
 from .datafile import load_data
 from .diagnostics import chain_seed, rhat
+from .diagnostics import load as load_diagnostics
 from .executors import SerialExecutor
 from .fit import FitResult, information_criteria, predictive, predictive_checks, run_fit
 from .fitspec import fitspec_from
@@ -153,17 +154,23 @@ def _compare_groups(groups, settings, executor, chains=1):
     fits' chains (so every worker has a chain to run), then one over their rows, regrouped in
     order.  Chain ``c`` of every fit is seeded :func:`chain_seed` ``(settings.seed, c)``.
 
-    The rows stay tasks, although each worker's first one imports ArviZ (~2 s): 877275d
-    computed them in this process, importing ArviZ on a thread while the chains ran, and in a
-    report, whose sections run side by side on threads, that import crossed another's and
-    CPython handed one of them a half-imported ``dask.array`` (the comparison section failed
-    in about one ``report --quick`` of five)."""
+    With several chains the rows need ArviZ (the between-chain R-hat), ~2 s for a worker to
+    import, then ~0.04 s a row: local workers load it as their chains end, one task per
+    worker queued behind the chains and not waited for (``after``), so that the rows, after
+    the longest chain, find it loaded.  (877275d computed the rows in this process instead,
+    importing ArviZ on a thread while the chains ran; in a report, whose sections run side by
+    side on threads, that import crossed another's and CPython handed one of them a
+    half-imported ``dask.array``: the comparison section failed in about one ``report
+    --quick`` of five.  Workers import on their own main thread.)"""
 
     ex = executor or SerialExecutor()
     pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
     seeds = [chain_seed(settings.seed, c) for c in range(chains)]
     jobs = [(lik, dataclasses.replace(settings, seed=s)) for lik, _ in pairs for s in seeds]
-    done = ex.map(_fit_one, jobs, tasks=len(jobs))
+    if chains > 1 and ex.kind != "serial":
+        done = ex.map(_fit_one, jobs, tasks=len(jobs), after=(load_diagnostics, ex.workers))
+    else:
+        done = ex.map(_fit_one, jobs, tasks=len(jobs))
     per_fit = [done[i * chains : (i + 1) * chains] for i in range(len(pairs))]
     rows = ex.map(
         _row, [(nm, f, settings.seed) for (_, nm), f in zip(pairs, per_fit, strict=True)], tasks=len(pairs)

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-__all__ = ["rhat", "chain_seed"]
+__all__ = ["rhat", "chain_seed", "load"]
 
 
 def chain_seed(seed: int, index: int) -> int:
@@ -21,6 +21,12 @@ def chain_seed(seed: int, index: int) -> int:
     if index == 0:
         return int(seed)
     return int(np.random.SeedSequence([int(seed), int(index)]).generate_state(1)[0])
+
+
+def load():
+    """Import ArviZ (about 2 s), which :func:`rhat` does on its first call: a task that
+    prepares a worker for the rows of a model comparison."""
+    import arviz  # noqa: F401
 
 
 def rhat(draws) -> float:

@@ -193,9 +193,9 @@ class SerialExecutor:
     #: sections at once: :func:`scatterbench.validation.report.build.side_by_side`)
     one_task_per_process = False
 
-    def map(self, fn, items, tasks=None):
+    def map(self, fn, items, tasks=None, after=None):
         """``[fn(x) for x in items]``; ``tasks`` (how many pieces the work is cut
-        into elsewhere) changes nothing in-process."""
+        into elsewhere) and ``after`` (:meth:`ProcessExecutor.map`) change nothing in-process."""
         out = []
         with _sigint_between_calls() as pending:
             for x in items:
@@ -237,8 +237,12 @@ class ProcessExecutor(SerialExecutor):
         for _ in range(self.workers):
             self._pool.submit(_started)
 
-    def map(self, fn, items, tasks=None):
-        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker)."""
+    def map(self, fn, items, tasks=None, after=None):
+        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker).
+
+        ``after``: ``(load, n)``, ``n`` calls of ``load()`` (a module-level function) queued
+        behind the chunks and not waited for: the workers whose chunks end first take them, and
+        so load, while the last chunks run, what a later map needs."""
         # The function (e.g. a likelihood holding the data) is pickled once per
         # distinct function object, not once per call; workers unpickle it once.
         # one lock: sections call map from threads at once (the last function is per executor)
@@ -250,6 +254,9 @@ class ProcessExecutor(SerialExecutor):
         futs = [
             self._pool.submit(_run_pickled_chunk, key, blob, c) for c in _chunks(items, tasks or self.workers)
         ]
+        load, n = after or (None, 0)
+        for _ in range(n):
+            self._pool.submit(load)  # its result, or error, is nobody's: the later map's own tells
         return [y for f in futs for y in f.result()]
 
     def close(self):
@@ -274,8 +281,10 @@ class DaskExecutor(SerialExecutor):
         self.one_task_per_process = bool(info) and all(w["nthreads"] == 1 for w in info.values())
         self._threads = _dask_kernel_threads(info, self.client.run(_local_cores) if info else {})
 
-    def map(self, fn, items, tasks=None):
-        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker)."""
+    def map(self, fn, items, tasks=None, after=None):
+        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker);
+        ``after`` is not queued here (a cluster's scheduler orders tasks by its own priorities):
+        a later map's tasks load what they need."""
         chunks = _chunks(items, tasks or self.workers)
         # pure=False: every call runs (no result caching across identical inputs)
         futs = [self.client.submit(_run_chunk_dask, fn, c, self._threads, pure=False) for c in chunks]
