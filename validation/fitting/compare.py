@@ -167,10 +167,8 @@ def _compare_groups(groups, settings, executor, chains=1):
     pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
     seeds = [chain_seed(settings.seed, c) for c in range(chains)]
     jobs = [(lik, dataclasses.replace(settings, seed=s)) for lik, _ in pairs for s in seeds]
-    if chains > 1 and ex.kind != "serial":
-        done = ex.map(_fit_one, jobs, tasks=len(jobs), after=(load_diagnostics, ex.workers))
-    else:
-        done = ex.map(_fit_one, jobs, tasks=len(jobs))
+    after = (load_diagnostics, ex.workers) if chains > 1 else None
+    done = ex.map(_fit_one, jobs, tasks=len(jobs), after=after)
     per_fit = [done[i * chains : (i + 1) * chains] for i in range(len(pairs))]
     rows = ex.map(
         _row, [(nm, f, settings.seed) for (_, nm), f in zip(pairs, per_fit, strict=True)], tasks=len(pairs)

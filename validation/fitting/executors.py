@@ -1,7 +1,8 @@
 """Executors: where likelihood evaluations and study members run.
 
-Every executor has ``map(fn, items, tasks=None) -> list`` (results in the
-order of ``items``, as emcee's ``pool`` expects) and ``close()``.  By default
+Every executor has ``map(fn, items, tasks=None, after=None) -> list`` (results in the
+order of ``items``, as emcee's ``pool`` expects; ``after``: loads queued behind the map's
+tasks, :meth:`ProcessExecutor.map`) and ``close()``.  By default
 the work is cut into one contiguous chunk per worker, so each call ships the
 function once per worker: right for many cheap calls (a log posterior over
 walkers).  Long, uneven calls (a study's members, the fits of a model

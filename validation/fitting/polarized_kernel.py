@@ -27,7 +27,7 @@ Each term is a loop over a walker's rows with no call and no branch inside, as i
 :mod:`.mueller_kernel`.  Measured (ad hoc, 2026-12-07, one thread, 12 walkers x 200 rows of
 seed 003's paint data): after the model's kernel, Maxwell-Beard with every term took 40 us
 here (53 us with this module's Python) against ~210 us of numpy, the BRDF alone 18 (23)
-against ~65 us.
+against ~70 us.
 """
 
 from __future__ import annotations
