@@ -4,8 +4,8 @@ stability sweep give the same results, in the same order, on a dask.distributed 
 processes and in-process."""
 
 import functools
-import importlib
 import json
+import time
 from dataclasses import dataclass
 
 import command_files
@@ -93,17 +93,28 @@ def test_local_workers_start_with_the_executor_and_import_the_fitting_machinery(
         assert ex.map(worker_probe.imported, [fit]) == [False]
 
 
-def test_a_map_queues_its_after_tasks_behind_its_own_and_returns_its_own_results():
-    """``after`` tasks run on the workers behind the map's own chunks (one worker: the next
-    map's task finds what they loaded), and the map gives its own items' results alone."""
-    name = "tabnanny"  # a module nothing here imports
-    load = functools.partial(importlib.import_module, name)
-    with ProcessExecutor(1) as ex:
-        assert ex.map(worker_probe.imported, [name, name], tasks=2, after=(load, 2)) == [False, False]
-        assert ex.map(worker_probe.imported, [name]) == [True]
-    with ProcessExecutor(1) as ex:
-        assert ex.map(worker_probe.imported, [name]) == [False]
-        assert ex.map(worker_probe.imported, [name]) == [False]
+def _stamped(seconds):
+    """A task: sleeps ``seconds``, then returns the time it ends."""
+    time.sleep(seconds)
+    return time.time()
+
+
+def test_a_map_runs_meanwhile_here_while_its_tasks_run(cluster):
+    """``meanwhile`` runs once in the calling thread after the tasks are sent, before they end
+    (local processes, a cluster), and the map returns the tasks' results alone; in-process it
+    runs before the items.  What it raises propagates once the tasks have ended."""
+    with ProcessExecutor(1) as local:
+        for ex in (local, cluster):
+            ran = []
+            ends = ex.map(_stamped, [0.5], meanwhile=lambda ran=ran: ran.append(time.time()))
+            assert len(ran) == 1 and len(ends) == 1 and ran[0] < ends[0]
+            t = time.time()
+            with pytest.raises(ValueError, match="meanwhile"):
+                ex.map(_stamped, [0.5], meanwhile=functools.partial(int, "meanwhile"))
+            assert time.time() - t >= 0.5  # the task was waited for
+    order = []
+    SerialExecutor().map(order.append, ["item"], meanwhile=lambda: order.append("meanwhile"))
+    assert order == ["meanwhile", "item"]
 
 
 def test_local_workers_share_the_cores_among_their_threads(monkeypatch):

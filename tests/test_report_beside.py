@@ -5,6 +5,7 @@ another, and every section is rendered in page order on the calling thread.
 Equal results on every executor are ``tests/test_report_executors.py``'s (its subset, the
 seed 003 presets and the stability sweep, are both ``beside``)."""
 
+import sys
 import threading
 import time
 
@@ -91,6 +92,37 @@ def test_a_beside_section_that_raises_fails_alone(monkeypatch):
     assert results["sections"]["good"]["numbers"] == {"data": 1.0}
     assert [c["id"] for c in results["checks"]] == ["report.section_bad"]
     assert log == [("good", True), ("after", True)]
+
+
+def test_what_sections_import_on_first_use_is_imported_on_the_main_thread_first(monkeypatch, tmp_path):
+    """A section's ``preloads`` are imported before the sections' threads start, on the
+    report's main thread (an import on a section's thread can cross another's), once."""
+    (tmp_path / "preload_probe.py").write_text(
+        "import threading\nTHREADS = [threading.current_thread().name]\n", encoding="utf-8"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "preload_probe", raising=False)
+    compute, seen = _meeting(2)
+
+    def computed_after_the_import(ctx):
+        compute(ctx)
+        return list(sys.modules["preload_probe"].THREADS)  # KeyError if not imported yet
+
+    specs = [
+        SectionSpec(
+            f"s{i}",
+            f"S{i}",
+            computed_after_the_import,
+            _rendering([]),
+            beside=True,
+            preloads=("preload_probe",),
+        )
+        for i in range(2)
+    ]
+    results = _report(monkeypatch, specs, Workers())
+    assert [s["error"] for s in results["sections"].values()] == [None] * 4
+    assert len(set(seen)) == 2 and all(name.startswith("scatterbench-section") for name in seen)
+    assert sys.modules["preload_probe"].THREADS == ["MainThread"]
 
 
 def test_the_dask_executor_says_whether_its_workers_run_one_task_at_a_time():

@@ -33,9 +33,9 @@ class Spy(SerialExecutor):
     def __init__(self):
         self.tasks = []
 
-    def map(self, fn, items, tasks=None, after=None):
+    def map(self, fn, items, tasks=None, meanwhile=None):
         self.tasks.append(tasks)
-        return super().map(fn, items, tasks, after)
+        return super().map(fn, items, tasks, meanwhile)
 
 
 # ----------------------------------------------------------------------------- the flags

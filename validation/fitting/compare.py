@@ -99,7 +99,7 @@ def _medians(fit):
 def _comparison_row(name, fits, seed):
     """One scene's row from its independent chains ``fits`` (one or more): the maximum ln L
     over them all, WAIC, predictive coverage and medians of their pooled samples, their worst
-    tau, mean acceptance and, with several chains, the between-chain R-hat."""
+    tau and mean acceptance (the between-chain R-hat: :func:`_with_rhat`)."""
     pooled = _pooled(fits)
     best = max(fits, key=lambda f: information_criteria(f)["max_log_likelihood"])
     row = {
@@ -118,10 +118,18 @@ def _comparison_row(name, fits, seed):
     }
     row["converged_chains"] = sum(bool(f.chain.converged) for f in fits)
     if len(fits) > 1:
-        rh = _between_chains(fits)
         row["stop_reason"] = (
             f"{row['converged_chains']} of {len(fits)} chains converged (N >= tau_factor tau)"
         )
+    return row
+
+
+def _with_rhat(row, fits):
+    """``row`` (:func:`_comparison_row` of ``fits``) with, for several chains, their number, the
+    between-chain R-hat per parameter and its largest: computed where the rows are gathered,
+    which has ArviZ loaded (:func:`_compare_groups`)."""
+    if len(fits) > 1:
+        rh = _between_chains(fits)
         row.update(chains=len(fits), rhat=rh, rhat_max=max(rh.values()))
     return row
 
@@ -154,25 +162,28 @@ def _compare_groups(groups, settings, executor, chains=1):
     fits' chains (so every worker has a chain to run), then one over their rows, regrouped in
     order.  Chain ``c`` of every fit is seeded :func:`chain_seed` ``(settings.seed, c)``.
 
-    With several chains the rows need ArviZ (the between-chain R-hat), ~2 s for a worker to
-    import, then ~0.04 s a row: local workers load it as their chains end, one task per
-    worker queued behind the chains and not waited for (``after``), so that the rows, after
-    the longest chain, find it loaded.  (877275d computed the rows in this process instead,
-    importing ArviZ on a thread while the chains ran; in a report, whose sections run side by
-    side on threads, that import crossed another's and CPython handed one of them a
-    half-imported ``dask.array``: the comparison section failed in about one ``report
-    --quick`` of five.  Workers import on their own main thread.)"""
+    With several chains the between-chain R-hat needs ArviZ (~2 s to import), which this
+    process loads while the chains run (``meanwhile``) and uses once their rows are back
+    (:func:`_with_rhat`, ~0.04 s a row); the rows (WAIC and predictive draws, ~0.3 s each) are
+    tasks and need no ArviZ.  Before, the rows computed the R-hat on the workers, each of which
+    then imported ArviZ, queued behind the chains: with 16 workers (on 2 cores, ad hoc) one row
+    in eight still landed on a worker that had not, where it would cost ~2 s after the longest
+    chain.  In a report this runs on a section's
+    thread, where ArviZ is already imported (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`):
+    an import on a thread beside other sections' can cross theirs (877275d, reverted: CPython
+    handed one a half-imported ``dask.array``).
+    """
 
     ex = executor or SerialExecutor()
     pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
     seeds = [chain_seed(settings.seed, c) for c in range(chains)]
     jobs = [(lik, dataclasses.replace(settings, seed=s)) for lik, _ in pairs for s in seeds]
-    after = (load_diagnostics, ex.workers) if chains > 1 else None
-    done = ex.map(_fit_one, jobs, tasks=len(jobs), after=after)
+    done = ex.map(_fit_one, jobs, tasks=len(jobs), meanwhile=load_diagnostics if chains > 1 else None)
     per_fit = [done[i * chains : (i + 1) * chains] for i in range(len(pairs))]
     rows = ex.map(
         _row, [(nm, f, settings.seed) for (_, nm), f in zip(pairs, per_fit, strict=True)], tasks=len(pairs)
     )
+    rows = [_with_rhat(row, f) for row, f in zip(rows, per_fit, strict=True)]
     out, start = [], 0
     for liks, _ in groups:
         part = slice(start, start + len(liks))

@@ -1,8 +1,8 @@
 """Executors: where likelihood evaluations and study members run.
 
-Every executor has ``map(fn, items, tasks=None, after=None) -> list`` (results in the
-order of ``items``, as emcee's ``pool`` expects; ``after``: loads queued behind the map's
-tasks, :meth:`ProcessExecutor.map`) and ``close()``.  By default
+Every executor has ``map(fn, items, tasks=None, meanwhile=None) -> list`` (results in the
+order of ``items``, as emcee's ``pool`` expects; ``meanwhile``: this process's own work done
+while the tasks run, :meth:`SerialExecutor.map`) and ``close()``.  By default
 the work is cut into one contiguous chunk per worker, so each call ships the
 function once per worker: right for many cheap calls (a log posterior over
 walkers).  Long, uneven calls (a study's members, the fits of a model
@@ -187,6 +187,21 @@ def _sigint_between_calls():
         raise KeyboardInterrupt
 
 
+def _gathered(futs, meanwhile, gather):
+    """``gather()`` of submitted ``futs`` after running ``meanwhile`` (if any) in this thread; if
+    ``meanwhile`` raises, the tasks are still waited for (none is left running behind the
+    caller's back) before its error propagates."""
+    try:
+        if meanwhile is not None:
+            meanwhile()
+    except BaseException:
+        for f in futs:
+            with contextlib.suppress(BaseException):
+                f.result()
+        raise
+    return gather()
+
+
 class SerialExecutor:
     workers = 1
     kind = "serial"
@@ -194,9 +209,17 @@ class SerialExecutor:
     #: sections at once: :func:`scatterbench.validation.report.build.side_by_side`)
     one_task_per_process = False
 
-    def map(self, fn, items, tasks=None, after=None):
-        """``[fn(x) for x in items]``; ``tasks`` (how many pieces the work is cut
-        into elsewhere) and ``after`` (:meth:`ProcessExecutor.map`) change nothing in-process."""
+    def map(self, fn, items, tasks=None, meanwhile=None):
+        """``[fn(x) for x in items]``; ``tasks`` (how many pieces the work is cut into
+        elsewhere) changes nothing in-process.
+
+        ``meanwhile``: a callable of no arguments that the calling thread runs once (here before
+        the items; elsewhere while the tasks run, before it waits for them): work of this
+        process that it needs after the map, such as importing what will read the results.
+        What it returns is dropped; what it raises propagates (from local processes or a
+        cluster, once the tasks have ended)."""
+        if meanwhile is not None:
+            meanwhile()
         out = []
         with _sigint_between_calls() as pending:
             for x in items:
@@ -238,12 +261,9 @@ class ProcessExecutor(SerialExecutor):
         for _ in range(self.workers):
             self._pool.submit(_started)
 
-    def map(self, fn, items, tasks=None, after=None):
-        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker).
-
-        ``after``: ``(load, n)``, ``n`` calls of ``load()`` (a module-level function) queued
-        behind the chunks and not waited for: the workers whose chunks end first take them, and
-        so load, while the last chunks run, what a later map needs."""
+    def map(self, fn, items, tasks=None, meanwhile=None):
+        """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker);
+        ``meanwhile`` (:meth:`SerialExecutor.map`) runs here while they run."""
         # The function (e.g. a likelihood holding the data) is pickled once per
         # distinct function object, not once per call; workers unpickle it once.
         # one lock: sections call map from threads at once (the last function is per executor)
@@ -255,10 +275,7 @@ class ProcessExecutor(SerialExecutor):
         futs = [
             self._pool.submit(_run_pickled_chunk, key, blob, c) for c in _chunks(items, tasks or self.workers)
         ]
-        load, n = after or (None, 0)
-        for _ in range(n):
-            self._pool.submit(load)  # its result, or error, is nobody's: the later map's own tells
-        return [y for f in futs for y in f.result()]
+        return _gathered(futs, meanwhile, lambda: [y for f in futs for y in f.result()])
 
     def close(self):
         self._pool.shutdown(wait=True, cancel_futures=True)
@@ -282,14 +299,13 @@ class DaskExecutor(SerialExecutor):
         self.one_task_per_process = bool(info) and all(w["nthreads"] == 1 for w in info.values())
         self._threads = _dask_kernel_threads(info, self.client.run(_local_cores) if info else {})
 
-    def map(self, fn, items, tasks=None, after=None):
+    def map(self, fn, items, tasks=None, meanwhile=None):
         """``fn`` over ``items`` in ``tasks`` contiguous chunks (default: one per worker);
-        ``after`` is not queued here (a cluster's scheduler orders tasks by its own priorities):
-        a later map's tasks load what they need."""
+        ``meanwhile`` (:meth:`SerialExecutor.map`) runs here while they run."""
         chunks = _chunks(items, tasks or self.workers)
         # pure=False: every call runs (no result caching across identical inputs)
         futs = [self.client.submit(_run_chunk_dask, fn, c, self._threads, pure=False) for c in chunks]
-        return [y for part in self.client.gather(futs) for y in part]
+        return _gathered(futs, meanwhile, lambda: [y for part in self.client.gather(futs) for y in part])
 
     def close(self):
         if self._own:

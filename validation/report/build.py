@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextvars
 import datetime
+import importlib
 import json
 import os
 import sys
@@ -195,13 +196,12 @@ def warm_group(group):
 
 
 def compile_ahead(executor):
-    """Compile the loops a report runs that numba's cache lacks on ``executor``'s local
+    """Start compiling the loops a report runs that numba's cache lacks on ``executor``'s local
     worker processes, a different group of them (:data:`COMPILE_GROUPS`) on each at once, before
     the sections need them: otherwise every process compiled each loop it reached, the workers
-    the same ones at the same time.  Nothing for one process or a Dask cluster."""
-    todo = _cold_groups(executor, COMPILE_GROUPS)
-    if todo:
-        executor.map(warm_group, todo, tasks=len(todo))
+    the same ones at the same time.  Returns the future of that (its result raises what a
+    compile raised), or ``None``: nothing to compile, one process, a Dask cluster."""
+    return _in_background(executor, _cold_groups(executor, COMPILE_GROUPS))
 
 
 def compile_later(executor, specs):
@@ -212,14 +212,30 @@ def compile_later(executor, specs):
     the workers are idle; ahead of all sections those loops took every core's time (the float32
     facet: 3.6 s of CPU, ``benchmarks/scaling.py --compile``).  A section with such loops waits
     for the future, so that it loads them rather than compiling them again."""
-    todo = _cold_groups(executor, [spec.compiles for spec in specs if spec.compiles])
-    if not todo:
+    return _in_background(
+        executor, _cold_groups(executor, [spec.compiles for spec in specs if spec.compiles])
+    )
+
+
+def _in_background(executor, groups):
+    """The future of ``executor.map(warm_group, groups)``, run from a thread of its own so that
+    this one goes on; ``None`` when ``groups`` is empty."""
+    if not groups:
         return None
     pool = ThreadPoolExecutor(1, thread_name_prefix="scatterbench-compile")
     try:
-        return pool.submit(executor.map, warm_group, todo, tasks=len(todo))
+        return pool.submit(executor.map, warm_group, groups, tasks=len(groups))
     finally:
         pool.shutdown(wait=False)  # the thread ends with its one task
+
+
+def preload(specs):
+    """Import, on this thread (a report's main thread), what the sections of ``specs`` import on
+    first use (:attr:`~.core.SectionSpec.preloads`), before their threads start: an import on
+    a section's thread beside other sections' imports can cross theirs (877275d: CPython handed
+    one a half-imported ``dask.array`` in about one ``report --quick`` of five)."""
+    for name in dict.fromkeys(m for spec in specs for m in spec.preloads):
+        importlib.import_module(name)
 
 
 def every_compile_group() -> tuple:
@@ -270,9 +286,13 @@ def build_report(
     if checks is not None:
         ctx.cache["check_specs"] = select(checks)
     t0 = time.perf_counter()  # a first run's compilation counts in the report's time
-    compile_ahead(ctx.executor)
     wanted = None if only is None else set(only) | {"summary", "provenance"}
-    sections = _run_sections(ctx, [sp for sp in SECTIONS if wanted is None or sp.id in wanted])
+    specs = [sp for sp in SECTIONS if wanted is None or sp.id in wanted]
+    compiling = compile_ahead(ctx.executor)
+    preload(specs)  # while the workers compile, if they do
+    if compiling is not None:
+        compiling.result()
+    sections = _run_sections(ctx, specs)
     # every check is counted even if the summary section itself failed to draw them
     checks = report_checks(ctx) + ctx.cache["section_failures"]
     summary = tally(checks)

@@ -84,6 +84,9 @@ class SectionSpec:
     section uses, one that is not ``beside``: a first run compiles them on a worker while this
     process computes the sections before it (:func:`~.build.compile_later`), not ahead of all
     sections, when every core is compiling.
+
+    ``preloads``: modules the section's compute imports on first use (ArviZ): a report imports
+    them on its main thread before the sections' threads start (:func:`~.build.preload`).
     """
 
     id: str
@@ -93,6 +96,7 @@ class SectionSpec:
     stage: int = 0
     beside: bool = False
     compiles: tuple = ()
+    preloads: tuple = ()
 
 
 def _clean(v):

@@ -33,8 +33,8 @@ from .summary import report_checks
 __all__ = ["SECTIONS", "report_checks"]
 
 
-def _spec(sid, title, module, stage=0, beside=False, compiles=()):
-    return SectionSpec(sid, title, module.compute, module.render, stage, beside, compiles)
+def _spec(sid, title, module, stage=0, beside=False, compiles=(), preloads=()):
+    return SectionSpec(sid, title, module.compute, module.render, stage, beside, compiles, preloads)
 
 
 #: the page, in order; the summary runs last (it shows every check and every section that
@@ -62,9 +62,14 @@ SECTIONS = (
         "Model comparison: seed 003's combination against Maxwell-Beard",
         model_comparison,
         beside=True,
+        preloads=("arviz",),  # the between-chain R-hat
     ),
     _spec(
-        "ptfe", "Real data: NIST's sintered PTFE, five models compared and cross-validated", ptfe, beside=True
+        "ptfe",
+        "Real data: NIST's sintered PTFE, five models compared and cross-validated",
+        ptfe,
+        beside=True,
+        preloads=("arviz",),  # PSIS-LOO, WAIC and their comparison
     ),
     # the float32 facet: only the trade-off study's precision knob runs it (the loops the beside
     # sections run, recorded at their first call in one process: ad hoc, 2026-12-06)
