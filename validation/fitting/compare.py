@@ -164,15 +164,14 @@ def _compare_groups(groups, settings, executor, chains=1):
 
     With several chains the between-chain R-hat needs ArviZ (~2 s to import), which this
     process loads while the chains run (``meanwhile``) and uses once their rows are back
-    (:func:`_with_rhat`, ~0.04 s a row); the rows (WAIC and predictive draws, ~0.3 s each) are
-    tasks and need no ArviZ.  Before, the rows computed the R-hat on the workers, each of which
-    then imported ArviZ, queued behind the chains: with 16 workers (on 2 cores, ad hoc) one row
-    in eight still landed on a worker that had not, where it would cost ~2 s after the longest
-    chain.  In a report this runs on a section's
-    thread, where ArviZ is already imported (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`):
-    an import on a thread beside other sections' can cross theirs (877275d, reverted: CPython
-    handed one a half-imported ``dask.array``).
-    """
+    (:func:`_with_rhat`, ~3 ms a parameter); the rows (WAIC, predictive draws) are tasks and
+    need no ArviZ.  Before, the rows computed the R-hat on the workers, which imported ArviZ
+    from tasks queued behind the chains: with 16 workers (on 2 cores, ad hoc) one row in eight
+    still landed on a worker that had not, where it costs ~2 s after the longest chain.  In a
+    report this runs on a section's thread, where ArviZ is already imported
+    (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`): an import on a thread
+    beside other sections' can cross theirs (877275d, reverted: CPython handed one a
+    half-imported ``dask.array``)."""
 
     ex = executor or SerialExecutor()
     pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
