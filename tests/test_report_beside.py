@@ -5,6 +5,7 @@ another, and every section is rendered in page order on the calling thread.
 Equal results on every executor are ``tests/test_report_executors.py``'s (its subset, the
 seed 003 presets and the stability sweep, are both ``beside``)."""
 
+import importlib
 import sys
 import threading
 import time
@@ -123,6 +124,24 @@ def test_what_sections_import_on_first_use_is_imported_on_the_main_thread_first(
     assert [s["error"] for s in results["sections"].values()] == [None] * 4
     assert len(set(seen)) == 2 and all(name.startswith("scatterbench-section") for name in seen)
     assert sys.modules["preload_probe"].THREADS == ["MainThread"]
+
+
+def test_a_preload_that_fails_to_import_fails_its_sections_alone(monkeypatch, tmp_path):
+    """A module in ``preloads`` that raises on import does not stop the report: the sections
+    that import it fail with its error, the others are computed."""
+    (tmp_path / "broken_probe.py").write_text("raise RuntimeError('broken on import')\n", encoding="utf-8")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    specs = [
+        SectionSpec(
+            "needs", "Needs", lambda ctx: importlib.import_module("broken_probe"), _rendering([]), beside=True,
+            preloads=("broken_probe",),
+        ),
+        SectionSpec("other", "Other", lambda ctx: 1, _rendering([]), beside=True),
+    ]  # fmt: skip
+    results = _report(monkeypatch, specs, Workers())
+    assert results["sections"]["needs"]["error"] == "RuntimeError: broken on import"
+    assert results["sections"]["other"]["error"] is None
+    assert [c["id"] for c in results["checks"]] == ["report.section_needs"]
 
 
 def test_the_dask_executor_says_whether_its_workers_run_one_task_at_a_time():
