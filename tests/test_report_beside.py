@@ -5,6 +5,7 @@ another, and every section is rendered in page order on the calling thread.
 Equal results on every executor are ``tests/test_report_executors.py``'s (its subset, the
 seed 003 presets and the stability sweep, are both ``beside``)."""
 
+import functools
 import importlib
 import sys
 import threading
@@ -96,14 +97,19 @@ def test_a_beside_section_that_raises_fails_alone(monkeypatch):
 
 
 def test_what_sections_import_on_first_use_is_imported_on_the_main_thread_first(monkeypatch, tmp_path):
-    """A section's ``preloads`` are imported before the sections' threads start, on the
-    report's main thread (an import on a section's thread can cross another's), once."""
+    """A section's ``preloads`` run before the sections' threads start, on the report's main
+    thread (an import on a section's thread can cross another's), once each."""
     (tmp_path / "preload_probe.py").write_text(
         "import threading\nTHREADS = [threading.current_thread().name]\n", encoding="utf-8"
     )
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.delitem(sys.modules, "preload_probe", raising=False)
     compute, seen = _meeting(2)
+    calls = []
+
+    def load():
+        calls.append(threading.current_thread().name)
+        importlib.import_module("preload_probe")
 
     def computed_after_the_import(ctx):
         compute(ctx)
@@ -116,25 +122,25 @@ def test_what_sections_import_on_first_use_is_imported_on_the_main_thread_first(
             computed_after_the_import,
             _rendering([]),
             beside=True,
-            preloads=("preload_probe",),
+            preloads=(load,),
         )
         for i in range(2)
     ]
     results = _report(monkeypatch, specs, Workers())
     assert [s["error"] for s in results["sections"].values()] == [None] * 4
     assert len(set(seen)) == 2 and all(name.startswith("scatterbench-section") for name in seen)
-    assert sys.modules["preload_probe"].THREADS == ["MainThread"]
+    assert sys.modules["preload_probe"].THREADS == calls == ["MainThread"]  # once, shared
 
 
 def test_a_preload_that_fails_to_import_fails_its_sections_alone(monkeypatch, tmp_path):
-    """A module in ``preloads`` that raises on import does not stop the report: the sections
-    that import it fail with its error, the others are computed."""
+    """A preload that raises (an import that fails) does not stop the report: the sections that
+    import the module fail with its error, the others are computed."""
     (tmp_path / "broken_probe.py").write_text("raise RuntimeError('broken on import')\n", encoding="utf-8")
     monkeypatch.syspath_prepend(str(tmp_path))
     specs = [
         SectionSpec(
             "needs", "Needs", lambda ctx: importlib.import_module("broken_probe"), _rendering([]), beside=True,
-            preloads=("broken_probe",),
+            preloads=(functools.partial(importlib.import_module, "broken_probe"),),
         ),
         SectionSpec("other", "Other", lambda ctx: 1, _rendering([]), beside=True),
     ]  # fmt: skip

@@ -7,6 +7,7 @@ too).  Chains agree to within their sampling error below about 1.01.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -23,10 +24,26 @@ def chain_seed(seed: int, index: int) -> int:
     return int(np.random.SeedSequence([int(seed), int(index)]).generate_state(1)[0])
 
 
+@functools.cache
 def load():
-    """Import ArviZ (about 2 s), which :func:`rhat` does on its first call: a task that
-    prepares a worker for the rows of a model comparison."""
-    import arviz  # noqa: F401
+    """Import ArviZ (about 2 s) and run it once on a tiny posterior (~0.15 s): what the
+    comparison's R-hat and the PTFE study need, loaded where they will run.  ArviZ's first
+    InferenceData makes xarray import ~140 more modules (``dask.array``, the chunk managers'
+    entry points, ``psutil``...; ad hoc, 2026-12-07), so a report runs this on its main thread
+    before its sections' threads start (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`):
+    imports on threads side by side can cross (877275d: a half-imported ``dask.array``).  Once
+    per process."""
+    import warnings
+
+    import arviz
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a posterior of four draws: its diagnostics warn
+        draws = np.arange(8.0).reshape(2, 4)
+        idata = arviz.from_dict(posterior={"x": draws}, log_likelihood={"y": draws[..., None]})
+        arviz.loo(idata)
+        arviz.waic(idata)
+        arviz.rhat(draws, method="rank")
 
 
 def rhat(draws) -> float:

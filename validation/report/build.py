@@ -5,7 +5,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import datetime
-import importlib
 import json
 import os
 import sys
@@ -231,15 +230,15 @@ def _in_background(executor, groups):
 
 
 def preload(specs):
-    """Import, on this thread (a report's main thread), what the sections of ``specs`` import on
-    first use (:attr:`~.core.SectionSpec.preloads`), before their threads start: an import on
-    a section's thread beside other sections' imports can cross theirs (877275d: CPython handed
-    one a half-imported ``dask.array`` in about one ``report --quick`` of five).  A module that
-    fails to import is left to the sections that import it, which then fail alone (with its
-    error), as a broken section must not lose the rest of the report."""
-    for name in dict.fromkeys(m for spec in specs for m in spec.preloads):
+    """Run, on this thread (a report's main thread), what the sections of ``specs`` need imported
+    (:attr:`~.core.SectionSpec.preloads`, each once), before their threads start: an import on a
+    section's thread beside other sections' imports can cross theirs (877275d: CPython handed
+    one a half-imported ``dask.array`` in about one ``report --quick`` of five).  A preload that
+    raises is left to the sections that import what it imports, which then fail alone (with
+    its error), as a broken section must not lose the rest of the report."""
+    for load in dict.fromkeys(fn for spec in specs for fn in spec.preloads):
         with contextlib.suppress(Exception):
-            importlib.import_module(name)
+            load()
 
 
 def every_compile_group() -> tuple:

@@ -85,8 +85,9 @@ class SectionSpec:
     process computes the sections before it (:func:`~.build.compile_later`), not ahead of all
     sections, when every core is compiling.
 
-    ``preloads``: modules the section's compute imports on first use (ArviZ): a report imports
-    them on its main thread before the sections' threads start (:func:`~.build.preload`).
+    ``preloads``: callables of no arguments that import what the section's compute imports on
+    first use (ArviZ, and what xarray imports at its first dataset): a report runs them on its
+    main thread before the sections' threads start (:func:`~.build.preload`).
     """
 
     id: str

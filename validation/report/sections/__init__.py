@@ -8,6 +8,8 @@ draws and tabulates from it.
 
 from __future__ import annotations
 
+from scatterbench.validation.fitting import diagnostics
+
 from ..core import SectionSpec
 from . import (
     conservation,
@@ -62,14 +64,14 @@ SECTIONS = (
         "Model comparison: seed 003's combination against Maxwell-Beard",
         model_comparison,
         beside=True,
-        preloads=("arviz",),  # the between-chain R-hat
+        preloads=(diagnostics.load,),  # ArviZ: the between-chain R-hat
     ),
     _spec(
         "ptfe",
         "Real data: NIST's sintered PTFE, five models compared and cross-validated",
         ptfe,
         beside=True,
-        preloads=("arviz",),  # PSIS-LOO, WAIC and their comparison
+        preloads=(diagnostics.load,),  # ArviZ: PSIS-LOO, WAIC and their comparison
     ),
     # the float32 facet: only the trade-off study's precision knob runs it (the loops the beside
     # sections run, recorded at their first call in one process: ad hoc, 2026-12-06)
