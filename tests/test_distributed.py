@@ -99,10 +99,15 @@ def _stamped(seconds):
     return time.time()
 
 
+def _interrupt():
+    raise KeyboardInterrupt
+
+
 def test_a_map_runs_meanwhile_here_while_its_tasks_run(cluster):
     """``meanwhile`` runs once in the calling thread after the tasks are sent, before they end
     (local processes, a cluster), and the map returns the tasks' results alone; in-process it
-    runs before the items.  What it raises propagates once the tasks have ended."""
+    runs before the items.  An error it raises propagates once the tasks have ended, an
+    interrupt at once."""
     with ProcessExecutor(1) as local:
         for ex in (local, cluster):
             ran = []
@@ -112,6 +117,10 @@ def test_a_map_runs_meanwhile_here_while_its_tasks_run(cluster):
             with pytest.raises(ValueError, match="meanwhile"):
                 ex.map(_stamped, [0.5], meanwhile=functools.partial(int, "meanwhile"))
             assert time.time() - t >= 0.5  # the task was waited for
+        t = time.time()
+        with pytest.raises(KeyboardInterrupt):
+            local.map(_stamped, [2.0], meanwhile=_interrupt)
+        assert time.time() - t < 1.5  # an interrupt is not held back by the task
     order = []
     SerialExecutor().map(order.append, ["item"], meanwhile=lambda: order.append("meanwhile"))
     assert order == ["meanwhile", "item"]

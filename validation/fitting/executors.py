@@ -189,12 +189,13 @@ def _sigint_between_calls():
 
 def _gathered(futs, meanwhile, gather):
     """``gather()`` of submitted ``futs`` after running ``meanwhile`` (if any) in this thread; if
-    ``meanwhile`` raises, the tasks are still waited for (none is left running behind the
-    caller's back) before its error propagates."""
+    ``meanwhile`` raises an error, the tasks are still waited for (none is left running behind
+    the caller's back) before it propagates.  An interrupt (Ctrl-C) propagates at once, as it
+    does from the wait itself: the executor's ``close`` cancels what has not started."""
     try:
         if meanwhile is not None:
             meanwhile()
-    except BaseException:
+    except Exception:
         for f in futs:
             with contextlib.suppress(BaseException):
                 f.result()
