@@ -2,6 +2,7 @@
 model's derived tolerance: :mod:`scatterbench.models.kernel_tolerance`), model sets, the
 small-call path, float32, and the cache location."""
 
+import contextlib
 import math
 import os
 import subprocess
@@ -520,3 +521,33 @@ def test_a_long_evaluation_is_one_kernel_call_with_the_chunks_bits(monkeypatch):
     for a in range(0, n, evaluation.KERNEL_CHUNK):
         b = min(a + evaluation.KERNEL_CHUNK, n)
         np.testing.assert_array_equal(whole[:, a:b], m.mueller16(0.3, tr[a:b], pr[a:b])[1])
+
+
+def test_r_bar_integrand_first_uses_on_threads_restore_numba_s_cache_folder(monkeypatch):
+    """Two threads' first calls of :func:`kernels.rbar_integrand` at once leave numba's
+    ``config.CACHE_DIR`` as it was (the report's sections run on threads): each switches it
+    for its import, one at a time.  Fails without the lock: the second saves the first's
+    setting and restores it last."""
+    import threading
+
+    from numba.core import config
+
+    from scatterbench.models import kernels
+
+    switch = kernels._caching_in
+
+    @contextlib.contextmanager
+    def slow(path):
+        with switch(path):
+            time.sleep(0.2)  # the other thread's call starts meanwhile
+            yield
+
+    monkeypatch.setattr(kernels, "_caching_in", slow)
+    monkeypatch.setattr(config, "CACHE_DIR", "users-own")
+    threads = [threading.Thread(target=kernels.rbar_integrand) for _ in range(2)]
+    for t in threads:
+        t.start()
+        time.sleep(0.05)
+    for t in threads:
+        t.join()
+    assert config.CACHE_DIR == "users-own"

@@ -79,6 +79,7 @@ import logging
 import math
 import os
 import tempfile
+import threading
 
 import numpy as np
 
@@ -154,11 +155,17 @@ with _caching_in(cache_dir()):
     from . import aperture, disc, drive, montecarlo, rough, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
+#: one first use at a time: two threads' :func:`_caching_in` side by side could restore numba's
+#: cache folder in the wrong order and leave it on ours for the rest of the process (the report's
+#: sections run on threads, and ``_low_level``'s cache does not hold a second caller back)
+_RBAR_LOCK = threading.Lock()
+
+
 def rbar_integrand():
     """R-bar's compiled integrand (:mod:`~scatterbench.models.kernels.rbar`, a ``cfunc``), imported
     on first use: a ``cfunc`` compiles (or loads from the cache) when decorated, and only models
     with a smooth interface need it.  Imported here, so that it caches with the kernels."""
-    with _caching_in(cache_dir()):
+    with _RBAR_LOCK, _caching_in(cache_dir()):
         from . import rbar
     return rbar.integrand
 
