@@ -7,6 +7,7 @@ import math
 import os
 import subprocess
 import sys
+import threading
 import time
 
 import numba
@@ -526,10 +527,8 @@ def test_a_long_evaluation_is_one_kernel_call_with_the_chunks_bits(monkeypatch):
 def test_r_bar_integrand_first_uses_on_threads_restore_numba_s_cache_folder(monkeypatch):
     """Two threads' first calls of :func:`kernels.rbar_integrand` at once leave numba's
     ``config.CACHE_DIR`` as it was (the report's sections run on threads): each switches it
-    for its import, one at a time.  Fails without the lock: the second saves the first's
-    setting and restores it last."""
-    import threading
-
+    for its import, one at a time (:func:`kernels._caching_in`'s lock).  Fails without the lock:
+    the second saves the first's setting and restores it last."""
     from numba.core import config
 
     from scatterbench.models import kernels

@@ -135,17 +135,25 @@ def cache_dir() -> str:
     return ""  # nowhere writable: compile in every process
 
 
+#: one switch of numba's cache folder at a time: two threads' side by side could restore it in
+#: the wrong order and leave it on ours for the rest of the process (the report's sections run
+#: on threads, and R-bar's integrand, :func:`rbar_integrand`, is imported on first use)
+_CACHING_LOCK = threading.RLock()
+
+
 @contextlib.contextmanager
 def _caching_in(path):
-    """numba's cache locator reads ``config.CACHE_DIR`` when a function is decorated."""
+    """numba's cache locator reads ``config.CACHE_DIR`` when a function is decorated: set to
+    ``path`` for the block, one thread at a time (:data:`_CACHING_LOCK`)."""
     from numba.core import config
 
-    old = config.CACHE_DIR
-    config.CACHE_DIR = path
-    try:
-        yield
-    finally:
-        config.CACHE_DIR = old
+    with _CACHING_LOCK:
+        old = config.CACHE_DIR
+        config.CACHE_DIR = path
+        try:
+            yield
+        finally:
+            config.CACHE_DIR = old
 
 
 with _caching_in(cache_dir()):
@@ -155,17 +163,11 @@ with _caching_in(cache_dir()):
     from . import aperture, disc, drive, montecarlo, rough, vector  # noqa: E402, F401  (decorated here, cached there)
 
 
-#: one first use at a time: two threads' :func:`_caching_in` side by side could restore numba's
-#: cache folder in the wrong order and leave it on ours for the rest of the process (the report's
-#: sections run on threads, and ``_low_level``'s cache does not hold a second caller back)
-_RBAR_LOCK = threading.Lock()
-
-
 def rbar_integrand():
     """R-bar's compiled integrand (:mod:`~scatterbench.models.kernels.rbar`, a ``cfunc``), imported
     on first use: a ``cfunc`` compiles (or loads from the cache) when decorated, and only models
     with a smooth interface need it.  Imported here, so that it caches with the kernels."""
-    with _RBAR_LOCK, _caching_in(cache_dir()):
+    with _caching_in(cache_dir()):
         from . import rbar
     return rbar.integrand
 

@@ -26,7 +26,7 @@ def chain_seed(seed: int, index: int) -> int:
 
 @functools.cache
 def load():
-    """Import ArviZ (about 2 s) and run it once on a tiny posterior (~0.15 s): what the
+    """Import ArviZ (about 2 s) and run it once on a tiny posterior (0.4-0.6 s, ad hoc): what the
     comparison's R-hat and the PTFE study need, loaded where they will run.  ArviZ's first
     InferenceData makes xarray import ~140 more modules (``dask.array``, the chunk managers'
     entry points, ``psutil``...; ad hoc, 2026-12-07), so a report runs this on its main thread
