@@ -2,7 +2,7 @@
 count, and the first ``report --quick`` cold and warm.
 
     python benchmarks/scaling.py [--geometries 1000000] [--threads 1 2 ...] [--workers 1 2 ...]
-                                 [--studies sweep-quick presets ...] [--first-run [--pairs N]]
+                                 [--studies sweep-quick presets ...] [--first-run [--pairs N] [--full]]
                                  [--compile]
                                  [--repeat 3]
 
@@ -15,10 +15,10 @@ count, and the first ``report --quick`` cold and warm.
   process per worker count of ``--workers`` (default 1, 2, 4, ... and the cores): seconds,
   speedup over one worker, and the digest of its results, which must be equal for every
   worker count (the command exits 1 when they are not).
-* **First run** (``--first-run``): ``scatterbench report --quick`` with an empty numba cache
-  (``NUMBA_CACHE_DIR`` a fresh folder: every kernel compiles) and then again with that cache
-  (warm), with the default ``--workers``, ``--pairs`` times: the seconds of each and their
-  ratio.
+* **First run** (``--first-run``): ``scatterbench report --quick`` (with ``--full``, the
+  full ``scatterbench report``) with an empty numba cache (``NUMBA_CACHE_DIR`` a fresh folder:
+  every kernel compiles) and then again with that cache (warm), with the default ``--workers``,
+  ``--pairs`` times: the seconds of each and their ratio.
 * **Compilation** (``--compile``): each compile group of a report
   (``validation.report.build.every_compile_group``: a kernel's loops, or the Monte Carlo, aperture or
   disc entries, grouped by the helpers they share; the last ones compiled beside the sections
@@ -112,34 +112,46 @@ def studies(names, workers):
     return ok
 
 
-def first_run(pairs=1):
-    """``report --quick`` with an empty numba cache, then warm, each in a fresh process, ``pairs``
-    times (a fresh cache each): per pair the whole command's seconds, ``results.json``'s and the
-    cold run's ratio to the warm one, then the ratios' range (a shared host moves them by more
-    than one pair shows)."""
-    print(f"\nfirst run: scatterbench report --quick, {pairs} pair(s); {_load()}")
-    ratios = []
+def first_run(pairs=1, full=False):
+    """``report --quick`` (``report`` where ``full``) with an empty numba cache, then warm, each in
+    a fresh process, ``pairs`` times (a fresh cache each): per pair the whole command's seconds,
+    ``results.json``'s and the cold run's ratio to the warm one, then the ratios' range (a shared
+    host moves them by more than one pair shows). False when a cold run's results differ from
+    its warm run's (``results_digest``: the timings left out)."""
+    from scatterbench.validation.report.timing import results_digest
+
+    quick = [] if full else ["--quick"]
+    name = " ".join(["scatterbench report", *quick])
+    print(f"\nfirst run: {name}, {pairs} pair(s); {_load()}")
+    ratios, ok = [], True
     for k in range(pairs):
         with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as out:
             env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-            walls, seconds = [], []
+            walls, seconds, digests = [], [], []
             for label in ("cold (empty numba cache)", "warm"):
                 t = time.perf_counter()
-                cmd = [sys.executable, "-m", "scatterbench.validation.cli", "report", "--quick", "--out", out]
+                cmd = [sys.executable, "-m", "scatterbench.validation.cli", "report", *quick, "--out", out]
                 r = subprocess.run(cmd, env=env, capture_output=True, text=True)
                 walls.append(time.perf_counter() - t)
                 if r.returncode not in (0, 1):  # 1: a check failed, the report still written
-                    sys.exit(f"report --quick exited {r.returncode}:\n{r.stderr[-2000:]}")
+                    sys.exit(f"{name} exited {r.returncode}:\n{r.stderr[-2000:]}")
                 with open(os.path.join(out, "results.json"), encoding="utf-8") as f:
-                    seconds.append(json.load(f)["meta"]["seconds"])
+                    results = json.load(f)
+                seconds.append(results["meta"]["seconds"])
+                digests.append(results_digest(results))
                 print(
-                    f"  pair {k + 1} {label:<25} {walls[-1]:7.1f} s  results.json {seconds[-1]:6.1f} s  exit {r.returncode}"
+                    f"  pair {k + 1} {label:<25} {walls[-1]:7.1f} s  results.json {seconds[-1]:6.1f} s"
+                    f"  exit {r.returncode}  digest {digests[-1]}"
                 )
+            if digests[0] != digests[1]:
+                print(f"  pair {k + 1}: RESULTS DIFFER between the cold and the warm run")
+                ok = False
             ratios.append(walls[0] / walls[1])
             print(
                 f"  pair {k + 1} cold / warm: {ratios[-1]:.2f} of wall, {seconds[0] / seconds[1]:.2f} of results.json"
             )
     print(f"  cold / warm of wall over {pairs} pair(s): {min(ratios):.2f} - {max(ratios):.2f}; {_load()}")
+    return ok
 
 
 _COMPILE = """
@@ -195,6 +207,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--first-run", action="store_true", help="also time report --quick cold and warm")
     ap.add_argument("--pairs", type=int, default=1, help="cold and warm pairs of --first-run (default 1)")
+    ap.add_argument("--full", action="store_true", help="--first-run times the full report, not --quick")
     ap.add_argument("--compile", action="store_true", help="also time each compile-ahead task, empty cache")
     args = ap.parse_args()
     c = cores()
@@ -204,10 +217,10 @@ def main():
     if args.compile:
         compile_tasks()
     if args.first_run:
-        first_run(args.pairs)
+        ok = first_run(args.pairs, args.full) and ok
     print(f"\nend; {_load()}")
     if not ok:
-        sys.exit("RESULTS DIFFER between worker counts: the results must not depend on them")
+        sys.exit("RESULTS DIFFER: the results must not depend on the worker count or the numba cache")
 
 
 if __name__ == "__main__":
