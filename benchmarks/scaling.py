@@ -141,7 +141,7 @@ def first_run(pairs=1, full=False):
                 digests.append(results_digest(results))
                 print(
                     f"  pair {k + 1} {label:<25} {walls[-1]:7.1f} s  results.json {seconds[-1]:6.1f} s"
-                    f"  exit {r.returncode}  digest {digests[-1]}"
+                    f"  exit {r.returncode}  digest {digests[-1]}  {phases(results)}"
                 )
             if digests[0] != digests[1]:
                 print(f"  pair {k + 1}: RESULTS DIFFER between the cold and the warm run")
@@ -152,6 +152,17 @@ def first_run(pairs=1, full=False):
             )
     print(f"  cold / warm of wall over {pairs} pair(s): {min(ratios):.2f} - {max(ratios):.2f}; {_load()}")
     return ok
+
+
+def phases(results):
+    """Where a report's seconds went (``meta.phase_seconds``): before its sections, its sections
+    side by side (what more workers shorten), then one at a time (what they do not)."""
+    p = results["meta"].get("phase_seconds")
+    return (
+        ""
+        if p is None
+        else f"(start {p['start']:.1f}, beside {p['beside']:.1f}, in turn {p['in turn']:.1f} s)"
+    )
 
 
 _COMPILE = """

@@ -64,9 +64,10 @@ export NUMBA_CACHE_DIR=/tmp/numba-cache  # empty on a fresh machine: part 1 is t
 # the reports' folders: fresh ones (a report refuses a folder holding files it does not write)
 WORK=$(mktemp -d /tmp/scaling16.XXXXXX) || exit 1
 SB="python3 -m scatterbench.validation.cli"
-digest() {
-    python3 -c "import json, sys; from scatterbench.validation.report.timing import results_digest
-print(results_digest(json.load(open(sys.argv[1]))))" "$1/results.json"
+digest() {  # the results' digest, then where the report's seconds went
+    python3 -c "import json, sys; sys.path.insert(0, 'benchmarks'); from scaling import phases
+from scatterbench.validation.report.timing import results_digest
+r = json.load(open(sys.argv[1])); print(results_digest(r), phases(r))" "$1/results.json"
 }
 timed() {  # timed LABEL LIMIT CMD...: wall seconds and exit status of CMD under LIMIT seconds
     local label=$1 limit=$2

@@ -96,6 +96,34 @@ def test_a_beside_section_that_raises_fails_alone(monkeypatch):
     assert log == [("good", True), ("after", True)]
 
 
+def _sleeping(seconds, value=1):
+    def compute(ctx):
+        time.sleep(seconds)
+        return value
+
+    return compute
+
+
+def test_the_report_says_where_its_seconds_went(monkeypatch):
+    """``meta.phase_seconds``: before the sections (the preloads), the sections side by side,
+    then the rest one at a time; left out of the results' digest, as every time is."""
+    from scatterbench.validation.report.timing import results_digest
+
+    specs = [
+        SectionSpec(
+            "s0", "S0", _sleeping(0.6), _rendering([]), beside=True, preloads=(lambda: time.sleep(0.3),)
+        ),
+        SectionSpec("s1", "S1", _sleeping(0.6), _rendering([]), beside=True),
+        SectionSpec("later", "Later", _sleeping(0.2), _rendering([])),
+    ]
+    results = _report(monkeypatch, specs, Workers())
+    phases = results["meta"]["phase_seconds"]
+    assert phases["start"] >= 0.3 and phases["beside"] >= 0.6 and 0.2 <= phases["in turn"] < phases["beside"]
+    assert sum(phases.values()) <= results["meta"]["seconds"]
+    moved = {**results, "meta": {**results["meta"], "phase_seconds": {"start": 0.0}}}
+    assert results_digest(moved) == results_digest(results)
+
+
 def test_what_sections_import_on_first_use_is_imported_on_the_main_thread_first(monkeypatch, tmp_path):
     """A section's ``preloads`` run before the sections' threads start, on the report's main
     thread (an import on a section's thread can cross another's), once each."""

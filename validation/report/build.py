@@ -108,12 +108,16 @@ def _beside(ctx, specs):
 def _run_sections(ctx, specs):
     """Every section of ``specs``: first those computed side by side (:func:`_beside`), then
     the others one at a time by stage (page order within one), each rendered in that order on
-    this thread (matplotlib's figures are not thread-safe); returns them in page order."""
+    this thread (matplotlib's figures are not thread-safe); returns them in page order.  The
+    seconds of the two phases go to ``ctx.cache["phase_seconds"]``: ``beside`` is what more
+    workers can shorten, ``in turn`` what they cannot."""
     ctx.cache.setdefault("section_times", {})
     ctx.cache.setdefault("section_failures", [])
     done = {}
     with _progress(len(specs), "report") as bar:
+        t = time.perf_counter()
         early = _beside(ctx, specs)
+        beside = time.perf_counter() - t
         late = compile_later(ctx.executor, specs)
         for spec in sorted(specs, key=lambda sp: sp.stage):
             bar.set_postfix_str(spec.id)
@@ -124,6 +128,7 @@ def _run_sections(ctx, specs):
             done[spec.id] = _rendered(ctx, spec, computed)
             ctx.cache["section_times"][spec.id] = done[spec.id].seconds
             bar.update(1)
+    ctx.cache["phase_seconds"] = {"beside": beside, "in turn": time.perf_counter() - t - beside}
     return [done[spec.id] for spec in specs]
 
 
@@ -295,6 +300,7 @@ def build_report(
     preload(specs)  # while the workers compile, if they do
     if compiling is not None:
         compiling.result()
+    start = time.perf_counter() - t0
     sections = _run_sections(ctx, specs)
     # every check is counted even if the summary section itself failed to draw them
     checks = report_checks(ctx) + ctx.cache["section_failures"]
@@ -305,6 +311,8 @@ def build_report(
         "quick": quick,
         "seed": seed,
         "seconds": time.perf_counter() - t0,
+        # where those seconds went: before the sections (compile-ahead, preloads), then _run_sections'
+        "phase_seconds": {"start": start, **ctx.cache["phase_seconds"]},
     }
     results = {
         "meta": meta,

@@ -15,7 +15,9 @@ import json
 __all__ = ["without_timings", "results_digest"]
 
 #: keys whose values are measured times, anywhere in results.json
-_TIMED_KEYS = frozenset({"seconds", "date", "git_commit", "us per geometry (CPU)", "us per geometry (wall)"})
+_TIMED_KEYS = frozenset(
+    {"seconds", "phase_seconds", "date", "git_commit", "us per geometry (CPU)", "us per geometry (wall)"}
+)
 #: per section: the ``numbers`` tables chosen by measured time (prefixes)
 _TIMED_TABLES = {"speed": ("pareto|",), "provenance": ("section_times",)}
 #: the provenance table's row naming the commit (as ``git_commit`` does in ``meta``): two
