@@ -23,9 +23,15 @@
 #      machine): what bounds part 5 on that machine, and by how much the workers' start-up and
 #      the busy cores' clock take it further down.  Not in the default list.
 # The reports' digests (results.json without timings) must be equal.
+# Each report part prints its digest and where its seconds went (results.json's
+# meta.phase_seconds: the sections side by side are what more workers shorten, the rest not).
 # At 4235c56 the quick report, the kernels, the full report and the comparison in-process took
-# ~560 s of the device call's 600 (figures in docs/guide/nightly.md, "How it scales"); part 6
-# needs a call of its own (~400 s at 4235c56).
+# ~560 s of the device call's 600 (figures in docs/guide/scaling.md); part 6 needs a call of its
+# own (~400 s at 4235c56). At ffda8ce the 2-core development machine ran the full report in
+# 143 s warm; assuming the 16-core machine's cores 1.5x slower (not measured at this code), a
+# session's 15 minutes fit `1 4 6` first (~90 + 50 + 220 s: issue 30's 5x is part 4 against
+# part 6), then `5 3` on the warm machine (~120 + 60 s: the comparison's 8x, the kernels' 12x
+# and 14x).
 set -u
 OUT=${1:?usage: scaling_16core.sh OUTDIR}
 mkdir -p "$OUT"
