@@ -107,6 +107,7 @@ def _sleeping(seconds, value=1):
 def test_the_report_says_where_its_seconds_went(monkeypatch):
     """``meta.phase_seconds``: before the sections (the preloads), the sections side by side,
     then the rest one at a time; left out of the results' digest, as every time is."""
+    from scatterbench.validation.report.core import render_html
     from scatterbench.validation.report.timing import results_digest
 
     specs = [
@@ -120,6 +121,8 @@ def test_the_report_says_where_its_seconds_went(monkeypatch):
     phases = results["meta"]["phase_seconds"]
     assert phases["start"] >= 0.3 and phases["beside"] >= 0.6 and 0.2 <= phases["in turn"] < phases["beside"]
     assert sum(phases.values()) <= results["meta"]["seconds"]
+    header = render_html(results["meta"], [], results["summary"])
+    assert f"{phases['beside']:.1f} s of studies side by side" in header
     moved = {**results, "meta": {**results["meta"], "phase_seconds": {"start": 0.0}}}
     assert results_digest(moved) == results_digest(results)
 
