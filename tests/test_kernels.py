@@ -550,3 +550,40 @@ def test_r_bar_integrand_first_uses_on_threads_restore_numba_s_cache_folder(monk
     for t in threads:
         t.join()
     assert config.CACHE_DIR == "users-own"
+
+
+def test_vector_loops_first_made_on_threads_restore_numba_s_cache_folder(monkeypatch):
+    """Two threads' first calls of :func:`vector.lanes_of` at once (two option sets) leave numba's
+    ``config.CACHE_DIR`` as it was, each loop decorated with scatterbench's folder; and two
+    threads' first calls for one option set get one loop.  Fails without the lock (the second
+    thread saves the first's setting and restores it last) and without the second look-up."""
+    from numba.core import config
+
+    from scatterbench.models.kernels import vector
+
+    made, folders = [], []
+    real = vector.entry
+
+    def slow(*key):
+        folders.append(config.CACHE_DIR)
+        time.sleep(0.2)  # the other thread's call starts meanwhile
+        made.append(key)
+        return real(*key)
+
+    monkeypatch.setattr(vector, "entry", slow)
+    monkeypatch.setattr(vector, "_ENTRIES", {})
+    monkeypatch.setattr(config, "CACHE_DIR", "users-own")
+    sets = vector.option_sets(vector.FACET)
+    got = []
+    for opts in ([sets[0], sets[1]], [sets[2], sets[2]]):
+        threads = [
+            threading.Thread(target=lambda o=o: got.append(vector.lanes_of(vector.FACET, o))) for o in opts
+        ]
+        for t in threads:
+            t.start()
+            time.sleep(0.05)
+        for t in threads:
+            t.join()
+    assert config.CACHE_DIR == "users-own"
+    assert folders == [vector._CACHE_DIR] * 3 and len(made) == 3  # the shared set made once
+    assert got[2] is got[3]

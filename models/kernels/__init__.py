@@ -73,18 +73,17 @@ a study sharing the cores).
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import logging
 import math
 import os
 import tempfile
-import threading
 
 import numpy as np
 
 from .. import evaluation, smooth_interface
 from ..float32_domain import ANGLE_ROWS
+from .helper import caching_in as _caching_in
 from .threads import spread
 
 __all__ = ["Compiled", "PARALLEL_MIN", "cache_dir"]
@@ -133,27 +132,6 @@ def cache_dir() -> str:
         if _writable(os.path.join(base, sub)):
             return os.path.join(base, sub)
     return ""  # nowhere writable: compile in every process
-
-
-#: one switch of numba's cache folder at a time: two threads' side by side could restore it in
-#: the wrong order and leave it on ours for the rest of the process (the report's sections run
-#: on threads, and R-bar's integrand, :func:`rbar_integrand`, is imported on first use)
-_CACHING_LOCK = threading.RLock()
-
-
-@contextlib.contextmanager
-def _caching_in(path):
-    """numba's cache locator reads ``config.CACHE_DIR`` when a function is decorated: set to
-    ``path`` for the block, one thread at a time (:data:`_CACHING_LOCK`)."""
-    from numba.core import config
-
-    with _CACHING_LOCK:
-        old = config.CACHE_DIR
-        config.CACHE_DIR = path
-        try:
-            yield
-        finally:
-            config.CACHE_DIR = old
 
 
 with _caching_in(cache_dir()):

@@ -4,8 +4,30 @@ inlines, and :func:`entry_point`, that of the entries (numba; which functions ar
 
 from __future__ import annotations
 
+import contextlib
+import threading
+
 from numba import njit
+from numba.core import config
 from numba.extending import register_jitable
+
+#: one switch of numba's cache folder at a time: two threads' side by side could restore it in
+#: the wrong order and leave it on ours for the rest of the process (the report's sections run
+#: on threads; R-bar's integrand is imported, and a vector loop decorated, on first use)
+_CACHING_LOCK = threading.RLock()
+
+
+@contextlib.contextmanager
+def caching_in(path):
+    """numba's cache locator reads ``config.CACHE_DIR`` when a function is decorated: set to
+    ``path`` for the block, one thread at a time (:data:`_CACHING_LOCK`)."""
+    with _CACHING_LOCK:
+        old = config.CACHE_DIR
+        config.CACHE_DIR = path
+        try:
+            yield
+        finally:
+            config.CACHE_DIR = old
 
 
 def helper(fn=None, *, forceinline=True, fastmath=False):

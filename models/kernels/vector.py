@@ -50,7 +50,7 @@ from ..kernel_specs import COOK_SHADOWING, EXPONENTIAL, GAUSSIAN, GGX, RUNTIME, 
 from .common import NO_SHADOWING, azimuths_at, polar
 from .drive import COOK, DIFFUSE, FACET, MAXWELL, NAMES, PARAM_ROWS, ROWS, SINGLE, own_kernel
 from .facet import coating, facet_lanes
-from .helper import helper
+from .helper import caching_in, helper
 from .memory import STREAM_MIN, copy_into, copy_rows, fill, line_aligned, pick_rows
 
 #: geometries per block: the scratch, :data:`_ROWS` rows of them in float64 (90 kB), stays
@@ -327,9 +327,8 @@ def lanes_of(code, opts):
     key = (int(code), tuple(int(x) for x in opts))  # ints: the closures' cells key the cache
     got = _ENTRIES.get(key)
     if got is None:
-        old, config.CACHE_DIR = config.CACHE_DIR, _CACHE_DIR  # numba reads it when decorating
-        try:
-            got = _ENTRIES[key] = entry(*key)
-        finally:
-            config.CACHE_DIR = old
+        with caching_in(_CACHE_DIR):  # numba reads it when decorating; one thread at a time
+            got = _ENTRIES.get(key)  # another thread's, made while this one waited
+            if got is None:
+                got = _ENTRIES[key] = entry(*key)
     return got
