@@ -524,6 +524,17 @@ def test_a_long_evaluation_is_one_kernel_call_with_the_chunks_bits(monkeypatch):
         np.testing.assert_array_equal(whole[:, a:b], m.mueller16(0.3, tr[a:b], pr[a:b])[1])
 
 
+def _run_apart(calls):
+    """Each of ``calls`` on a thread of its own, started 0.05 s apart (each call slowed by its
+    test, so that they overlap), then joined."""
+    threads = [threading.Thread(target=call) for call in calls]
+    for t in threads:
+        t.start()
+        time.sleep(0.05)
+    for t in threads:
+        t.join()
+
+
 def test_r_bar_integrand_first_uses_on_threads_restore_numba_s_cache_folder(monkeypatch):
     """Two threads' first calls of :func:`kernels.rbar_integrand` at once leave numba's
     ``config.CACHE_DIR`` as it was (the report's sections run on threads): each switches it
@@ -543,12 +554,7 @@ def test_r_bar_integrand_first_uses_on_threads_restore_numba_s_cache_folder(monk
 
     monkeypatch.setattr(kernels, "_caching_in", slow)
     monkeypatch.setattr(config, "CACHE_DIR", "users-own")
-    threads = [threading.Thread(target=kernels.rbar_integrand) for _ in range(2)]
-    for t in threads:
-        t.start()
-        time.sleep(0.05)
-    for t in threads:
-        t.join()
+    _run_apart([kernels.rbar_integrand] * 2)
     assert config.CACHE_DIR == "users-own"
 
 
@@ -576,14 +582,7 @@ def test_vector_loops_first_made_on_threads_restore_numba_s_cache_folder(monkeyp
     sets = vector.option_sets(vector.FACET)
     got = []
     for opts in ([sets[0], sets[1]], [sets[2], sets[2]]):
-        threads = [
-            threading.Thread(target=lambda o=o: got.append(vector.lanes_of(vector.FACET, o))) for o in opts
-        ]
-        for t in threads:
-            t.start()
-            time.sleep(0.05)
-        for t in threads:
-            t.join()
+        _run_apart([lambda o=o: got.append(vector.lanes_of(vector.FACET, o)) for o in opts])
     assert config.CACHE_DIR == "users-own"
     assert folders == [vector._CACHE_DIR] * 3 and len(made) == 3  # the shared set made once
     assert got[2] is got[3]
