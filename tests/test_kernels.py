@@ -538,7 +538,7 @@ def _run_apart(calls):
 def test_r_bar_integrand_first_uses_on_threads_restore_numba_s_cache_folder(monkeypatch):
     """Two threads' first calls of :func:`kernels.rbar_integrand` at once leave numba's
     ``config.CACHE_DIR`` as it was (the report's sections run on threads): each switches it
-    for its import, one at a time (:func:`kernels._caching_in`'s lock).  Fails without the lock:
+    for its import, one at a time (:func:`kernels.helper.caching_in`'s lock).  Fails without the lock:
     the second saves the first's setting and restores it last."""
     from numba.core import config
 

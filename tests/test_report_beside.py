@@ -96,10 +96,10 @@ def test_a_beside_section_that_raises_fails_alone(monkeypatch):
     assert log == [("good", True), ("after", True)]
 
 
-def _sleeping(seconds, value=1):
+def _sleeping(seconds):
     def compute(ctx):
         time.sleep(seconds)
-        return value
+        return seconds
 
     return compute
 

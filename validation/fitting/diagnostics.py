@@ -43,7 +43,7 @@ def load():
         idata = arviz.from_dict(posterior={"x": draws}, log_likelihood={"y": draws[..., None]})
         arviz.loo(idata)
         arviz.waic(idata)
-        arviz.rhat(draws, method="rank")
+        rhat(draws)
 
 
 def rhat(draws) -> float:

@@ -108,9 +108,9 @@ def _beside(ctx, specs):
 def _run_sections(ctx, specs):
     """Every section of ``specs``: first those computed side by side (:func:`_beside`), then
     the others one at a time by stage (page order within one), each rendered in that order on
-    this thread (matplotlib's figures are not thread-safe); returns them in page order.  The
-    seconds of the two phases go to ``ctx.cache["phase_seconds"]``: ``beside`` is what more
-    workers can shorten, ``in turn`` what they cannot."""
+    this thread (matplotlib's figures are not thread-safe).  Returns them in page order and the
+    seconds of the two phases: ``beside``, what more workers can shorten, and ``in turn``, what
+    they cannot."""
     ctx.cache.setdefault("section_times", {})
     ctx.cache.setdefault("section_failures", [])
     done = {}
@@ -128,8 +128,8 @@ def _run_sections(ctx, specs):
             done[spec.id] = _rendered(ctx, spec, computed)
             ctx.cache["section_times"][spec.id] = done[spec.id].seconds
             bar.update(1)
-    ctx.cache["phase_seconds"] = {"beside": beside, "in turn": time.perf_counter() - t - beside}
-    return [done[spec.id] for spec in specs]
+    phases = {"beside": beside, "in turn": time.perf_counter() - t - beside}
+    return [done[spec.id] for spec in specs], phases
 
 
 #: the loops a report runs, as tasks of :func:`compile_ahead`: ``(kernel, precision, option
@@ -301,7 +301,7 @@ def build_report(
     if compiling is not None:
         compiling.result()
     start = time.perf_counter() - t0
-    sections = _run_sections(ctx, specs)
+    sections, phases = _run_sections(ctx, specs)
     # every check is counted even if the summary section itself failed to draw them
     checks = report_checks(ctx) + ctx.cache["section_failures"]
     summary = tally(checks)
@@ -312,7 +312,7 @@ def build_report(
         "seed": seed,
         "seconds": time.perf_counter() - t0,
         # where those seconds went: before the sections (compile-ahead, preloads), then _run_sections'
-        "phase_seconds": {"start": start, **ctx.cache["phase_seconds"]},
+        "phase_seconds": {"start": start, **phases},
     }
     results = {
         "meta": meta,
