@@ -1,6 +1,9 @@
 """The report computes its ``beside`` sections (the studies on the executor) at once, on
 threads of their own, when its workers run one task at a time; everything else one after
-another, and every section is rendered in page order on the calling thread.
+another, before them (the other sections of stage 0) or after them (those that time code, the
+later stages).  Every section is rendered on the calling thread, those computed before the
+beside ones and each beside one as it is done while the others compute; what later stages read
+(the failures, the seconds) follows the order sections run.
 
 Equal results on every executor are ``tests/test_report_executors.py``'s (its subset, the
 seed 003 presets and the stability sweep, are both ``beside``)."""
@@ -55,15 +58,132 @@ def _rendering(log):
     return render
 
 
-def test_beside_sections_are_computed_at_once_and_rendered_in_page_order(monkeypatch):
+def test_beside_sections_are_computed_at_once_and_rendered_on_the_main_thread(monkeypatch):
     compute, seen = _meeting(3)
     log = []
     specs = [SectionSpec(f"s{i}", f"S{i}", compute, _rendering(log), beside=True) for i in range(3)]
     results = _report(monkeypatch, specs, Workers())
     assert [s["error"] for s in results["sections"].values()] == [None] * 5
     assert len(set(seen)) == 3 and all(name.startswith("scatterbench-section") for name in seen)
-    assert log == [("s0", True), ("s1", True), ("s2", True)]  # page order, on the main thread
+    assert sorted(log) == [("s0", True), ("s1", True), ("s2", True)]  # on the main thread
+    assert list(results["sections"]) == ["summary", "s0", "s1", "s2", "provenance"]  # page order
     assert results["summary"]["n_fail"] == 0
+
+
+def _waiting_for(event, then=None, timeout=10.0):
+    """A compute that waits for ``event`` (raising after ``timeout`` s), then returns
+    ``then``."""
+
+    def compute(ctx):
+        if not event.wait(timeout):
+            raise TimeoutError("not rendered meanwhile")
+        return then
+
+    return compute
+
+
+def _rendering_sets(log, event):
+    def render(sec, data):
+        log.append(sec.id)
+        event.set()
+
+    return render
+
+
+def test_sections_are_rendered_as_they_are_done_while_the_beside_ones_compute(monkeypatch):
+    """This thread renders the sections computed before the beside ones, then each beside one
+    as it is done, while the others still compute: each compute below waits for the render
+    before it (its event), and fails after 10 s if the renders wait for every compute."""
+    events = [threading.Event() for _ in range(3)]
+    log = []
+    specs = [
+        SectionSpec(
+            "b0", "B0", _waiting_for(events[2]), _rendering_sets(log, threading.Event()), beside=True
+        ),
+        SectionSpec("b1", "B1", _waiting_for(events[1]), _rendering_sets(log, events[2]), beside=True),
+        SectionSpec("b2", "B2", _waiting_for(events[0]), _rendering_sets(log, events[1]), beside=True),
+        SectionSpec("first", "First", lambda ctx: 0, _rendering_sets(log, events[0])),
+    ]
+    results = _report(monkeypatch, specs, Workers())
+    assert [s["error"] for s in results["sections"].values()] == [None] * 6
+    assert log == ["first", "b2", "b1", "b0"]
+    assert list(results["sections"]) == ["summary", "b0", "b1", "b2", "first", "provenance"]
+
+
+def test_what_later_stages_read_is_in_page_order_whatever_order_sections_are_done(monkeypatch):
+    """The summary's check list (and so the results' digest) has the failed sections, and the
+    provenance section's table their seconds, in the order sections run, although the beside
+    ones are rendered as they are done (here the last first)."""
+    events = [threading.Event() for _ in range(2)]
+
+    def failing_after(event):
+        def compute(ctx):
+            assert event.wait(10.0)
+            raise RuntimeError("broken")
+
+        return compute
+
+    def broken_now(ctx):
+        raise RuntimeError("broken")
+
+    def render_setting(event):
+        def render(sec, data):
+            event.set()
+
+        return render
+
+    specs = [
+        SectionSpec("b0", "B0", failing_after(events[1]), _rendering([]), beside=True),
+        SectionSpec("b1", "B1", failing_after(events[0]), _rendering([]), beside=True),
+        SectionSpec("b2", "B2", lambda ctx: 0, render_setting(events[0]), beside=True),
+        SectionSpec("first", "First", broken_now, _rendering([])),
+        SectionSpec("alone", "Alone", broken_now, _rendering([]), alone=True),
+    ]
+    # b1 fails once b2 is rendered, b0 once b1 has failed (its event set here)
+    monkeypatch.setattr(build, "_section_failure", _failure_noting(events[1]))
+    results = _report(monkeypatch, specs, Workers())
+    failed = ["report.section_b0", "report.section_b1", "report.section_first", "report.section_alone"]
+    assert [c["id"] for c in results["checks"]] == failed
+    times = results["sections"]["provenance"]["numbers"]["section_times"]
+    assert [row["section"] for row in times] == ["b0", "b1", "b2", "first", "alone"]
+
+
+def _failure_noting(event):
+    real = build._section_failure
+
+    def failure(name):
+        if name == "b1":
+            event.set()
+        return real(name)
+
+    return failure
+
+
+def test_a_section_that_times_code_is_computed_with_nothing_else_running(monkeypatch):
+    """An ``alone`` section is computed after the beside ones, no section thread left; any
+    other section of stage 0 before them, so that this process only renders while they run."""
+    log = []
+
+    def noting(name):
+        def compute(ctx):
+            threads = [t.name for t in threading.enumerate() if t.name.startswith("scatterbench-section")]
+            log.append((name, threading.current_thread() is threading.main_thread(), bool(threads)))
+            return 0
+
+        return compute
+
+    specs = [
+        SectionSpec("timed", "Timed", noting("timed"), _rendering([]), alone=True),
+        SectionSpec("b0", "B0", lambda ctx: time.sleep(0.3), _rendering([]), beside=True),
+        SectionSpec("b1", "B1", noting("b1"), _rendering([]), beside=True),
+        SectionSpec("other", "Other", noting("other"), _rendering([])),
+    ]
+    results = _report(monkeypatch, specs, Workers())
+    assert results["summary"]["n_fail"] == 0
+    assert log[0] == ("other", True, False) and log[2] == ("timed", True, False)
+    assert log[1] == ("b1", False, True)
+    # the report's one such section: the speed section times the kernels
+    assert [sp.id for sp in sections.SECTIONS if sp.alone] == ["speed"]
 
 
 def test_on_one_process_or_many_task_threads_the_sections_run_one_after_another(monkeypatch):
@@ -93,7 +213,7 @@ def test_a_beside_section_that_raises_fails_alone(monkeypatch):
     assert results["sections"]["bad"]["error"] == "RuntimeError: the study failed"
     assert results["sections"]["good"]["numbers"] == {"data": 1.0}
     assert [c["id"] for c in results["checks"]] == ["report.section_bad"]
-    assert log == [("good", True), ("after", True)]
+    assert log == [("after", True), ("good", True)]  # computed before the beside ones
 
 
 def _sleeping(seconds):
@@ -264,19 +384,24 @@ def _late_compile(monkeypatch, fail=False):
             for i in range(2)
         ),
         SectionSpec("before", "Before", before, _rendering([])),
-        SectionSpec("needs", "Needs", needs, _rendering([]), compiles=(task,)),
+        SectionSpec("needs", "Needs", needs, _rendering([]), compiles=(task,), alone=True),
     ]
     return log, task, _report(monkeypatch, specs, Workers())
 
 
-def test_a_sections_own_loops_compile_after_the_beside_sections_and_beside_those_before_it(monkeypatch):
-    """A section's own loops (``SectionSpec.compiles``) compile on the workers once the beside
-    sections are done, while this process computes the sections before it, and that section
-    starts only when they are compiled (it loads them rather than compiling them again).
-    Fails when they compile ahead of every section, or the section does not wait."""
+def test_a_sections_own_loops_compile_on_the_workers_while_this_process_computes_the_first_sections(
+    monkeypatch,
+):
+    """A section's own loops (``SectionSpec.compiles``; here a section that times code, as the
+    speed section) compile on the workers as the sections start, while this process computes
+    those before the beside ones, and that section starts only when they are compiled (it
+    loads them rather than compiling them again).  Fails when they compile ahead of every
+    section (the compile then waits 20 s for a section that has not started), or the section
+    does not wait."""
     log, task, results = _late_compile(monkeypatch)
-    assert log[:2] == ["beside", "beside"] and log[-2:] == ["compiled", "needs"]
-    assert sorted(log[2:4], key=str) == [("compile", (task,)), "before"]  # at once: either first
+    assert sorted(log[:2], key=str) == [("compile", (task,)), "before"]  # at once: either first
+    assert log.count("beside") == 2 and log.index("beside") > log.index("before")
+    assert log.index("compiled") < log.index("needs") == len(log) - 1
     assert results["summary"]["n_fail"] == 0
 
 

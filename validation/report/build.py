@@ -10,7 +10,7 @@ import os
 import sys
 import time
 import traceback
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from concurrent.futures import wait as wait_for
 
 from tqdm import tqdm
@@ -66,9 +66,9 @@ def _computed(ctx, spec):
         return None, (f"{type(exc).__name__}: {exc}", _section_failure(spec.id)), time.perf_counter() - t
 
 
-def _rendered(ctx, spec, computed):
-    """``spec`` rendered from ``computed`` (:func:`_computed`); a failure of either is kept as
-    the section's error and recorded in ``ctx.cache["section_failures"]``."""
+def _rendered(spec, computed):
+    """``(section, failure)``: ``spec`` rendered from ``computed`` (:func:`_computed`), and the
+    failure record of its compute or render (``None`` when neither raised)."""
     data, error, seconds = computed
     sec = Section(spec.id, spec.title)
     t = time.perf_counter()
@@ -79,9 +79,8 @@ def _rendered(ctx, spec, computed):
             error = (f"{type(exc).__name__}: {exc}", _section_failure(spec.id))
     if error is not None:
         sec = Section(spec.id, spec.title, error=error[0])
-        ctx.cache["section_failures"].append(error[1])
     sec.seconds = seconds + time.perf_counter() - t
-    return sec
+    return sec, None if error is None else error[1]
 
 
 def side_by_side(executor) -> bool:
@@ -93,43 +92,95 @@ def side_by_side(executor) -> bool:
     return getattr(executor, "workers", 1) > 1 and getattr(executor, "one_task_per_process", False)
 
 
-def _beside(ctx, specs):
-    """``{id: computed}`` of the sections of ``specs`` that run beside each other, each
-    computed on a thread of its own (in a copy of this thread's context: the backend and
-    precision settings), their tasks then sharing the executor's workers."""
-    specs = [sp for sp in specs if sp.beside] if side_by_side(ctx.executor) else []
-    if len(specs) < 2:
-        return {}
+def _plan(ctx, specs):
+    """``(before, beside, after)``: the sections of ``specs`` this process computes before the
+    side-by-side ones start, those (:func:`side_by_side`; at least two), and the rest, each in
+    the order sections run (by stage, page order within one).  Before: every other section of
+    stage 0 but those that time code (:attr:`~.core.SectionSpec.alone`), so that while the
+    beside ones run this process only renders, which records no warnings (a check's
+    :func:`~scatterbench.validation.numerics.probes.fp_warnings` swaps process-wide state,
+    which a side-by-side thread's ``warnings.catch_warnings`` would cross)."""
+    order = sorted(specs, key=lambda sp: sp.stage)
+    beside = [sp for sp in order if sp.beside] if side_by_side(ctx.executor) else []
+    if len(beside) < 2:
+        return [], [], order
+    before = [sp for sp in order if not sp.beside and sp.stage == 0 and not sp.alone]
+    return before, beside, [sp for sp in order if sp not in before and sp not in beside]
+
+
+@contextlib.contextmanager
+def _computing(ctx, specs):
+    """``{future: spec}`` of ``specs``' :func:`_computed`, each on a thread of its own (in a
+    copy of this thread's context: the backend and precision settings), their tasks then
+    sharing the executor's workers; the block's end waits for them."""
+    if not specs:
+        yield {}
+        return
     with ThreadPoolExecutor(len(specs), thread_name_prefix="scatterbench-section") as pool:
-        futs = {sp.id: pool.submit(contextvars.copy_context().run, _computed, ctx, sp) for sp in specs}
-        return {sid: f.result() for sid, f in futs.items()}
+        yield {pool.submit(contextvars.copy_context().run, _computed, ctx, sp): sp for sp in specs}
+
+
+class _Rendering:
+    """The sections rendered so far, on this thread (matplotlib's figures are not
+    thread-safe), in whatever order they are done; what the later stages read of them (their
+    seconds, the failures) is published in the order sections run, as if one by one."""
+
+    def __init__(self, ctx, order, bar):
+        self.order, self.bar = order, bar
+        self.done, self.failed = {}, {}
+        self.times = ctx.cache.setdefault("section_times", {})
+        self.failures = ctx.cache.setdefault("section_failures", [])
+        self.prior = len(self.failures)  # a shared context's, kept first
+
+    def __call__(self, spec, computed):
+        self.done[spec.id], failure = _rendered(spec, computed)
+        if failure is not None:
+            self.failed[spec.id] = failure
+        self.bar.update(1)
+
+    def publish(self):
+        ran = [sp.id for sp in self.order if sp.id in self.done]
+        self.times.update((sid, self.done[sid].seconds) for sid in ran)
+        self.failures[self.prior :] = [self.failed[sid] for sid in ran if sid in self.failed]
 
 
 def _run_sections(ctx, specs):
-    """Every section of ``specs``: first those computed side by side (:func:`_beside`), then
-    the others one at a time by stage (page order within one), each rendered in that order on
-    this thread (matplotlib's figures are not thread-safe).  Returns them in page order and the
-    seconds of the two phases: ``beside``, what more workers can shorten, and ``in turn``, what
-    they cannot."""
-    ctx.cache.setdefault("section_times", {})
-    ctx.cache.setdefault("section_failures", [])
-    done = {}
+    """Every section of ``specs``, as :func:`_plan` orders them: the first ones computed here
+    one at a time; the side-by-side ones, while this thread renders the first ones and then
+    each of them as it is done; the rest one at a time.  Returns the sections in page order
+    and the seconds of two phases: ``beside``, what more workers can shorten, and ``in turn``,
+    before and after it, what they cannot (on 2 cores, warm: the full report's 18.9-20.3 s
+    one at a time became 10.5-10.6 s, ``report --quick``'s 16.2-18.0 s 8.3-9.1 s, the digests
+    unchanged: docs/guide/scaling.md)."""
+    before, beside, after = _plan(ctx, specs)
     with _progress(len(specs), "report") as bar:
+        render = _Rendering(ctx, sorted(specs, key=lambda sp: sp.stage), bar)
+        late = compile_later(ctx.executor, specs)  # while the workers are idle, before the beside ones
         t = time.perf_counter()
-        early = _beside(ctx, specs)
-        beside = time.perf_counter() - t
-        late = compile_later(ctx.executor, specs)
-        for spec in sorted(specs, key=lambda sp: sp.stage):
-            bar.set_postfix_str(spec.id)
-            if spec.compiles and late is not None:
-                # then its loops load from the cache; a failed compile leaves it to compile them
-                wait_for([late])
-            computed = early.pop(spec.id, None) or _computed(ctx, spec)
-            done[spec.id] = _rendered(ctx, spec, computed)
-            ctx.cache["section_times"][spec.id] = done[spec.id].seconds
-            bar.update(1)
-    phases = {"beside": beside, "in turn": time.perf_counter() - t - beside}
-    return [done[spec.id] for spec in specs], phases
+        first = [(spec, _computed_after(ctx, spec, late, bar)) for spec in before]
+        t_beside = time.perf_counter()
+        with _computing(ctx, beside) as futures:
+            for spec, computed in first:
+                render(spec, computed)
+            for fut in as_completed(futures):
+                render(futures[fut], fut.result())
+        t_after = time.perf_counter()
+        for spec in after:
+            render.publish()  # provenance shows the seconds, the summary the failures
+            render(spec, _computed_after(ctx, spec, late, bar))
+        render.publish()
+    in_turn = t_beside - t + time.perf_counter() - t_after
+    return [render.done[spec.id] for spec in specs], {"beside": t_after - t_beside, "in turn": in_turn}
+
+
+def _computed_after(ctx, spec, late, bar):
+    """:func:`_computed` of ``spec`` once ``late`` (:func:`compile_later`) is done if it
+    compiles ``spec``'s loops (then they load from the cache; a failed compile leaves it to
+    compile them)."""
+    bar.set_postfix_str(spec.id)
+    if spec.compiles and late is not None:
+        wait_for([late])
+    return _computed(ctx, spec)
 
 
 #: the loops a report runs, as tasks of :func:`compile_ahead`: ``(kernel, precision, option
@@ -211,9 +262,9 @@ def compile_ahead(executor):
 
 def compile_later(executor, specs):
     """Start compiling, on ``executor``'s local worker processes, the loops that only sections
-    computed in this process after the beside ones use (their
-    :attr:`~.core.SectionSpec.compiles`); returns the future of that, or ``None`` when nothing
-    is to compile.  While this process computes the sections before those, one core at a time,
+    computed in this process use (their :attr:`~.core.SectionSpec.compiles`); returns the
+    future of that, or ``None`` when nothing is to compile.  A report starts it with its
+    sections: while this process computes those before the beside ones, one core at a time,
     the workers are idle; ahead of all sections those loops took every core's time (the float32
     facet: 3.6 s of CPU, ``benchmarks/scaling.py --compile``).  A section with such loops waits
     for the future, so that it loads them rather than compiling them again."""

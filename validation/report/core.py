@@ -77,8 +77,12 @@ class SectionSpec:
 
     ``beside``: the section's work is mostly tasks on the run's executor, it records no
     warnings in this process and times nothing: on worker processes it is computed at once
-    with the other such sections, before the rest (:func:`~.build.side_by_side`), so that
-    the workers always have tasks.
+    with the other such sections (:func:`~.build.side_by_side`), so that the workers always
+    have tasks, after the other sections of stage 0 and before the rest (:func:`~.build._plan`);
+    meanwhile this process renders the sections done.
+
+    ``alone``: the section times code, which other work would slow: computed after the
+    ``beside`` ones, with nothing else running.
 
     ``compiles``: compile tasks (:data:`~.build.COMPILE_GROUPS`' form) of loops that only this
     section uses, one that is not ``beside``: a first run compiles them on a worker while this
@@ -98,6 +102,7 @@ class SectionSpec:
     beside: bool = False
     compiles: tuple = ()
     preloads: tuple = ()
+    alone: bool = False
 
 
 def _clean(v):

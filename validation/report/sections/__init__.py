@@ -35,8 +35,8 @@ from .summary import report_checks
 __all__ = ["SECTIONS", "report_checks"]
 
 
-def _spec(sid, title, module, stage=0, beside=False, compiles=(), preloads=()):
-    return SectionSpec(sid, title, module.compute, module.render, stage, beside, compiles, preloads)
+def _spec(sid, title, module, stage=0, beside=False, compiles=(), preloads=(), alone=False):
+    return SectionSpec(sid, title, module.compute, module.render, stage, beside, compiles, preloads, alone)
 
 
 #: the page, in order; the summary runs last (it shows every check and every section that
@@ -75,7 +75,7 @@ SECTIONS = (
     ),
     # the float32 facet: only the trade-off study's precision knob runs it (the loops the beside
     # sections run, recorded at their first call in one process: ad hoc, 2026-12-06)
-    _spec("speed", "Speed and accuracy", speed, compiles=(("facet", "float32", None, True),)),
+    _spec("speed", "Speed and accuracy", speed, compiles=(("facet", "float32", None, True),), alone=True),
     _spec("stability", "Stability sweep at the extremes", edge_findings, beside=True),
     _spec("scenes", "Scenes and the mechanisms they build", scenes),
     _spec("contributed", "Contributed models (scatterbench.models entry points)", contributed),
