@@ -409,3 +409,30 @@ def test_a_failed_late_compile_leaves_the_section_to_compile_its_own(monkeypatch
     log, _, results = _late_compile(monkeypatch, fail=True)
     assert log[-2:] == ["compiled", "needs"]
     assert results["sections"]["needs"]["error"] is None and results["summary"]["n_fail"] == 0
+
+
+class _Stop(Exception):
+    """Raised by a stand-in example fit, carrying what it saw."""
+
+
+def _fit_seeing(started, wait):
+    def fit(ctx):
+        raise _Stop(started.wait(wait))  # whether the recovery study had started meanwhile
+
+    return fit
+
+
+def test_the_recovery_study_starts_on_the_workers_before_the_example_fit_runs_here(monkeypatch):
+    """The uncertainty section's two studies: the recovery's tasks go to the workers and the
+    example fit runs in this process meanwhile, not before them (on many cores the fit was
+    the report's longest path); in-process the fit runs first, as nothing would overlap."""
+    from scatterbench.validation.report.sections import uncertainty
+
+    started = threading.Event()
+    monkeypatch.setattr(uncertainty, "_recovery", lambda ctx: started.set())
+    for executor, wait, seen in ((Workers(), 10.0, True), (executors.SerialExecutor(), 0.2, False)):
+        started.clear()
+        monkeypatch.setattr(uncertainty, "_fit", _fit_seeing(started, wait))
+        with pytest.raises(_Stop) as stop:
+            uncertainty.compute(CheckContext(quick=True, executor=executor))
+        assert stop.value.args[0] is seen
