@@ -422,10 +422,10 @@ def _fit_seeing(started, wait):
     return fit
 
 
-def test_the_recovery_study_starts_on_the_workers_before_the_example_fit_runs_here(monkeypatch):
-    """The uncertainty section's two studies: the recovery's tasks go to the workers and the
-    example fit runs in this process meanwhile, not before them (on many cores the fit was
-    the report's longest path); in-process the fit runs first, as nothing would overlap."""
+def test_the_recovery_study_and_the_example_fit_run_at_once_on_the_workers(monkeypatch):
+    """The uncertainty section's two studies: the recovery's tasks go to the workers while the
+    example fit is computed (its own task), not after it (on many cores the fit was the
+    report's longest path); in-process the fit runs first, as nothing would overlap."""
     from scatterbench.validation.report.sections import uncertainty
 
     started = threading.Event()

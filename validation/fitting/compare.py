@@ -24,7 +24,7 @@ from .datafile import load_data
 from .diagnostics import chain_seed, rhat
 from .diagnostics import load as load_diagnostics
 from .executors import SerialExecutor
-from .fit import FitResult, information_criteria, predictive, predictive_checks, run_fit
+from .fit import FitResult, fit_task, information_criteria, predictive, predictive_checks
 from .fitspec import fitspec_from
 from .likelihood import Likelihood
 from .recovery import subsample
@@ -134,15 +134,6 @@ def _with_rhat(row, fits):
     return row
 
 
-def _fit_one(job):
-    """One chain of one scene (a task): ``job`` is ``(likelihood, settings)``.
-
-    Runs where the executor puts it, whole (a fit's chain is seeded by ``settings``
-    alone, so it is the same chain wherever it runs)."""
-    lik, settings = job
-    return run_fit(lik, settings)
-
-
 def _row(job):
     """A scene's comparison row from its chains (a task): ``job`` is ``(name, fits, seed)``."""
     return _comparison_row(*job)
@@ -177,7 +168,7 @@ def _compare_groups(groups, settings, executor, chains=1):
     pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
     seeds = [chain_seed(settings.seed, c) for c in range(chains)]
     jobs = [(lik, dataclasses.replace(settings, seed=s)) for lik, _ in pairs for s in seeds]
-    done = ex.map(_fit_one, jobs, tasks=len(jobs), meanwhile=load_diagnostics if chains > 1 else None)
+    done = ex.map(fit_task, jobs, tasks=len(jobs), meanwhile=load_diagnostics if chains > 1 else None)
     per_fit = [done[i * chains : (i + 1) * chains] for i in range(len(pairs))]
     rows = ex.map(
         _row, [(nm, f, settings.seed) for (_, nm), f in zip(pairs, per_fit, strict=True)], tasks=len(pairs)

@@ -29,6 +29,7 @@ __all__ = [
     "FitError",
     "FitResult",
     "run_fit",
+    "fit_task",
     "predictive",
     "write_fit",
     "fingerprint",
@@ -163,6 +164,14 @@ def run_fit(
     # the kept chain's own burn-in ("burn_in": 2 max tau of it, dropped from its samples)
     summary["sampling"]["burned_before_chain"] = burned
     return FitResult(lik, optimum, chain, summary, settings)
+
+
+def fit_task(job):
+    """:func:`run_fit` of ``job``, ``(likelihood, settings)``, as an executor's task (a
+    module-level function of one item): it runs wherever the executor puts it, whole, and
+    gives the same chain there, which ``settings`` alone seeds."""
+    lik, settings = job
+    return run_fit(lik, settings)
 
 
 def information_criteria(fit: FitResult) -> dict:
