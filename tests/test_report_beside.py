@@ -13,6 +13,7 @@ import importlib
 import sys
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
@@ -126,16 +127,10 @@ def test_what_later_stages_read_is_in_page_order_whatever_order_sections_are_don
     def broken_now(ctx):
         raise RuntimeError("broken")
 
-    def render_setting(event):
-        def render(sec, data):
-            event.set()
-
-        return render
-
     specs = [
         SectionSpec("b0", "B0", failing_after(events[1]), _rendering([]), beside=True),
         SectionSpec("b1", "B1", failing_after(events[0]), _rendering([]), beside=True),
-        SectionSpec("b2", "B2", lambda ctx: 0, render_setting(events[0]), beside=True),
+        SectionSpec("b2", "B2", lambda ctx: 0, _rendering_sets([], events[0]), beside=True),
         SectionSpec("first", "First", broken_now, _rendering([])),
         SectionSpec("alone", "Alone", broken_now, _rendering([]), alone=True),
     ]
@@ -415,24 +410,31 @@ class _Stop(Exception):
     """Raised by a stand-in example fit, carrying what it saw."""
 
 
-def _fit_seeing(started, wait):
-    def fit(ctx):
-        raise _Stop(started.wait(wait))  # whether the recovery study had started meanwhile
+class _Submitting(Workers):
+    """Runs a map's tasks on threads while the caller does its ``meanwhile``, as worker
+    processes do."""
 
-    return fit
+    def map(self, fn, items, tasks=None, meanwhile=None):
+        with ThreadPoolExecutor(len(items)) as pool:
+            futs = [pool.submit(fn, x) for x in items]
+            if meanwhile is not None:
+                meanwhile()
+            return [f.result() for f in futs]
 
 
-def test_the_recovery_study_and_the_example_fit_run_at_once_on_the_workers(monkeypatch):
-    """The uncertainty section's two studies: the recovery's tasks go to the workers while the
-    example fit is computed (its own task), not after it (on many cores the fit was the
-    report's longest path); in-process the fit runs first, as nothing would overlap."""
+def test_the_recovery_study_runs_while_the_example_fit_runs_on_the_workers(monkeypatch):
+    """The uncertainty section's example fit is a task, and the recovery study's tasks go to the
+    workers while it runs, not after it (on many cores the fit was the report's longest path):
+    the stand-in fit waits for the recovery to start, and sees it start only then."""
     from scatterbench.validation.report.sections import uncertainty
 
     started = threading.Event()
-    monkeypatch.setattr(uncertainty, "_recovery", lambda ctx: started.set())
-    for executor, wait, seen in ((Workers(), 10.0, True), (executors.SerialExecutor(), 0.2, False)):
-        started.clear()
-        monkeypatch.setattr(uncertainty, "_fit", _fit_seeing(started, wait))
-        with pytest.raises(_Stop) as stop:
-            uncertainty.compute(CheckContext(quick=True, executor=executor))
-        assert stop.value.args[0] is seen
+    monkeypatch.setattr(uncertainty, "recovery_cells", lambda ctx: started.set())
+
+    def fit(job):
+        raise _Stop(started.wait(10.0), threading.current_thread() is threading.main_thread())
+
+    monkeypatch.setattr(uncertainty, "fit_task", fit)
+    with pytest.raises(_Stop) as stop:
+        uncertainty.compute(CheckContext(quick=True, executor=_Submitting()))
+    assert stop.value.args == (True, False)  # the recovery started meanwhile; the fit a task

@@ -2,11 +2,8 @@
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import functools
 import tempfile
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 from scatterbench import references
@@ -112,15 +109,20 @@ def _recovery(ctx):
 
 
 def _fit(ctx):
-    """The example fit, its posterior.json summary (truth check, predictive checks) and data."""
+    """The example fit, its posterior.json summary (truth check, predictive checks) and data;
+    the recovery study (:func:`recovery_cells`) run meanwhile."""
 
     sc = scene_mod.load(references.scene_path(FIT_SCENE))
     data = load_data(references.data_path(FIT_DATA))
     spec = fitspec_from(sc)
     st = _fit_settings(ctx.quick, ctx.seed)
-    # a task, as each of the recovery's: in this process it took its CPU (8.9 s alone, 13.9 s
-    # in a full report on 2 cores, ad hoc) from what every section thread here shares
-    fit = ctx.runner().map(fit_task, [(Likelihood(sc, spec, data), st)], tasks=1)[0]
+    # a task, the recovery study's tasks submitted from here while it runs (its results kept
+    # in ctx's memo): computed here before them, the fit took its CPU (8.9 s alone, 13.9 s in
+    # a full report on 2 cores, ad hoc) from what every section thread shares and held the
+    # recovery back (106.8 s after it), the whole fit on a many-core report's longest path;
+    # each has its own seed, so the results are the same
+    job = (Likelihood(sc, spec, data), st)
+    fit = ctx.runner().map(fit_task, [job], tasks=1, meanwhile=functools.partial(recovery_cells, ctx))[0]
     with tempfile.TemporaryDirectory() as tmp:  # write_fit's summary (truth check, predictive checks)
         post = write_fit(fit, tmp, data_path=FIT_DATA, scene_path=FIT_SCENE, plots=False)
     return fit, post, data, spec, st
@@ -177,28 +179,10 @@ def _sampling_row(samp, timing):
     }
 
 
-@contextlib.contextmanager
-def _started(ctx, study):
-    """``study(ctx)`` started on a thread of its own (in a copy of this thread's context) when
-    its tasks run on worker processes or a cluster, so that this thread's own work in the block
-    overlaps them; yields the callable that returns its result (waiting for it).  In-process
-    it is computed when asked, after the block: nothing would overlap."""
-    if ctx.runner().kind == "serial":
-        yield functools.partial(study, ctx)
-        return
-    with ThreadPoolExecutor(1, thread_name_prefix="scatterbench-study") as pool:
-        yield pool.submit(contextvars.copy_context().run, study, ctx).result
-
-
 def compute(ctx):
-    # the recovery's tasks and the example fit's at once: the fit first, in this process, held
-    # the recovery back (a full report on 2 cores: the fit 13.9 s, then the recovery 106.8 s,
-    # ad hoc), the whole fit on a many-core report's longest path; each has its own seed, so
-    # the results are the same
-    with _started(ctx, _recovery) as recovery:
-        fit, post, data, spec, st = _fit(ctx)
-        pp = predictive(fit, n_draws=200, seed=ctx.seed)
-        recovered = recovery()
+
+    fit, post, data, spec, st = _fit(ctx)
+    pp = predictive(fit, n_draws=200, seed=ctx.seed)
     pprows = tuple(
         {"term": t, "rows": c["rows"], "inside 68%": c["inside_68"], "inside 95%": c["inside_95"]}
         for t, c in post["posterior_predictive"].items()
@@ -217,7 +201,7 @@ def compute(ctx):
         posterior_rows=_posterior_rows(data, post),
         sampling_rows=(_sampling_row(samp, post["timing"]),),
         predictive_rows=pprows,
-        recovery=recovered,
+        recovery=_recovery(ctx),  # its study already run, by _fit
     )
 
 
