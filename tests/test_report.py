@@ -246,7 +246,13 @@ def test_speed_section_shows_the_peer_timings_as_measured():
     assert not hasattr(speed, "QUOTED_US")
     knob = KnobResult("k", "q", "ref", [Point(1.0, 1e-3, 1e-3, 10), Point(2.0, 1e-4, 2e-3, 20)])
     throughput = (
-        {"model": "M", "geometries per call": 5, "us per geometry (CPU)": 1.0, "us per geometry (wall)": 1.0},
+        {
+            "model": "M",
+            "geometries per call": 5,
+            "kernel threads": 1,
+            "us per geometry (CPU)": 1.0,
+            "us per geometry (wall)": 1.0,
+        },
     )
     data = speed.SpeedData((knob,), ((),), 5, throughput, rows, run)
     sec = Section("speed", "Speed")

@@ -113,6 +113,27 @@ def test_the_trade_off_runs_its_knobs_one_task_each_with_the_same_errors():
     assert errors(spied) == errors(serial) and len(serial) == 2
 
 
+def test_the_speed_section_times_the_knobs_and_each_models_throughput_in_one_map(monkeypatch):
+    """One task per knob and per model, in one map: the section runs alone, so on many workers
+    it takes about its longest task.  The rows name the model and the threads it ran on."""
+    from scatterbench import models
+    from scatterbench.validation.report.core import Context
+    from scatterbench.validation.report.sections import speed
+
+    knob = tradeoff.KNOBS["precision"]
+    monkeypatch.setattr(tradeoff, "KNOBS", {"precision": knob})
+    few = [models.FacetBRDF.sweep_base(), models.CookTorranceBRDF.sweep_base()]
+    monkeypatch.setattr(speed, "default_models", lambda: few)
+    spy = Spy()
+    data = speed.compute(Context(quick=True, executor=spy))
+    assert spy.tasks == [1 + len(few)]
+    assert [r.knob for r in data.knobs] == ["precision"]
+    assert [r["model"] for r in data.throughput_rows] == ["FacetBRDF", "CookTorranceBRDF"]
+    for row in data.throughput_rows:
+        assert row["geometries per call"] == data.geometries and row["kernel threads"] >= 1
+        assert row["us per geometry (CPU)"] > 0 and row["us per geometry (wall)"] > 0
+
+
 # ----------------------------------------------------------------------------- the results
 def _subset(monkeypatch):
     """The report's sections and checks cut to :data:`SUBSET` and :data:`CHECK`, on the same path."""

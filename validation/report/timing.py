@@ -2,7 +2,7 @@
 the executor (``--workers N``, ``--scheduler``) and however loaded the machine.
 
 Left out: every ``seconds``, the date and the commit; the measured speeds (the speed section's
-per-geometry throughput); the trade-off's Pareto fronts (which settings no other beats on cost
+per-geometry throughput and the threads it ran on); the trade-off's Pareto fronts (which settings no other beats on cost
 and error is decided by measured seconds).  Everything else, every check's measured value and
 status, every table and tracked number, stays.
 """
@@ -14,9 +14,18 @@ import json
 
 __all__ = ["without_timings", "results_digest"]
 
-#: keys whose values are measured times, anywhere in results.json
+#: keys whose values are measured times, anywhere in results.json, and the kernel threads the
+#: speed section's throughput was timed on (a worker's share of the cores: the executor's)
 _TIMED_KEYS = frozenset(
-    {"seconds", "phase_seconds", "date", "git_commit", "us per geometry (CPU)", "us per geometry (wall)"}
+    {
+        "seconds",
+        "phase_seconds",
+        "date",
+        "git_commit",
+        "us per geometry (CPU)",
+        "us per geometry (wall)",
+        "kernel threads",
+    }
 )
 #: per section: the ``numbers`` tables chosen by measured time (prefixes)
 _TIMED_TABLES = {"speed": ("pareto|",), "provenance": ("section_times",)}

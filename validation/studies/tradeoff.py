@@ -67,6 +67,11 @@ __all__ = [
     "float32_unavailable",
     "at_precision",
     "study",
+    "run",
+    "measure_knob",
+    "knob_tasks",
+    "collected",
+    "throughput",
     "pareto",
     "choose",
 ]
@@ -399,13 +404,41 @@ def choose(result: KnobResult, tol: float):
     return min(ok, key=lambda p: p.seconds) if ok else None
 
 
-def _measure(job):
-    """One knob measured (a task of :func:`study`): ``(KnobResult, None)`` or ``(None, why)``."""
-    fn, quick = job
+def run(task):
+    """``task()``: what :func:`study` maps, so that one map can carry tasks of different
+    functions (each a ``functools.partial``: the report's speed section sends the knobs and
+    the models' :func:`throughput` together)."""
+    return task()
+
+
+def measure_knob(knob, quick=False):
+    """Registered knob function ``knob`` measured: ``(KnobResult, None)``, or ``(None, why)``
+    when it cannot be here (:class:`KnobUnavailable`).  A task of :func:`study` (the function
+    itself travels, so a worker imports the module that registered it)."""
     try:
-        return fn(quick=quick), None
+        return knob(quick=quick), None
     except KnobUnavailable as exc:
         return None, str(exc)
+
+
+def knob_tasks(names=None, quick=False):
+    """``(names, tasks)``: the knobs ``names`` (default every one) and a :func:`measure_knob`
+    task (for :func:`run`) for each."""
+    names = list(names or KNOBS)
+    return names, [functools.partial(measure_knob, KNOBS[n], quick) for n in names]
+
+
+def collected(names, done, skipped=None):
+    """The :class:`KnobResult` of each measured knob of ``names`` (``done``: their
+    :func:`measure_knob` results, in order); a knob that could not be measured is left out,
+    its reason put in the dict ``skipped`` when one is given."""
+    out = []
+    for n, (result, why) in zip(names, done, strict=True):
+        if result is not None:
+            out.append(result)
+        elif skipped is not None:
+            skipped[n] = why
+    return out
 
 
 def study(names=None, quick=False, skipped=None, executor=None):
@@ -417,13 +450,20 @@ def study(names=None, quick=False, skipped=None, executor=None):
     The errors do not depend on it; each cost is timed where its knob runs, on that worker's
     share of the cores, beside the other knobs' work.
     """
-    names = list(names or KNOBS)
-    jobs = [(KNOBS[n], quick) for n in names]
-    done = (executor or SerialExecutor()).map(_measure, jobs, tasks=len(jobs))
-    out = []
-    for n, (result, why) in zip(names, done, strict=True):
-        if result is not None:
-            out.append(result)
-        elif skipped is not None:
-            skipped[n] = why
-    return out
+    names, tasks = knob_tasks(names, quick)
+    return collected(names, (executor or SerialExecutor()).map(run, tasks, tasks=len(tasks)), skipped)
+
+
+def throughput(model, n, seed, k=None):
+    """``(Timing, threads)``: the cost of one ``model.mueller`` call (:func:`time_call`) on the
+    first ``k`` (default all) of ``n`` random geometries drawn with ``seed`` (incidence and
+    reflection in [0, 1.45] rad, azimuth in [-pi, pi]), and the threads its compiled kernels
+    may run on where it was timed (``numba.get_num_threads``: a worker's share of the cores)."""
+    import numba  # numba (heavy): loaded where the kernels run anyway
+
+    rng = np.random.default_rng(seed)
+    ti, tr = rng.uniform(0, 1.45, (2, n))
+    pr = rng.uniform(-math.pi, math.pi, n)
+    k = n if k is None else k
+    _, timing = time_call(functools.partial(model.mueller, ti[:k], tr[:k], pr[:k]))
+    return timing, numba.get_num_threads()

@@ -4,21 +4,25 @@ the peers' timings measured by ``benchmarks/peers.py`` (committed data, read her
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import dataclass
-
-import numpy as np
 
 from scatterbench import references
 from scatterbench.models.kernels import PARALLEL_MIN
-from scatterbench.validation.studies.tradeoff import pareto, study, time_call
+from scatterbench.validation.studies import tradeoff
+from scatterbench.validation.studies.tradeoff import pareto, throughput
 
 from ..core import figure_block, table_block
 from ._common import default_models, is_heavy, plt
 
 __all__ = ["SpeedData", "compute", "render"]
 
-_THROUGHPUT = ["model", "geometries per call", "us per geometry (CPU)", "us per geometry (wall)"]
+_THROUGHPUT = [
+    "model",
+    "geometries per call",
+    "kernel threads",
+    "us per geometry (CPU)",
+    "us per geometry (wall)",
+]
 _PEERS = [
     "model",
     "peer",
@@ -37,6 +41,7 @@ _PEER_RUN = ["date", "machine", "load average (1 min, start / end)", "threads", 
 class SpeedData:
     """``knobs``: the trade-off study's results (each with every measured point);
     ``pareto``: per knob, its non-dominated points' rows; ``geometries``: throughput sample size;
+    ``throughput_rows``: per model, its cost per geometry and the kernel threads it ran on;
     ``peer_rows``, ``peer_run``: :func:`scatterbench.references.peer_timings`' pairs with their ratios, and
     the run that measured them (date, machine, load, threads)."""
 
@@ -52,27 +57,29 @@ class SpeedData:
 HEAVY_GEOMETRIES = 200
 
 
-def _throughput(n, seed):
-    """Per model, the cost of one ``mueller`` call on ``n`` random geometries
-    (:data:`HEAVY_GEOMETRIES` for the Monte Carlo and wrapper models), timed by the
-    trade-off study's :func:`time_call`."""
+def _throughput_tasks(n, seed):
+    """Per model, a :func:`~scatterbench.validation.studies.tradeoff.throughput` task (for
+    ``tradeoff.run``): one ``mueller`` call on ``n`` random geometries
+    (:data:`HEAVY_GEOMETRIES` of them for the Monte Carlo and wrapper models)."""
+    return [
+        functools.partial(
+            throughput, m, n, seed, HEAVY_GEOMETRIES if is_heavy(m) else n
+        )  # per geometry compared
+        for m in default_models()
+    ]
 
-    rng = np.random.default_rng(seed)
-    ti, tr = rng.uniform(0, 1.45, (2, n))
-    pr = rng.uniform(-math.pi, math.pi, n)
-    rows = []
-    for m in default_models():
-        k = HEAVY_GEOMETRIES if is_heavy(m) else n  # per-geometry cost is what is compared
-        _, t = time_call(functools.partial(m.mueller, ti[:k], tr[:k], pr[:k]))
-        rows.append(
-            {
-                "model": type(m).__name__,
-                "geometries per call": k,
-                "us per geometry (CPU)": t.seconds / k * 1e6,
-                "us per geometry (wall)": t.wall_seconds / k * 1e6,
-            }
-        )
-    return tuple(rows)
+
+def _throughput_row(task, measured):
+    """The throughput table's row of ``task`` (:func:`_throughput_tasks`) from what it measured."""
+    model, k = task.args[0], task.args[3]
+    t, threads = measured
+    return {
+        "model": type(model).__name__,
+        "geometries per call": k,
+        "kernel threads": threads,
+        "us per geometry (CPU)": t.seconds / k * 1e6,
+        "us per geometry (wall)": t.wall_seconds / k * 1e6,
+    }
 
 
 def _peers():
@@ -109,8 +116,14 @@ def _peers():
 
 
 def compute(ctx):
-
-    knobs = tuple(study(quick=ctx.quick, executor=ctx.runner()))  # knobs one task each
+    # the knobs and the models' throughput in one map, a task each: on many workers the speed
+    # section, which runs alone (it times code), takes about its longest task; before, the
+    # throughput ran after the knobs in this process, 2.0-2.3 s on 2 cores (ad hoc, 2026-12-08)
+    n = 20_000 if ctx.quick else 200_000
+    names, knob_tasks = tradeoff.knob_tasks(quick=ctx.quick)
+    rates = _throughput_tasks(n, ctx.seed)
+    done = ctx.runner().map(tradeoff.run, knob_tasks + rates, tasks=len(knob_tasks) + len(rates))
+    knobs = tuple(tradeoff.collected(names, done[: len(names)]))
     fronts = tuple(
         tuple(
             {"setting": p.setting, "error": p.error, "seconds": p.seconds, "evaluations": p.evaluations}
@@ -118,8 +131,8 @@ def compute(ctx):
         )
         for r in knobs
     )
-    n = 20_000 if ctx.quick else 200_000
-    return SpeedData(knobs, fronts, n, _throughput(n, ctx.seed), *_peers())
+    rows = tuple(_throughput_row(task, out) for task, out in zip(rates, done[len(names) :], strict=True))
+    return SpeedData(knobs, fronts, n, rows, *_peers())
 
 
 def _draw(d):
@@ -149,9 +162,10 @@ def render(s, d: SpeedData):
         )
     caption = (
         f"throughput: one mueller call on {d.geometries} random geometries ({HEAVY_GEOMETRIES} for "
-        "Monte Carlo and wrapper models), this run; best batch of validation.studies.tradeoff.time_call, "
-        "CPU time of every thread of the process (the kernels run on every core from "
-        f"{PARALLEL_MIN} geometries) and wall time"
+        "Monte Carlo and wrapper models), this run, each model a task on the run's executor beside the "
+        "knobs' tasks; best batch of validation.studies.tradeoff.time_call, CPU time of every thread of "
+        "the process that timed it and wall time; the kernels run on that process's kernel threads (a "
+        f"worker's share of the cores) from {PARALLEL_MIN} geometries"
     )
     s.blocks.append(table_block(s, "throughput", _THROUGHPUT, d.throughput_rows, caption=caption))
     run = d.peer_run
