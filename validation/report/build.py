@@ -109,15 +109,33 @@ def _plan(ctx, specs):
 
 
 @contextlib.contextmanager
-def _computing(ctx, specs):
-    """``{future: spec}`` of ``specs``' :func:`_computed`, each on a thread of its own (in a
-    copy of this thread's context: the backend and precision settings), their tasks then
-    sharing the executor's workers; the block's end waits for them."""
-    if not specs:
-        yield {}
+def _computing(ctx, count):
+    """A function that starts a section's :func:`_computed` on a thread of its own (in a copy
+    of this thread's context: the backend and precision settings) and returns its future, the
+    sections' tasks then sharing the executor's workers; at most ``count`` sections; the
+    block's end waits for them."""
+    if not count:
+        yield None
         return
-    with ThreadPoolExecutor(len(specs), thread_name_prefix="scatterbench-section") as pool:
-        yield {pool.submit(contextvars.copy_context().run, _computed, ctx, sp): sp for sp in specs}
+    with ThreadPoolExecutor(count, thread_name_prefix="scatterbench-section") as pool:
+        yield lambda spec: pool.submit(contextvars.copy_context().run, _computed, ctx, spec)
+
+
+def _started(submit, beside):
+    """``{future: spec}`` of the ``beside`` sections, started by ``submit`` (:func:`_computing`):
+    first those without :attr:`~.core.SectionSpec.preloads`, then, once this thread has run
+    the preloads (:func:`preload`: ArviZ, ~2 s), the others.  Before, a report ran the preloads
+    before any section, on a 16-core machine on its longest path (the replay of
+    ``benchmarks/report_schedule.py``); now the first ones' tasks run meanwhile.  Nothing of
+    theirs can cross the preloads: the sections before the side-by-side ones are done, and the
+    threads of those started first imported no module and entered no
+    ``warnings.catch_warnings`` in the whole report (ad hoc, 2026-12-08: a ``sys.meta_path``
+    hook and a wrapped ``catch_warnings.__enter__`` in ``report --quick`` and the full report;
+    only the PTFE section's thread swaps the warnings' state, after the preloads)."""
+    futures = {submit(sp): sp for sp in beside if not sp.preloads}
+    preload([sp for sp in beside if sp.preloads])
+    futures.update({submit(sp): sp for sp in beside if sp.preloads})
+    return futures
 
 
 class _Rendering:
@@ -159,7 +177,8 @@ def _run_sections(ctx, specs):
         t = time.perf_counter()
         first = [(spec, _computed_after(ctx, spec, late, bar)) for spec in before]
         t_beside = time.perf_counter()
-        with _computing(ctx, beside) as futures:
+        with _computing(ctx, len(beside)) as submit:
+            futures = _started(submit, beside) if beside else {}
             for spec, computed in first:
                 render(spec, computed)
             for fut in as_completed(futures):
@@ -348,8 +367,8 @@ def build_report(
     wanted = None if only is None else set(only) | {"summary", "provenance"}
     specs = [sp for sp in SECTIONS if wanted is None or sp.id in wanted]
     compiling = compile_ahead(ctx.executor)
-    preload(specs)  # while the workers compile, if they do
-    if compiling is not None:
+    if compiling is not None:  # a first run: the preloads while the workers compile (then done)
+        preload(specs)
         compiling.result()
     start = time.perf_counter() - t0
     sections, phases = _run_sections(ctx, specs)
@@ -362,7 +381,7 @@ def build_report(
         "quick": quick,
         "seed": seed,
         "seconds": time.perf_counter() - t0,
-        # where those seconds went: before the sections (compile-ahead, preloads), then _run_sections'
+        # where those seconds went: before the sections (compile-ahead), then _run_sections'
         "phase_seconds": {"start": start, **phases},
     }
     results = {

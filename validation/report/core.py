@@ -91,7 +91,8 @@ class SectionSpec:
 
     ``preloads``: callables of no arguments that import what the section's compute imports on
     first use (ArviZ, and what xarray imports at its first dataset): a report runs them on its
-    main thread before the sections' threads start (:func:`~.build.preload`).
+    main thread before the threads of the sections that declare them start, while those that
+    declare none compute (:func:`~.build.preload`, :func:`~.build._started`).
     """
 
     id: str
