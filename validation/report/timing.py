@@ -2,9 +2,9 @@
 the executor (``--workers N``, ``--scheduler``) and however loaded the machine.
 
 Left out: every ``seconds``, the date and the commit; the measured speeds (the speed section's
-per-geometry throughput and the threads it ran on); the trade-off's Pareto fronts (which settings no other beats on cost
-and error is decided by measured seconds).  Everything else, every check's measured value and
-status, every table and tracked number, stays.
+per-geometry throughput and the threads it ran on); the trade-off's Pareto fronts (which
+settings no other beats on cost and error is decided by measured seconds).  Everything else,
+every check's measured value and status, every table and tracked number, stays.
 """
 
 from __future__ import annotations

@@ -61,12 +61,11 @@ def _throughput_tasks(n, seed):
     """Per model, a :func:`~scatterbench.validation.studies.tradeoff.throughput` task (for
     ``tradeoff.run``): one ``mueller`` call on ``n`` random geometries
     (:data:`HEAVY_GEOMETRIES` of them for the Monte Carlo and wrapper models)."""
-    return [
-        functools.partial(
-            throughput, m, n, seed, HEAVY_GEOMETRIES if is_heavy(m) else n
-        )  # per geometry compared
-        for m in default_models()
-    ]
+    tasks = []
+    for m in default_models():
+        k = HEAVY_GEOMETRIES if is_heavy(m) else n  # per-geometry cost is what is compared
+        tasks.append(functools.partial(throughput, m, n, seed, k))
+    return tasks
 
 
 def _throughput_row(task, measured):
