@@ -17,7 +17,8 @@
 #   5. the full model comparison on 16 workers and in-process, with digests (scaling.py;
 #      COMPARISON_WORKERS, default "16 1", the worker counts);
 #   6. the full `report` restricted to 2 cores (taskset, 2 workers, NUMBA_NUM_THREADS=2: numba
-#      counts the host's cores, not the affinity mask).
+#      counts the host's cores, not the affinity mask), by benchmarks/report_schedule.py: it
+#      also replays the run's schedule on 16 workers, the estimate that part 4 measures.
 #   7. the comparison's 16 chains one after another on one thread, each split into its optimum,
 #      burn-in and kept chain (benchmarks/comparison_chains.py --burn 1000; ~85 s on the 2-core
 #      machine): what bounds part 5 on that machine, and by how much the workers' start-up and
@@ -114,10 +115,12 @@ part5() {
         --studies comparison --workers ${COMPARISON_WORKERS:-16 1}
 }
 part6() {
-    echo "== 6. full report on 2 cores; load $(cut -d' ' -f1-3 /proc/loadavg)"
-    NUMBA_NUM_THREADS=2 timed full-2cores 420 taskset -c 0,1 $SB report --workers 2 --out "$WORK/rf2"
-    echo "full-2cores digest $(digest "$WORK/rf2")"
-    cp "$WORK/rf2/results.json" "$OUT/full2.json" 2>/dev/null
+    # recorded as it runs (benchmarks/report_schedule.py): its replay on 16 workers, printed
+    # beside it, is then checked against part 4's measurement on the same machine
+    echo "== 6. full report on 2 cores, its schedule replayed on 16 workers; load $(cut -d' ' -f1-3 /proc/loadavg)"
+    NUMBA_NUM_THREADS=2 timeout 420 taskset -c 0,1 python3 benchmarks/report_schedule.py --workers 2 \
+        --replay 2 16 --save "$OUT/schedule2.json"
+    echo "exit $?"
 }
 part7() {
     echo "== 7. the comparison's chains, one thread, one after another; load $(cut -d' ' -f1-3 /proc/loadavg)"
