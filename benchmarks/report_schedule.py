@@ -178,9 +178,11 @@ def replay(sections, ids, workers, slower, t):
 
 
 def phases(rec):
-    """``(sections, renders, before, beside, after)``: the record's programs and its section ids
-    in three groups: computed on the report's thread before the side-by-side ones started, on
-    threads of their own, on the report's thread after them (each in the order they ran)."""
+    """``(sections, renders, before, beside, after, lead)``: the record's programs, its section
+    ids in three groups (computed on the report's thread before the side-by-side ones started,
+    on threads of their own, on the report's thread after them; each in the order they ran),
+    and the seconds from the first side-by-side section's start to the report's first render
+    (its thread's own work meanwhile: starting the sections, the preloads)."""
     sections, renders, threads = programs(rec["events"])
     starts = {key: t for _, kind, key, t, _ in rec["events"] if kind == "start"}
     order = sorted(sections, key=starts.get)
@@ -190,20 +192,21 @@ def phases(rec):
     after = [s for s in order if s not in beside and s not in before]
     for sid in beside:  # started later than the first (after the preloads): that long later
         sections[sid] = [("work", starts[sid] - first), *sections[sid]]
-    return sections, renders, before, beside, after
+    drawn = [t - x for _, kind, key, t, x in rec["events"] if kind == "render" and key in before + beside]
+    lead = min(drawn) - first if beside and drawn else 0.0
+    return sections, renders, before, beside, after, max(lead, 0.0)
 
 
 def estimate(rec, workers, slower):
     """``(seconds, ends)``: the replayed report on ``workers`` workers and when each of its side-by-side
     sections ended (from the start of the sections)."""
-    sections, renders, before, beside, after = phases(rec)
+    sections, renders, before, beside, after, lead = phases(rec)
     t = rec["phase_seconds"]["start"]
     for sid in before:
         t = replay(sections, [sid], workers, slower, t)[sid]
-    # this thread renders once it has started the side-by-side sections (the last, after the
-    # preloads), the first sections' renders first
-    started = max((sections[s][0][1] for s in beside), default=0.0)
-    t_beside, rendered = t, t + started + sum(renders.get(s, 0.0) for s in before)
+    # this thread renders once it has started the side-by-side sections and run the preloads
+    # (``lead``), the first sections' renders first
+    t_beside, rendered = t, t + lead + sum(renders.get(s, 0.0) for s in before)
     ends = replay(sections, beside, workers, slower, t) if beside else {}
     for sid in sorted(beside, key=ends.get):  # the report's thread renders each as it finishes
         rendered = max(rendered, ends[sid]) + renders.get(sid, 0.0)

@@ -37,8 +37,8 @@ def _record():
 
 
 def test_the_record_is_cut_into_each_sections_steps(schedule):
-    sections, renders, before, beside, after = schedule.phases(_record())
-    assert (before, beside, after) == (["a"], ["b", "c"], ["z"])
+    sections, renders, before, beside, after, lead = schedule.phases(_record())
+    assert (before, beside, after, lead) == (["a"], ["b", "c"], ["z"], 0.0)
     steps = sections["b"]
     assert [st[0] for st in steps] == ["work", "work", "map", "wait", "work"]
     assert [st[1] for st in steps if st[0] == "work"] == pytest.approx([0.0, 0.1, 0.1])
@@ -67,14 +67,17 @@ def test_the_replay_runs_tasks_first_submitted_first_on_the_first_free_worker(
 
 def test_a_section_started_later_than_the_first_waits_that_long_and_so_do_the_renders(schedule):
     """A side-by-side section started after the others (after the preloads) starts that much
-    later in the replay, and the report's thread renders only once it has started it."""
+    later in the replay; the report's thread renders once it has done what it did first (here
+    1.5 s: the first render, 0.1 s long, ends at 1.8 s)."""
     rec = _record()
+    later = {"c", 2}
     rec["events"] = [
-        (th, k, key, t + 1.0 if key == "c" or key == 2 else t, x) for th, k, key, t, x in rec["events"]
+        (th, k, key, t + 1.0 if key in later else t + 1.5 if (k, key) == ("render", "a") else t, x)
+        for th, k, key, t, x in rec["events"]
     ]
-    sections, *_ = schedule.phases(rec)
-    assert sections["c"][0] == ("work", pytest.approx(1.0))
+    sections, *_, lead = schedule.phases(rec)
+    assert sections["c"][0] == ("work", pytest.approx(1.0)) and lead == pytest.approx(1.5)
     # two workers: b's tasks first now, 0.8-1.8 on both (b ends 1.9); c's 1.8-4.8; the renders
-    # from 1.7 (0.7 + 1.0)
+    # from 2.2 (0.7 + 1.5), c's last at 4.8, then z
     total, ends = schedule.estimate(rec, 2, 1.0)
     assert ends == pytest.approx({"b": 1.2, "c": 4.1}) and total == pytest.approx(5.3)

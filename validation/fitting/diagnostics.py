@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 
 import numpy as np
 
@@ -24,15 +25,26 @@ def chain_seed(seed: int, index: int) -> int:
     return int(np.random.SeedSequence([int(seed), int(index)]).generate_state(1)[0])
 
 
-@functools.cache
+#: one thread at a time runs :func:`load`: a report's thread runs it while the sections that use
+#: ArviZ start, and they call it too before they use ArviZ (they then wait for that run)
+_LOADING = threading.Lock()
+
+
 def load():
     """Import ArviZ (about 2 s) and run it once on a tiny posterior (0.4-0.6 s, ad hoc): what the
     comparison's R-hat and the PTFE study need, loaded where they will run.  ArviZ's first
     InferenceData makes xarray import ~140 more modules (``dask.array``, the chunk managers'
-    entry points, ``psutil``...; ad hoc, 2026-12-07), so a report runs this on its main thread
-    before its sections' threads start (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`):
-    imports on threads side by side can cross (877275d: a half-imported ``dask.array``).  Once
-    per process."""
+    entry points, ``psutil``...; ad hoc, 2026-12-07), and imports on threads side by side can
+    cross (877275d: a half-imported ``dask.array``), so one thread at a time runs this (a
+    lock), and whoever uses ArviZ on a thread beside others calls it first: a report's main
+    thread runs it (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`), and
+    the sections that use ArviZ wait for it there.  Once per process."""
+    with _LOADING:
+        _load()
+
+
+@functools.cache
+def _load():
     import warnings
 
     import arviz

@@ -122,19 +122,17 @@ def _computing(ctx, count):
 
 
 def _started(submit, beside):
-    """``{future: spec}`` of the ``beside`` sections, started by ``submit`` (:func:`_computing`):
-    first those without :attr:`~.core.SectionSpec.preloads`, then, once this thread has run
-    the preloads (:func:`preload`: ArviZ, ~2 s), the others.  Before, a report ran the preloads
-    before any section, on a 16-core machine on its longest path (the replay of
-    ``benchmarks/report_schedule.py``); now the first ones' tasks run meanwhile.  Nothing of
-    theirs can cross the preloads: the sections before the side-by-side ones are done, and the
-    threads of those started first imported no module and entered no
-    ``warnings.catch_warnings`` in the whole report (ad hoc, 2026-12-08: a ``sys.meta_path``
-    hook and a wrapped ``catch_warnings.__enter__`` in ``report --quick`` and the full report;
-    only the PTFE section's thread swaps the warnings' state, after the preloads)."""
-    futures = {submit(sp): sp for sp in beside if not sp.preloads}
-    preload([sp for sp in beside if sp.preloads])
-    futures.update({submit(sp): sp for sp in beside if sp.preloads})
+    """``{future: spec}`` of the ``beside`` sections, each started by ``submit``
+    (:func:`_computing`); then this thread runs their preloads (:func:`preload`: ArviZ's
+    import, 1.3-2.2 s), while their tasks run.  A section that uses what a preload imports
+    calls it too, and waits for this thread's run (``diagnostics.load`` takes a lock): one
+    thread imports, and the others import nothing meanwhile (ad hoc, 2026-12-08: in
+    ``report --quick`` and the full report, a ``sys.meta_path`` hook saw no module imported by
+    a section's thread, and a wrapped ``catch_warnings.__enter__`` no swap of the warnings'
+    state but the PTFE section's, after its tasks).  Before, a report ran the preloads before
+    any section: on a 16-core machine, on its longest path (``benchmarks/report_schedule.py``)."""
+    futures = {submit(sp): sp for sp in beside}
+    preload(beside)
     return futures
 
 

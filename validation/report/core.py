@@ -91,8 +91,9 @@ class SectionSpec:
 
     ``preloads``: callables of no arguments that import what the section's compute imports on
     first use (ArviZ, and what xarray imports at its first dataset): a report runs them on its
-    main thread before the threads of the sections that declare them start, while those that
-    declare none compute (:func:`~.build.preload`, :func:`~.build._started`).
+    main thread once the sections have started, and the section calls them too before it uses
+    what they import, waiting for that run (each runs once, one thread at a time:
+    :func:`~.build.preload`, :func:`~.build._started`).
     """
 
     id: str

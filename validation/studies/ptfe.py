@@ -18,6 +18,7 @@ import numpy as np
 
 from scatterbench.models import scene as scene_mod
 from scatterbench.references import scene_path
+from scatterbench.validation.fitting import diagnostics
 from scatterbench.validation.fitting.executors import SerialExecutor
 from scatterbench.validation.fitting.fit import run_fit
 from scatterbench.validation.fitting.mueller_fit import (
@@ -178,6 +179,7 @@ def pointwise_loglik(fit) -> np.ndarray:
 def inference_data(fit, loglik):
     """An ArviZ InferenceData: the posterior in physical units (one chain per walker) and
     the per-row log-likelihood as ``log_likelihood['rows']``."""
+    diagnostics.load()  # ArviZ imported by one thread at a time (beside a report's others)
     import arviz as az
 
     U = _kept(fit)
@@ -188,6 +190,7 @@ def inference_data(fit, loglik):
 def compare_models(idatas: dict) -> dict:
     """PSIS-LOO (with Pareto-k counts) and WAIC per model and ArviZ's LOO comparison
     (``elpd_diff`` and its standard error ``dse`` against the best)."""
+    diagnostics.load()  # ArviZ imported by one thread at a time (beside a report's others)
     import arviz as az
 
     out = {}
