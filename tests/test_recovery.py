@@ -60,6 +60,30 @@ def test_study_members_are_identical_on_any_executor(setup):
     assert w[1] > w[0]
 
 
+def test_a_study_without_a_progress_bar_maps_every_member_at_once(setup):
+    """Without a progress bar no cell waits for the previous one: one map, a task per member;
+    with one, a map per cell (the bar moves); the same results either way."""
+    from scatterbench.validation.fitting.executors import SerialExecutor
+
+    class Spy(SerialExecutor):
+        def __init__(self):
+            self.tasks = []
+
+        def map(self, fn, items, tasks=None, meanwhile=None):
+            self.tasks.append(tasks)
+            return super().map(fn, items, tasks, meanwhile)
+
+    sc, data = setup
+    spec = fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0.1"])
+    st = ChainSettings(walkers=4, seed=1, max_steps=40, check_every=40)
+    kw = dict(noise_levels=(0.05, 0.2), n_geometries=(6,), injections=2)
+    once, by_cell = Spy(), Spy()
+    a = recovery_study(sc, spec, data, st, executor=once, **kw)
+    b = recovery_study(sc, spec, data, st, executor=by_cell, progress=True, **kw)
+    assert once.tasks == [4] and by_cell.tasks == [2, 2]
+    assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+
+
 def test_recovery_command(tmp_path, capsys):
     out = str(tmp_path / "rec")
     args = [
