@@ -159,10 +159,10 @@ def _compare_groups(groups, settings, executor, chains=1):
     need no ArviZ.  Before, the rows computed the R-hat on the workers, which imported ArviZ
     from tasks queued behind the chains: with 16 workers (on 2 cores, ad hoc) one row in eight
     still landed on a worker that had not, where it costs ~2 s after the longest chain.  In a
-    report this runs on a section's thread, where ArviZ is already imported
-    (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`): an import on a thread
-    beside other sections' can cross theirs (877275d, reverted: CPython handed one a
-    half-imported ``dask.array``)."""
+    report this runs on a section's thread while the report's thread imports ArviZ
+    (:attr:`~scatterbench.validation.report.core.SectionSpec.preloads`); the load here waits
+    for that import (a lock), as an import on a thread beside another's can cross it (877275d,
+    reverted: CPython handed one a half-imported ``dask.array``)."""
 
     ex = executor or SerialExecutor()
     pairs = [(lik, nm) for liks, names in groups for lik, nm in zip(liks, names, strict=True)]
