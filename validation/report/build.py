@@ -304,9 +304,10 @@ def _in_background(executor, groups):
 
 def preload(specs):
     """Run, on this thread (a report's main thread), what the sections of ``specs`` need imported
-    (:attr:`~.core.SectionSpec.preloads`, each once), before their threads start: an import on a
-    section's thread beside other sections' imports can cross theirs (877275d: CPython handed
-    one a half-imported ``dask.array`` in about one ``report --quick`` of five).  A preload that
+    (:attr:`~.core.SectionSpec.preloads`, each once), once their threads have started
+    (:func:`_started`; a first run, while its workers compile): an import on a section's thread
+    beside other sections' imports can cross theirs (877275d: CPython handed one a
+    half-imported ``dask.array`` in about one ``report --quick`` of five).  A preload that
     raises is left to the sections that import what it imports, which then fail alone (with
     its error), as a broken section must not lose the rest of the report."""
     for load in dict.fromkeys(fn for spec in specs for fn in spec.preloads):
