@@ -5,6 +5,7 @@ import os
 
 import numpy as np
 import pytest
+from spy_executor import Spy
 
 from scatterbench import references
 from scatterbench.models import scene
@@ -63,16 +64,6 @@ def test_study_members_are_identical_on_any_executor(setup):
 def test_a_study_without_a_progress_bar_maps_every_member_at_once(setup):
     """Without a progress bar no cell waits for the previous one: one map, a task per member;
     with one, a map per cell (the bar moves); the same results either way."""
-    from scatterbench.validation.fitting.executors import SerialExecutor
-
-    class Spy(SerialExecutor):
-        def __init__(self):
-            self.tasks = []
-
-        def map(self, fn, items, tasks=None, meanwhile=None):
-            self.tasks.append(tasks)
-            return super().map(fn, items, tasks, meanwhile)
-
     sc, data = setup
     spec = fitspec_from(sc, ["sigma:0.01:1:log"], ["brdf=0.1"])
     st = ChainSettings(walkers=4, seed=1, max_steps=40, check_every=40)

@@ -11,6 +11,7 @@ import json
 import os
 
 import pytest
+from spy_executor import Spy
 
 from scatterbench.validation.checks import registry
 from scatterbench.validation.checks.registry import CheckContext
@@ -25,17 +26,6 @@ from scatterbench.validation.studies import tradeoff
 
 SUBSET = ("seed003_presets", "stability", "summary", "provenance")
 CHECK = "stability.check_stability"
-
-
-class Spy(SerialExecutor):
-    """In-process, counting the tasks it was given."""
-
-    def __init__(self):
-        self.tasks = []
-
-    def map(self, fn, items, tasks=None, meanwhile=None):
-        self.tasks.append(tasks)
-        return super().map(fn, items, tasks, meanwhile)
 
 
 # ----------------------------------------------------------------------------- the flags
