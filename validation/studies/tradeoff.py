@@ -454,16 +454,13 @@ def study(names=None, quick=False, skipped=None, executor=None):
     return collected(names, (executor or SerialExecutor()).map(run, tasks, tasks=len(tasks)), skipped)
 
 
-def throughput(model, n, seed, k=None):
-    """``(Timing, threads)``: the cost of one ``model.mueller`` call (:func:`time_call`) on the
-    first ``k`` (default all) of ``n`` random geometries drawn with ``seed`` (incidence and
-    reflection in [0, 1.45] rad, azimuth in [-pi, pi]), and the threads its compiled kernels
-    may run on where it was timed (``numba.get_num_threads``: a worker's share of the cores)."""
+def throughput(model, n, seed):
+    """``(Timing, threads)``: the cost of one ``model.mueller`` call (:func:`time_call`) on
+    ``n`` random geometries drawn with ``seed`` (:func:`random_geometries`, polar angles up to
+    83 deg), and the threads its compiled kernels may run on where it was timed
+    (``numba.get_num_threads``: a worker's share of the cores)."""
     import numba  # numba (heavy): loaded where the kernels run anyway
 
-    rng = np.random.default_rng(seed)
-    ti, tr = rng.uniform(0, 1.45, (2, n))
-    pr = rng.uniform(-math.pi, math.pi, n)
-    k = n if k is None else k
-    _, timing = time_call(functools.partial(model.mueller, ti[:k], tr[:k], pr[:k]))
+    ti, tr, pr = random_geometries(n, seed=seed, max_deg=83.0)
+    _, timing = time_call(functools.partial(model.mueller, ti, tr, pr))
     return timing, numba.get_num_threads()

@@ -64,13 +64,13 @@ def _throughput_tasks(n, seed):
     tasks = []
     for m in default_models():
         k = HEAVY_GEOMETRIES if is_heavy(m) else n  # per-geometry cost is what is compared
-        tasks.append(functools.partial(throughput, m, n, seed, k))
+        tasks.append(functools.partial(throughput, m, k, seed))
     return tasks
 
 
 def _throughput_row(task, measured):
     """The throughput table's row of ``task`` (:func:`_throughput_tasks`) from what it measured."""
-    model, k = task.args[0], task.args[3]
+    model, k = task.args[0], task.args[1]
     t, threads = measured
     return {
         "model": type(model).__name__,
