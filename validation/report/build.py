@@ -109,31 +109,25 @@ def _plan(ctx, specs):
 
 
 @contextlib.contextmanager
-def _computing(ctx, count):
-    """A function that starts a section's :func:`_computed` on a thread of its own (in a copy
-    of this thread's context: the backend and precision settings) and returns its future, the
-    sections' tasks then sharing the executor's workers; at most ``count`` sections; the
-    block's end waits for them."""
-    if not count:
-        yield None
+def _computing(ctx, beside):
+    """``{future: spec}`` of the ``beside`` sections' :func:`_computed`, each on a thread of its
+    own (in a copy of this thread's context: the backend and precision settings), their tasks
+    then sharing the executor's workers; once all have started, this thread runs their
+    preloads (:func:`preload`: ArviZ's import, 1.3-2.2 s) while their tasks run.  A section
+    that uses what a preload imports calls it too, and waits for this thread's run
+    (``diagnostics.load`` takes a lock): one thread imports, and the others import nothing
+    meanwhile (ad hoc, 2026-12-08: in ``report --quick`` and the full report, a
+    ``sys.meta_path`` hook saw no module imported by a section's thread, and a wrapped
+    ``catch_warnings.__enter__`` no swap of the warnings' state but the PTFE section's, after
+    its tasks).  Before, a report ran the preloads before any section: on a 16-core machine, on
+    its longest path (``benchmarks/report_schedule.py``).  The block's end waits for them."""
+    if not beside:
+        yield {}
         return
-    with ThreadPoolExecutor(count, thread_name_prefix="scatterbench-section") as pool:
-        yield lambda spec: pool.submit(contextvars.copy_context().run, _computed, ctx, spec)
-
-
-def _started(submit, beside):
-    """``{future: spec}`` of the ``beside`` sections, each started by ``submit``
-    (:func:`_computing`); then this thread runs their preloads (:func:`preload`: ArviZ's
-    import, 1.3-2.2 s), while their tasks run.  A section that uses what a preload imports
-    calls it too, and waits for this thread's run (``diagnostics.load`` takes a lock): one
-    thread imports, and the others import nothing meanwhile (ad hoc, 2026-12-08: in
-    ``report --quick`` and the full report, a ``sys.meta_path`` hook saw no module imported by
-    a section's thread, and a wrapped ``catch_warnings.__enter__`` no swap of the warnings'
-    state but the PTFE section's, after its tasks).  Before, a report ran the preloads before
-    any section: on a 16-core machine, on its longest path (``benchmarks/report_schedule.py``)."""
-    futures = {submit(sp): sp for sp in beside}
-    preload(beside)
-    return futures
+    with ThreadPoolExecutor(len(beside), thread_name_prefix="scatterbench-section") as pool:
+        futures = {pool.submit(contextvars.copy_context().run, _computed, ctx, sp): sp for sp in beside}
+        preload(beside)
+        yield futures
 
 
 class _Rendering:
@@ -175,8 +169,7 @@ def _run_sections(ctx, specs):
         t = time.perf_counter()
         first = [(spec, _computed_after(ctx, spec, late, bar)) for spec in before]
         t_beside = time.perf_counter()
-        with _computing(ctx, len(beside)) as submit:
-            futures = _started(submit, beside) if beside else {}
+        with _computing(ctx, beside) as futures:
             for spec, computed in first:
                 render(spec, computed)
             for fut in as_completed(futures):
@@ -305,7 +298,7 @@ def _in_background(executor, groups):
 def preload(specs):
     """Run, on this thread (a report's main thread), what the sections of ``specs`` need imported
     (:attr:`~.core.SectionSpec.preloads`, each once), once their threads have started
-    (:func:`_started`; a first run, while its workers compile): an import on a section's thread
+    (:func:`_computing`; a first run, while its workers compile): an import on a section's thread
     beside other sections' imports can cross theirs (877275d: CPython handed one a
     half-imported ``dask.array`` in about one ``report --quick`` of five).  A preload that
     raises is left to the sections that import what it imports, which then fail alone (with

@@ -93,7 +93,7 @@ class SectionSpec:
     first use (ArviZ, and what xarray imports at its first dataset): a report runs them on its
     main thread once the sections have started, and the section calls them too before it uses
     what they import, waiting for that run (each runs once, one thread at a time:
-    :func:`~.build.preload`, :func:`~.build._started`).
+    :func:`~.build.preload`, :func:`~.build._computing`).
     """
 
     id: str
